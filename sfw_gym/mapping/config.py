@@ -1,0 +1,153 @@
+"""`MapperConfig`: every knob of k-estimation and sparse inverse k-visibility, validated."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+from sfw_gym.errors import ConfigError
+
+K_ESTIMATORS = ("distance_aware", "kmeans")
+ROUTER_POLICIES = ("strongest", "all")
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _is_int(v: Any) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+@dataclass(frozen=True)
+class MapperConfig:
+    """Configuration of the RSSI->k estimator and the sparse inverse k-visibility mapper.
+
+    Log-odds fields are natural-log odds of "occupied" added per observation; negative = free.
+
+    Attributes:
+        k_estimator: ``"distance_aware"`` clusters ``rssi + 10 n log10(d)`` (log-distance term
+            removed); ``"kmeans"`` clusters raw RSSI (the paper).
+        max_k: Largest k-value the estimator can output (K; K + 1 k-means clusters).
+        filter_window: Length of the sliding-window mean over each router's readings (1 = off).
+        path_loss_exponent: n in the log-distance term of the distance-aware feature.
+        min_distance_m: Distances below this are raised to it in the log-distance term.
+        refit_min_samples: Samples per router before the first k-means fit (a prior before).
+        refit_growth: Geometric refit schedule: the next fit after ``n * refit_growth`` samples.
+        refit_max_interval: Refit at least every this many samples, whatever the growth.
+        fit_buffer_size: Most samples per router kept for fitting (a uniform, strided subsample).
+        prior_wall_loss_db: Threshold spacing of the prior used before the first fit.
+        min_cluster_gap_db: Adjacent sorted centroids closer than this are merged (so data with
+            fewer than K + 1 levels is not split); 0 keeps exactly K + 1 clusters as the paper.
+        router_policy: ``"strongest"`` updates along the strongest router's ray only (the
+            paper); ``"all"`` fuses the rays of every heard router.
+        robot_radius_m: Footprint radius; footprint cells are observed free (rule 1).
+        free_log_odds: Per-cell log-odds on a ray piece with equal k at both ends (rules 2, 4).
+        footprint_log_odds: Per-cell log-odds for the robot's footprint each update.
+        bump_log_odds: Log-odds for the contact cell when the bumper fires.
+        wall_peak_probability: Eq. 6 peak P(occupied) of a one-wall piece no longer than
+            ``wall_ref_length_m``; longer pieces flatten (peak excess scales with ref / length).
+        wall_ref_length_m: Piece length up to which the Eq. 6 peak keeps its full height.
+        wall_sigma_fraction: Eq. 6 width: sigma = fraction * piece length.
+        wall_sigma_min_m: Lower bound on the Eq. 6 sigma.
+        log_odds_min: Clamp for free evidence (keeps the map able to change its mind).
+        log_odds_max: Clamp for wall evidence.
+        trajectory_gap_max_m: Successive positions closer than this are joined when rasterising
+            the trajectory (so rays cannot slip between samples); farther apart, only the cell.
+        extend_past_robot: Also update the piece from the robot to the next earlier trajectory
+            point beyond it on the same ray.
+        outer_bounds_m: Optional ``(xmin, ymin, xmax, ymax)``: cells outside are never updated
+            and carry no entropy.
+    """
+
+    k_estimator: str = "distance_aware"
+    max_k: int = 3
+    filter_window: int = 3
+    path_loss_exponent: float = 2.0
+    min_distance_m: float = 0.5
+    refit_min_samples: int = 32
+    refit_growth: float = 1.5
+    refit_max_interval: int = 2000
+    fit_buffer_size: int = 4096
+    prior_wall_loss_db: float = 10.0
+    min_cluster_gap_db: float = 5.0
+    router_policy: str = "strongest"
+    robot_radius_m: float = 0.17
+    free_log_odds: float = -0.4
+    footprint_log_odds: float = -1.0
+    bump_log_odds: float = 3.0
+    wall_peak_probability: float = 0.8
+    wall_ref_length_m: float = 0.5
+    wall_sigma_fraction: float = 0.25
+    wall_sigma_min_m: float = 0.05
+    log_odds_min: float = -4.0
+    log_odds_max: float = 4.0
+    trajectory_gap_max_m: float = 1.0
+    extend_past_robot: bool = True
+    outer_bounds_m: tuple[float, float, float, float] | None = None
+
+    def __post_init__(self) -> None:
+        if self.k_estimator not in K_ESTIMATORS:
+            raise ConfigError(f"k_estimator must be one of {K_ESTIMATORS}, got {self.k_estimator!r}")
+        if self.router_policy not in ROUTER_POLICIES:
+            raise ConfigError(
+                f"router_policy must be one of {ROUTER_POLICIES}, got {self.router_policy!r}"
+            )
+        ints = {
+            "max_k": (1, 32),
+            "filter_window": (1, 10_000),
+            "refit_min_samples": (2, 10**9),
+            "refit_max_interval": (1, 10**9),
+            "fit_buffer_size": (16, 10**8),
+        }
+        for name, (lo, hi) in ints.items():
+            v = getattr(self, name)
+            if not _is_int(v) or not lo <= v <= hi:
+                raise ConfigError(f"{name} must be an int in [{lo}, {hi}], got {v!r}")
+        positive = (
+            "path_loss_exponent",
+            "min_distance_m",
+            "prior_wall_loss_db",
+            "wall_ref_length_m",
+            "wall_sigma_fraction",
+            "wall_sigma_min_m",
+            "log_odds_max",
+            "bump_log_odds",
+        )
+        for name in positive:
+            v = getattr(self, name)
+            if not _is_number(v) or v <= 0:
+                raise ConfigError(f"{name} must be a finite number > 0, got {v!r}")
+        non_negative = ("min_cluster_gap_db", "robot_radius_m", "trajectory_gap_max_m")
+        for name in non_negative:
+            v = getattr(self, name)
+            if not _is_number(v) or v < 0:
+                raise ConfigError(f"{name} must be a finite number >= 0, got {v!r}")
+        for name in ("free_log_odds", "footprint_log_odds", "log_odds_min"):
+            v = getattr(self, name)
+            if not _is_number(v) or v >= 0:
+                raise ConfigError(f"{name} must be a finite number < 0, got {v!r}")
+        if not _is_number(self.refit_growth) or self.refit_growth <= 1.0:
+            raise ConfigError(f"refit_growth must be a number > 1, got {self.refit_growth!r}")
+        p = self.wall_peak_probability
+        if not _is_number(p) or not 0.5 < p < 1.0:
+            raise ConfigError(f"wall_peak_probability must be in (0.5, 1), got {p!r}")
+        if not isinstance(self.extend_past_robot, bool):
+            raise ConfigError(f"extend_past_robot must be a bool, got {self.extend_past_robot!r}")
+        if self.outer_bounds_m is not None:
+            b = self.outer_bounds_m
+            ok = isinstance(b, (tuple, list)) and len(b) == 4 and all(_is_number(v) for v in b)
+            if not ok or not (b[2] > b[0] and b[3] > b[1]):
+                raise ConfigError(
+                    f"outer_bounds_m must be None or (xmin, ymin, xmax, ymax) with max > min, "
+                    f"got {b!r}"
+                )
+            object.__setattr__(self, "outer_bounds_m", tuple(float(v) for v in b))
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-serialisable dict of the fields (round-trips through ``MapperConfig(**d)``)."""
+        d = asdict(self)
+        if d["outer_bounds_m"] is not None:
+            d["outer_bounds_m"] = list(d["outer_bounds_m"])
+        return d

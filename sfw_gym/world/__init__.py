@@ -1,0 +1,28 @@
+"""Ground truth of the simulation: floorplans, the radio model and the robot.
+
+Knows nothing of `sfw_gym.mapping`, `sfw_gym.envs` or `sfw_gym.agents`.
+"""
+
+from __future__ import annotations
+
+from sfw_gym.world.floorplan import (
+    MATERIALS,
+    Floorplan,
+    Room,
+    floorplan_from_polygon,
+    load_floorplan,
+)
+from sfw_gym.world.radio import NOT_HEARD_DBM, RadioConfig, RadioModel
+from sfw_gym.world.routers import place_routers
+
+__all__ = [
+    "MATERIALS",
+    "NOT_HEARD_DBM",
+    "Floorplan",
+    "RadioConfig",
+    "RadioModel",
+    "Room",
+    "floorplan_from_polygon",
+    "load_floorplan",
+    "place_routers",
+]

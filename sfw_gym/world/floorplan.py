@@ -1,0 +1,372 @@
+"""Floorplans: free space, walls with materials, wall counting, rasterisation, file formats."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import shapely
+from shapely.geometry import Polygon
+from shapely.validation import explain_validity
+
+from sfw_gym.errors import FloorplanError
+from sfw_gym.world.wall_crossing import DEFAULT_MIN_PIECE_M, cross_walls, cross_walls_parallel
+
+#: Wall materials that a floorplan may name; a radio preset maps each to a loss in dB.
+MATERIALS = ("generic", "drywall", "wood", "glass", "brick", "concrete")
+#: Thickness given to the exterior walls of plans that store only the free space (HouseExpo).
+EXTERIOR_WALL_M = 0.1
+#: Plausible extent of a building, metres: a plan outside this range is rejected.
+MIN_EXTENT_M, MAX_EXTENT_M = 1.0, 500.0
+#: A free space smaller than this cannot hold a robot: rejected as absurd.
+MIN_AREA_M2 = 0.5
+#: Above this many segments, wall counting runs on all cores.
+_PARALLEL_MIN_SEGMENTS = 2048
+FORMAT_NAME = "sfw_gym.floorplan"
+FORMAT_VERSION = 1
+
+
+@dataclass(frozen=True)
+class Room:
+    """A labelled axis-aligned room box (metres): metadata for placing routers and reporting."""
+
+    label: str
+    box: tuple[float, float, float, float]  # xmin, ymin, xmax, ymax
+
+
+@dataclass(frozen=True, eq=False)
+class Floorplan:
+    """Ground-truth geometry of one building storey.
+
+    The free space is one polygon (holes allowed); everything else inside the ``footprint`` is wall,
+    and everything outside the footprint is outside the building. Each edge of the free space is the
+    face of a wall and carries that wall's material.
+
+    Attributes:
+        free_space: shapely Polygon of the free space, metres.
+        footprint: shapely Polygon of the building including its walls.
+        edge_materials: material name of each free-space edge, in ring order (exterior ring, then
+            holes; each ring without its closing vertex).
+        name: an identifier (file id or generator seed).
+        rooms: labelled room boxes (metadata).
+    """
+
+    free_space: Polygon
+    footprint: Polygon
+    edge_materials: tuple[str, ...]
+    name: str = "floorplan"
+    rooms: tuple[Room, ...] = ()
+    edges: np.ndarray = field(init=False, repr=False)
+    edge_material_index: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        _check_polygon(self.free_space, "free_space", self.name)
+        _check_polygon(self.footprint, "footprint", self.name)
+        if not self.footprint.buffer(1e-6).contains(self.free_space):
+            raise FloorplanError(f"floorplan {self.name!r}: the footprint does not contain the free space")
+        edges = _polygon_edges(self.free_space)
+        if len(self.edge_materials) != len(edges):
+            raise FloorplanError(
+                f"floorplan {self.name!r}: {len(self.edge_materials)} edge materials for "
+                f"{len(edges)} free-space edges"
+            )
+        unknown = sorted(set(self.edge_materials) - set(MATERIALS))
+        if unknown:
+            raise FloorplanError(
+                f"floorplan {self.name!r}: unknown wall material(s) {unknown}; known: {list(MATERIALS)}"
+            )
+        index = np.array([MATERIALS.index(m) for m in self.edge_materials], dtype=np.int64)
+        edges.setflags(write=False)
+        index.setflags(write=False)
+        object.__setattr__(self, "edges", edges)
+        object.__setattr__(self, "edge_material_index", index)
+
+    # ----------------------------------------------------------------------------------- geometry
+    @property
+    def bounds(self) -> tuple[float, float, float, float]:
+        """(xmin, ymin, xmax, ymax) of the footprint, metres."""
+        return tuple(float(v) for v in self.footprint.bounds)  # type: ignore[return-value]
+
+    @property
+    def area_m2(self) -> float:
+        """Free-space area in m²."""
+        return float(self.free_space.area)
+
+    def is_free(self, points: np.ndarray) -> np.ndarray:
+        """Whether each point (…, 2) lies in the free space (boundary counts as not free)."""
+        pts = np.asarray(points, dtype=np.float64)
+        return shapely.contains_xy(self.free_space, pts[..., 0], pts[..., 1])
+
+    def count_walls(
+        self, a: np.ndarray, b: np.ndarray, *, min_piece_m: float = DEFAULT_MIN_PIECE_M
+    ) -> np.ndarray:
+        """Number of distinct walls crossed by each segment a[i]→b[i].
+
+        A wall is a maximal piece of the segment outside the free space: a 0.1 m notch is one wall,
+        a 1 cm bevel or staircase adds none, touching a wall's end is not a crossing.
+
+        Args:
+            a: (M, 2) or (2,) segment starts, metres.
+            b: (M, 2) or (2,) segment ends, broadcast against ``a``.
+            min_piece_m: pieces outside (and gaps inside a wall) shorter than this are ignored.
+
+        Returns:
+            (M,) int32 array (a scalar-shaped (1,) array for single points).
+        """
+        counts, _ = self._cross(a, b, np.zeros(len(MATERIALS)), min_piece_m)
+        return counts
+
+    def wall_loss_db(
+        self,
+        a: np.ndarray,
+        b: np.ndarray,
+        loss_by_material_db: Mapping[str, float],
+        *,
+        min_piece_m: float = DEFAULT_MIN_PIECE_M,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Wall counts and summed wall losses (dB) for segments a[i]→b[i].
+
+        Each crossed wall costs the loss of the material of the face the segment enters it by.
+        """
+        table = np.array([float(loss_by_material_db[m]) for m in MATERIALS])
+        return self._cross(a, b, table, min_piece_m)
+
+    def _cross(
+        self, a: np.ndarray, b: np.ndarray, table: np.ndarray, min_piece_m: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        a2, b2 = np.broadcast_arrays(np.asarray(a, np.float64), np.asarray(b, np.float64))
+        if a2.shape[-1] != 2:
+            raise FloorplanError(f"segment endpoints must have shape (M, 2), got {a2.shape}")
+        a2 = np.ascontiguousarray(a2.reshape(-1, 2))
+        b2 = np.ascontiguousarray(b2.reshape(-1, 2))
+        edge_loss = table[self.edge_material_index]
+        kernel = cross_walls_parallel if len(a2) >= _PARALLEL_MIN_SEGMENTS else cross_walls
+        return kernel(self.edges, edge_loss, a2, b2, float(min_piece_m))
+
+    def rasterize(self, resolution_m: float) -> tuple[np.ndarray, tuple[float, float]]:
+        """Ground-truth grid covering ``bounds``: 0 wall, 255 free, 127 outside the building.
+
+        Indexed [row, col] = [y, x]; cell centres at ``origin + (index + 0.5) * resolution_m``.
+        Each cell is sampled at sub-cells no coarser than 5 cm; a cell with any wall sample is wall
+        (so thin walls never vanish at coarse resolutions), else free with any free sample.
+
+        Returns:
+            (grid uint8 of shape (rows, cols), origin_xy).
+        """
+        if not (math.isfinite(resolution_m) and resolution_m > 0):
+            raise FloorplanError(f"resolution_m must be a positive number, got {resolution_m!r}")
+        xmin, ymin, xmax, ymax = self.bounds
+        cols = max(1, math.ceil((xmax - xmin) / resolution_m - 1e-9))
+        rows = max(1, math.ceil((ymax - ymin) / resolution_m - 1e-9))
+        sub = max(1, math.ceil(resolution_m / 0.05 - 1e-9))
+        step = resolution_m / sub
+        xs = xmin + (np.arange(cols * sub) + 0.5) * step
+        ys = ymin + (np.arange(rows * sub) + 0.5) * step
+        gx, gy = np.meshgrid(xs, ys)
+        free = shapely.contains_xy(self.free_space, gx, gy)
+        inside = shapely.contains_xy(self.footprint, gx, gy)
+        wall = inside & ~free
+        free = free.reshape(rows, sub, cols, sub).any(axis=(1, 3))
+        wall = wall.reshape(rows, sub, cols, sub).any(axis=(1, 3))
+        grid = np.full((rows, cols), 127, dtype=np.uint8)
+        grid[free] = 255
+        grid[wall] = 0
+        return grid, (xmin, ymin)
+
+    # ----------------------------------------------------------------------------------- files
+    def to_dict(self) -> dict[str, Any]:
+        """The sfw_gym JSON representation (exact: coordinates are stored as floats)."""
+        return {
+            "format": FORMAT_NAME,
+            "version": FORMAT_VERSION,
+            "name": self.name,
+            "free_space": {
+                "exterior": _ring_coords(self.free_space.exterior),
+                "holes": [_ring_coords(r) for r in self.free_space.interiors],
+            },
+            "footprint": _ring_coords(self.footprint.exterior),
+            "edge_materials": list(self.edge_materials),
+            "rooms": [{"label": r.label, "box": list(r.box)} for r in self.rooms],
+        }
+
+    def save(self, path: str | os.PathLike[str]) -> Path:
+        """Write the plan as sfw_gym JSON, atomically (temp file + rename). Returns the path."""
+        return write_text_atomic(Path(path), json.dumps(self.to_dict()))
+
+
+def write_text_atomic(path: Path, text: str) -> Path:
+    """Write ``text`` to ``path`` via a temp file in the same folder and an atomic rename."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def load_floorplan(source: str | os.PathLike[str] | Mapping[str, Any]) -> Floorplan:
+    """Load a HouseExpo JSON file or an sfw_gym JSON file (or an already parsed dict).
+
+    Raises:
+        FloorplanError: naming the file and the problem (not JSON, missing keys, too few vertices,
+            NaN/inf, self-intersecting or zero-area outline, absurd size, …).
+    """
+    if isinstance(source, Mapping):
+        where, data = "<dict>", source
+    else:
+        where = str(source)
+        try:
+            text = Path(source).read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise FloorplanError(f"{where}: cannot read floorplan file: {exc}") from exc
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise FloorplanError(f"{where}: not valid JSON: {exc}") from exc
+    if not isinstance(data, Mapping):
+        raise FloorplanError(f"{where}: expected a JSON object, got {type(data).__name__}")
+    try:
+        if data.get("format") == FORMAT_NAME:
+            return _from_sfw_dict(data)
+        if "verts" in data:
+            return _from_houseexpo_dict(data)
+    except FloorplanError as exc:
+        raise FloorplanError(f"{where}: {exc}") from None
+    raise FloorplanError(
+        f"{where}: neither a HouseExpo plan (key 'verts') nor an sfw_gym plan "
+        f"(key 'format' = {FORMAT_NAME!r}); keys found: {sorted(map(str, data))[:10]}"
+    )
+
+
+def floorplan_from_polygon(
+    free_space: Polygon,
+    *,
+    name: str = "floorplan",
+    material: str = "generic",
+    exterior_wall_m: float = EXTERIOR_WALL_M,
+    rooms: Sequence[Room] = (),
+) -> Floorplan:
+    """A plan whose walls all share one material, its footprint the free space grown by a wall."""
+    _check_polygon(free_space, "free_space", name)
+    grown = free_space.buffer(exterior_wall_m, join_style="mitre")
+    footprint = Polygon(grown.exterior)
+    n_edges = len(_polygon_edges(free_space))
+    return Floorplan(free_space, footprint, (material,) * n_edges, name=name, rooms=tuple(rooms))
+
+
+# --------------------------------------------------------------------------------------- helpers
+def _from_houseexpo_dict(data: Mapping[str, Any]) -> Floorplan:
+    name = str(data.get("id", "houseexpo"))
+    ring = _parse_ring(data["verts"], "verts")
+    rooms = []
+    categories = data.get("room_category", {})
+    if isinstance(categories, Mapping):
+        for label, boxes in categories.items():
+            for box in boxes if isinstance(boxes, list) else []:
+                coords = _parse_numbers(box, f"room_category[{label!r}]", 4)
+                rooms.append(Room(str(label), tuple(coords)))  # type: ignore[arg-type]
+    return floorplan_from_polygon(Polygon(ring), name=name, rooms=rooms)
+
+
+def _from_sfw_dict(data: Mapping[str, Any]) -> Floorplan:
+    if data.get("version") != FORMAT_VERSION:
+        raise FloorplanError(f"unsupported sfw_gym floorplan version {data.get('version')!r}")
+    for key in ("free_space", "footprint", "edge_materials"):
+        if key not in data:
+            raise FloorplanError(f"missing key {key!r}")
+    free = data["free_space"]
+    if not isinstance(free, Mapping) or "exterior" not in free:
+        raise FloorplanError("'free_space' must be an object with 'exterior' (and 'holes')")
+    holes = free.get("holes", [])
+    if not isinstance(holes, list):
+        raise FloorplanError("'free_space.holes' must be a list of rings")
+    shell = _parse_ring(free["exterior"], "free_space.exterior")
+    hole_rings = [_parse_ring(h, f"free_space.holes[{i}]") for i, h in enumerate(holes)]
+    materials = data["edge_materials"]
+    if not isinstance(materials, list) or not all(isinstance(m, str) for m in materials):
+        raise FloorplanError("'edge_materials' must be a list of material names")
+    rooms = []
+    for i, room in enumerate(data.get("rooms", [])):
+        if not isinstance(room, Mapping) or "label" not in room or "box" not in room:
+            raise FloorplanError(f"rooms[{i}] must be an object with 'label' and 'box'")
+        rooms.append(Room(str(room["label"]), tuple(_parse_numbers(room["box"], f"rooms[{i}].box", 4))))
+    return Floorplan(
+        Polygon(shell, hole_rings),
+        Polygon(_parse_ring(data["footprint"], "footprint")),
+        tuple(materials),
+        name=str(data.get("name", "floorplan")),
+        rooms=tuple(rooms),  # type: ignore[arg-type]
+    )
+
+
+def _parse_numbers(values: Any, what: str, n: int) -> list[float]:
+    if not isinstance(values, list | tuple) or len(values) != n:
+        raise FloorplanError(f"{what} must be a list of {n} numbers, got {values!r:.80}")
+    out = []
+    for v in values:
+        if isinstance(v, bool) or not isinstance(v, int | float):
+            raise FloorplanError(f"{what} must hold numbers, got {v!r:.40}")
+        out.append(float(v))
+    return out
+
+
+def _parse_ring(verts: Any, what: str) -> np.ndarray:
+    if not isinstance(verts, list):
+        raise FloorplanError(f"{what} must be a list of [x, y] vertices, got {type(verts).__name__}")
+    pts = np.array([_parse_numbers(v, f"{what}[{i}]", 2) for i, v in enumerate(verts)], np.float64)
+    if len(pts) and np.array_equal(pts[0], pts[-1]):
+        pts = pts[:-1]  # a closed ring: drop the repeated vertex
+    if len(pts) < 3:
+        raise FloorplanError(f"{what} has {len(pts)} distinct vertices; a polygon needs at least 3")
+    if not np.isfinite(pts).all():
+        raise FloorplanError(f"{what} contains NaN or infinite coordinates")
+    return pts
+
+
+def _check_polygon(poly: Any, what: str, name: str) -> None:
+    if not isinstance(poly, Polygon):
+        raise FloorplanError(f"floorplan {name!r}: {what} must be a shapely Polygon")
+    if poly.is_empty or poly.area <= 0:
+        raise FloorplanError(f"floorplan {name!r}: {what} has zero area")
+    coords = np.asarray(poly.exterior.coords)
+    if not np.isfinite(coords).all():
+        raise FloorplanError(f"floorplan {name!r}: {what} contains NaN or infinite coordinates")
+    if not poly.is_valid:
+        raise FloorplanError(
+            f"floorplan {name!r}: {what} is not a simple polygon ({explain_validity(poly)})"
+        )
+    xmin, ymin, xmax, ymax = poly.bounds
+    extent = max(xmax - xmin, ymax - ymin)
+    if not MIN_EXTENT_M <= extent <= MAX_EXTENT_M or max(map(abs, poly.bounds)) > 10 * MAX_EXTENT_M:
+        raise FloorplanError(
+            f"floorplan {name!r}: {what} spans {extent:.3g} m at {poly.bounds}; expected a building "
+            f"of {MIN_EXTENT_M:g}–{MAX_EXTENT_M:g} m in metres (wrong units?)"
+        )
+    if poly.area < MIN_AREA_M2:
+        raise FloorplanError(
+            f"floorplan {name!r}: {what} has an area of {poly.area:.3g} m² (< {MIN_AREA_M2} m²)"
+        )
+
+
+def _ring_coords(ring: Any) -> list[list[float]]:
+    return [[float(x), float(y)] for x, y in list(ring.coords)[:-1]]
+
+
+def _polygon_edges(poly: Polygon) -> np.ndarray:
+    """(E, 4) edges of all rings of ``poly`` in ring order, closing vertex excluded."""
+    parts = []
+    for ring in [poly.exterior, *poly.interiors]:
+        pts = np.asarray(ring.coords, dtype=np.float64)
+        parts.append(np.hstack([pts[:-1], pts[1:]]))
+    return np.ascontiguousarray(np.vstack(parts))

@@ -1,0 +1,288 @@
+"""WiFi RSSI simulation: log-distance path loss, per-wall losses, correlated shadowing, noise.
+
+RSSI [dBm] = P_tx − (PL(d0) + 10·n·log10(d/d0)) − min(Σ wall losses, cap) + shadowing(x) + noise,
+rounded to an integer; a reading below the sensitivity floor is "not heard" (``NOT_HEARD_DBM``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, field, replace
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+from numba import njit
+from shapely.geometry import Point
+
+from sfw_gym.errors import ConfigError
+from sfw_gym.world.floorplan import MATERIALS, Floorplan
+
+#: Sentinel RSSI of a router that is not heard.
+NOT_HEARD_DBM = -100
+_SPEED_OF_LIGHT_M_S = 299_792_458.0
+#: Per-material losses at 2.4 GHz (COST-231, IEEE TGax); "generic" is an unknown wall (HouseExpo).
+RESIDENTIAL_LOSS_DB = MappingProxyType(
+    {"generic": 10.0, "drywall": 3.0, "wood": 3.0, "glass": 2.0, "brick": 8.0, "concrete": 12.0}
+)
+PRESETS = ("default", "thick", "residential")
+BANDS = {"2.4": 2.437, "5": 5.25}
+
+
+def free_space_path_loss_db(distance_m: float, frequency_ghz: float) -> float:
+    """Friis free-space path loss 20·log10(4π d f / c) in dB."""
+    return 20.0 * math.log10(4.0 * math.pi * distance_m * frequency_ghz * 1e9 / _SPEED_OF_LIGHT_M_S)
+
+
+def _uniform_losses(loss_db: float) -> Mapping[str, float]:
+    return MappingProxyType(dict.fromkeys(MATERIALS, loss_db))
+
+
+@dataclass(frozen=True)
+class RadioConfig:
+    """Radio model parameters (DESIGN.md defaults: the ``default`` preset at 2.4 GHz).
+
+    ``path_loss_d0_db`` of ``None`` means the free-space loss at ``reference_distance_m`` for
+    ``frequency_ghz`` (40.2 dB at 1 m, 2.437 GHz). Distances below ``reference_distance_m`` are
+    clamped to it.
+    """
+
+    frequency_ghz: float = 2.437
+    tx_power_dbm: float = 20.0
+    path_loss_d0_db: float | None = None
+    reference_distance_m: float = 1.0
+    path_loss_exponent: float = 2.0
+    wall_loss_db: Mapping[str, float] = field(default_factory=lambda: _uniform_losses(10.0))
+    max_total_wall_loss_db: float = 45.0
+    shadowing_sigma_db: float = 4.0
+    shadowing_correlation_m: float = 5.0
+    noise_sigma_db: float = 2.0
+    sensitivity_dbm: float = -90.0
+
+    def __post_init__(self) -> None:
+        positive = ("frequency_ghz", "reference_distance_m", "path_loss_exponent",
+                    "shadowing_correlation_m")
+        non_negative = ("max_total_wall_loss_db", "shadowing_sigma_db", "noise_sigma_db")
+        for name in (*positive, *non_negative, "tx_power_dbm", "sensitivity_dbm"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+                raise ConfigError(f"RadioConfig.{name} must be a finite number, got {value!r}")
+            if name in positive and value <= 0:
+                raise ConfigError(f"RadioConfig.{name} must be > 0, got {value!r}")
+            if name in non_negative and value < 0:
+                raise ConfigError(f"RadioConfig.{name} must be ≥ 0, got {value!r}")
+        if self.path_loss_d0_db is not None and not math.isfinite(self.path_loss_d0_db):
+            raise ConfigError(f"RadioConfig.path_loss_d0_db must be finite, got {self.path_loss_d0_db!r}")
+        if not isinstance(self.wall_loss_db, Mapping):
+            raise ConfigError("RadioConfig.wall_loss_db must map material names to losses in dB")
+        missing = sorted(set(MATERIALS) - set(self.wall_loss_db))
+        unknown = sorted(set(self.wall_loss_db) - set(MATERIALS))
+        if missing or unknown:
+            raise ConfigError(
+                f"RadioConfig.wall_loss_db must give a loss for exactly {list(MATERIALS)}; "
+                f"missing {missing}, unknown {unknown}"
+            )
+        for material, loss in self.wall_loss_db.items():
+            if not (isinstance(loss, int | float) and math.isfinite(loss) and loss >= 0):
+                raise ConfigError(f"RadioConfig.wall_loss_db[{material!r}] must be ≥ 0, got {loss!r}")
+        object.__setattr__(self, "wall_loss_db", MappingProxyType(dict(self.wall_loss_db)))
+
+    @classmethod
+    def preset(cls, name: str = "default", band: str = "2.4", **overrides: Any) -> RadioConfig:
+        """A named preset: ``default`` (10 dB per wall), ``thick`` (15 dB, the paper's building),
+        ``residential`` (per-material losses: the hard mode); ``band`` "2.4" or "5" GHz.
+
+        At 5 GHz only the frequency (hence PL(d0) ≈ 46.8 dB) changes; wall losses stay the preset's.
+        """
+        losses = {"default": _uniform_losses(10.0), "thick": _uniform_losses(15.0),
+                  "residential": RESIDENTIAL_LOSS_DB}
+        if name not in losses:
+            raise ConfigError(f"unknown radio preset {name!r}; choose one of {list(PRESETS)}")
+        if band not in BANDS:
+            raise ConfigError(f"unknown radio band {band!r}; choose one of {list(BANDS)}")
+        try:
+            return cls(frequency_ghz=BANDS[band], wall_loss_db=losses[name], **overrides)
+        except TypeError as exc:
+            raise ConfigError(f"RadioConfig.preset: {exc}") from None
+
+    @property
+    def d0_loss_db(self) -> float:
+        """PL(d0) in dB: the configured value or the free-space loss at d0."""
+        if self.path_loss_d0_db is not None:
+            return float(self.path_loss_d0_db)
+        return free_space_path_loss_db(self.reference_distance_m, self.frequency_ghz)
+
+    def noiseless(self) -> RadioConfig:
+        """The same model without shadowing or temporal noise."""
+        return replace(self, shadowing_sigma_db=0.0, noise_sigma_db=0.0)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-serialisable fields."""
+        out = asdict(self)
+        out["wall_loss_db"] = dict(self.wall_loss_db)
+        return out
+
+
+class ShadowingField:
+    """Spatially correlated Gaussian shadowing, one independent field per router, fixed once drawn.
+
+    Exponential covariance σ²·exp(−r/L) (Gudmundson), drawn by random Fourier features (the
+    spectral density of the 2-D exponential kernel is a bivariate Student-t with 1 degree of freedom,
+    scaled by 1/L) and tabulated on a grid that is interpolated bilinearly.
+    """
+
+    def __init__(
+        self,
+        bounds: tuple[float, float, float, float],
+        n_routers: int,
+        sigma_db: float,
+        correlation_m: float,
+        rng: np.random.Generator,
+        *,
+        n_features: int = 128,
+        spacing_m: float = 0.5,
+    ) -> None:
+        xmin, ymin, xmax, ymax = bounds
+        self._origin = np.array([xmin - spacing_m, ymin - spacing_m])
+        self._spacing_m = spacing_m
+        nx = math.ceil((xmax - xmin) / spacing_m) + 3
+        ny = math.ceil((ymax - ymin) / spacing_m) + 3
+        gy, gx = np.meshgrid(np.arange(ny), np.arange(nx), indexing="ij")
+        nodes = self._origin + spacing_m * np.stack([gx.ravel(), gy.ravel()], axis=1)
+        tables = []
+        for _ in range(n_routers):
+            omega = rng.standard_normal((n_features, 2)) / (
+                correlation_m * np.abs(rng.standard_normal((n_features, 1))) + 1e-12
+            )
+            phase = rng.uniform(0.0, 2.0 * np.pi, n_features)
+            values = sigma_db * math.sqrt(2.0 / n_features) * np.cos(nodes @ omega.T + phase).sum(1)
+            tables.append(values.reshape(ny, nx))
+        self.table_db = np.stack(tables)  # (R, ny, nx), node (j, i) at origin + spacing·(i, j)
+
+    def __call__(self, points: np.ndarray) -> np.ndarray:
+        """Shadowing in dB at points (M, 2) for every router: (M, R)."""
+        return _bilinear(self.table_db, self._origin, self._spacing_m, points)
+
+
+@njit(cache=True)
+def _bilinear(tables: np.ndarray, origin: np.ndarray, spacing: float, pts: np.ndarray) -> np.ndarray:
+    """Bilinear interpolation of (R, ny, nx) node tables at points (M, 2), clamped to the grid."""
+    n_r, ny, nx = tables.shape
+    out = np.empty((pts.shape[0], n_r))
+    for m in range(pts.shape[0]):
+        fx = min(max((pts[m, 0] - origin[0]) / spacing, 0.0), nx - 1.000001)
+        fy = min(max((pts[m, 1] - origin[1]) / spacing, 0.0), ny - 1.000001)
+        i = int(fx)
+        j = int(fy)
+        tx = fx - i
+        ty = fy - j
+        for r in range(n_r):
+            top = tables[r, j, i] * (1 - tx) + tables[r, j, i + 1] * tx
+            bottom = tables[r, j + 1, i] * (1 - tx) + tables[r, j + 1, i + 1] * tx
+            out[m, r] = top * (1 - ty) + bottom * ty
+    return out
+
+
+class RadioModel:
+    """RSSI from routers at fixed positions in one floorplan, with one episode's shadowing.
+
+    Args:
+        floorplan: the ground-truth plan.
+        routers: (R, 2) router positions in metres; each must lie in the free space.
+        config: the radio parameters.
+        rng: the source of the shadowing field (drawn here) and of temporal noise (each reading).
+    """
+
+    def __init__(
+        self,
+        floorplan: Floorplan,
+        routers: np.ndarray,
+        config: RadioConfig | None = None,
+        rng: np.random.Generator | None = None,
+    ) -> None:
+        self.floorplan = floorplan
+        self.config = config or RadioConfig()
+        self.routers = validate_routers(floorplan, routers)
+        self.rng = rng if rng is not None else np.random.default_rng()
+        self._d0_loss_db = self.config.d0_loss_db
+        self._shadowing = (
+            ShadowingField(
+                floorplan.bounds,
+                len(self.routers),
+                self.config.shadowing_sigma_db,
+                self.config.shadowing_correlation_m,
+                self.rng,
+            )
+            if self.config.shadowing_sigma_db > 0
+            else None
+        )
+
+    @property
+    def n_routers(self) -> int:
+        """Number of routers R."""
+        return len(self.routers)
+
+    def _points(self, points: np.ndarray) -> np.ndarray:
+        pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        if not np.isfinite(pts).all():
+            raise ConfigError("points must be finite (got NaN or inf)")
+        return pts
+
+    def path_loss_db(self, points: np.ndarray) -> np.ndarray:
+        """Log-distance path loss (no walls) to each router: (M, R) dB."""
+        pts = self._points(points)
+        d = np.linalg.norm(pts[:, None, :] - self.routers[None, :, :], axis=2)
+        d = np.maximum(d, self.config.reference_distance_m)
+        ratio = np.log10(d / self.config.reference_distance_m)
+        return self._d0_loss_db + 10.0 * self.config.path_loss_exponent * ratio
+
+    def true_k(self, points: np.ndarray) -> np.ndarray:
+        """Number of walls between each router and each point: (M, R) int."""
+        pts = self._points(points)
+        return np.stack([self.floorplan.count_walls(r, pts) for r in self.routers], axis=1)
+
+    def mean_rssi(self, points: np.ndarray) -> np.ndarray:
+        """RSSI without temporal noise (path loss, capped walls, shadowing): (M, R) float dBm."""
+        pts = self._points(points)
+        walls = np.stack(
+            [self.floorplan.wall_loss_db(r, pts, self.config.wall_loss_db)[1] for r in self.routers],
+            axis=1,
+        )
+        rssi = (
+            self.config.tx_power_dbm
+            - self.path_loss_db(pts)
+            - np.minimum(walls, self.config.max_total_wall_loss_db)
+        )
+        if self._shadowing is not None:
+            rssi += self._shadowing(pts)
+        return rssi
+
+    def measure(self, point: np.ndarray) -> np.ndarray:
+        """One reading at ``point`` (2,): (R,) integer dBm, ``NOT_HEARD_DBM`` below sensitivity."""
+        rssi = self.mean_rssi(point)[0]
+        if self.config.noise_sigma_db > 0:
+            rssi = rssi + self.rng.normal(0.0, self.config.noise_sigma_db, rssi.shape)
+        reading = np.rint(rssi).astype(np.int32)
+        reading[reading < self.config.sensitivity_dbm] = NOT_HEARD_DBM
+        return reading
+
+
+def validate_routers(floorplan: Floorplan, routers: np.ndarray) -> np.ndarray:
+    """Routers as a (R, 2) float array, each in the plan's free space, else a ConfigError."""
+    arr = np.asarray(routers, dtype=np.float64)
+    if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) == 0:
+        raise ConfigError(f"routers must have shape (R, 2) with R ≥ 1, got {arr.shape}")
+    if not np.isfinite(arr).all():
+        raise ConfigError(f"router positions must be finite, got {arr.tolist()}")
+    free = floorplan.is_free(arr)
+    for i in np.flatnonzero(~free):
+        x, y = arr[i]
+        inside = floorplan.footprint.contains(Point(x, y))
+        where = "inside a wall" if inside else "outside the building"
+        raise ConfigError(
+            f"router {i} at ({x:.3f}, {y:.3f}) is {where} of floorplan {floorplan.name!r}; "
+            f"routers must stand in free space"
+        )
+    return arr
+

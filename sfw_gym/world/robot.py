@@ -1,0 +1,452 @@
+"""The robot: a differential-drive disc in a pymunk space whose static shapes are the walls.
+
+The robot has no camera and no range sensor. It reports a bump (contact with a wall during the last
+control step) and integrates odometry (its true motion in its own frame, plus optional Gaussian
+drift). The walls are plain segments ``[x0, y0, x1, y1]`` in metres, so this module does not depend
+on :class:`~sfw_gym.world.Floorplan`.
+
+Physics. Each control step lasts ``control_period_s`` and is split into ``physics_substeps`` pymunk
+steps. The drive is kinematic: a pymunk velocity callback sets, every substep, the body's velocity to
+the commanded forward speed along its current heading and its angular velocity to the commanded turn
+rate. pymunk's contact solver then removes the part of that velocity that would push into a wall
+(frictionless, inelastic contact), so the robot slides along walls it meets at an angle and stops at
+walls it meets head-on; collision impulses never make it spin or bounce. A wall is a static
+``pymunk.Segment`` of radius ``wall_radius_m`` (a thin skin around the wall line). A contact starts
+only once the disc overlaps that skin, so the deepest the disc can get before the solver pushes it
+back is one substep's travel: the robot's centre stays at least
+``radius_m + wall_radius_m - max_linear_speed_m_s * control_period_s / physics_substeps`` from every
+wall line (``radius_m`` with the defaults), and it rests ``radius_m + wall_radius_m`` from a wall it
+presses against.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+import numpy as np
+import pymunk
+
+from sfw_gym.errors import ConfigError
+
+__all__ = ["Pose", "Robot", "RobotConfig", "StepResult"]
+
+#: A substep may move the robot at most this far at full speed (a quarter of a 0.1 m wall).
+MAX_SUBSTEP_TRAVEL_M = 0.025
+
+_ROBOT_COLLISION_TYPE = 1
+_WALL_COLLISION_TYPE = 2
+# The drive is kinematic and the walls static, so the mass only scales the solver's impulses.
+_ROBOT_MASS_KG = 5.0
+# Overlap that pymunk leaves uncorrected (its default, 0.1, assumes pixels, not metres).
+_COLLISION_SLOP_M = 1e-4
+# Fraction of an overlap that the solver removes per substep.
+_OVERLAP_CORRECTION_PER_SUBSTEP = 0.3
+
+
+class Pose(NamedTuple):
+    """A planar pose: position in metres, heading in radians in [-π, π] (0 = +x, CCW positive)."""
+
+    x: float
+    y: float
+    theta: float
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """What one control step did.
+
+    Attributes:
+        pose: true pose after the step.
+        odometry_pose: the robot's odometry estimate after the step.
+        bumped: whether the robot touched a wall at any time during the step.
+        distance_m: straight-line distance between the true positions before and after the step.
+        linear_m_s: forward speed command after clipping to the limits.
+        angular_rad_s: turn rate command after clipping to the limits.
+    """
+
+    pose: Pose
+    odometry_pose: Pose
+    bumped: bool
+    distance_m: float
+    linear_m_s: float
+    angular_rad_s: float
+
+
+@dataclass(frozen=True)
+class RobotConfig:
+    """Robot geometry, limits, physics resolution and odometry noise.
+
+    Attributes:
+        radius_m: radius of the robot's disc (a TurtleBot/Roomba-sized 0.17 m by default).
+        max_linear_speed_m_s: forward/backward speed limit; commands are clipped to ± this.
+        max_angular_speed_rad_s: turn-rate limit; commands are clipped to ± this.
+        control_period_s: duration of one `Robot.step`.
+        physics_substeps: pymunk steps per control step. At full speed a substep may move the robot
+            at most ``MAX_SUBSTEP_TRAVEL_M`` (2.5 cm); the default moves it 1 cm.
+        odometry_translation_std: standard deviation of the odometry's translation error per step, as
+            a fraction of the distance travelled in that step (on each axis of the robot frame).
+        odometry_heading_std_rad: standard deviation of the odometry's heading error added each step.
+        wall_radius_m: radius of the static wall segments (a skin around each wall line). Keep it at
+            least one substep's travel at full speed so that the robot's centre never comes closer
+            than ``radius_m`` to a wall line.
+    """
+
+    radius_m: float = 0.17
+    max_linear_speed_m_s: float = 0.5
+    max_angular_speed_rad_s: float = 1.5
+    control_period_s: float = 0.2
+    physics_substeps: int = 10
+    odometry_translation_std: float = 0.0
+    odometry_heading_std_rad: float = 0.0
+    wall_radius_m: float = 0.01
+
+    def __post_init__(self) -> None:
+        """Validate every field; raise ConfigError naming the first bad one."""
+        for name in ("radius_m", "max_linear_speed_m_s", "max_angular_speed_rad_s"):
+            self._check_real(name, positive=True)
+        self._check_real("control_period_s", positive=True)
+        for name in ("odometry_translation_std", "odometry_heading_std_rad", "wall_radius_m"):
+            self._check_real(name, positive=False)
+        substeps = self.physics_substeps
+        if isinstance(substeps, bool) or not isinstance(substeps, numbers.Integral):
+            raise ConfigError(f"RobotConfig.physics_substeps must be an integer, got {substeps!r}")
+        if substeps < 1:
+            raise ConfigError(f"RobotConfig.physics_substeps must be >= 1, got {substeps}")
+        object.__setattr__(self, "physics_substeps", int(substeps))
+        travel = self.max_substep_travel_m
+        if travel > MAX_SUBSTEP_TRAVEL_M:
+            need = math.ceil(
+                self.max_linear_speed_m_s * self.control_period_s / MAX_SUBSTEP_TRAVEL_M
+            )
+            raise ConfigError(
+                f"RobotConfig.physics_substeps={substeps} lets the robot move {travel:.4f} m per "
+                f"substep at full speed (limit {MAX_SUBSTEP_TRAVEL_M} m); use at least {need}"
+            )
+
+    def _check_real(self, name: str, *, positive: bool) -> None:
+        value = getattr(self, name)
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
+            raise ConfigError(f"RobotConfig.{name} must be a real number, got {value!r}")
+        value = float(value)
+        if not math.isfinite(value):
+            raise ConfigError(f"RobotConfig.{name} must be finite, got {value}")
+        if positive and value <= 0.0:
+            raise ConfigError(f"RobotConfig.{name} must be > 0, got {value}")
+        if not positive and value < 0.0:
+            raise ConfigError(f"RobotConfig.{name} must be >= 0, got {value}")
+        object.__setattr__(self, name, value)
+
+    @property
+    def substep_s(self) -> float:
+        """Duration of one physics substep, seconds."""
+        return self.control_period_s / self.physics_substeps
+
+    @property
+    def max_substep_travel_m(self) -> float:
+        """Distance covered in one substep at full speed, metres."""
+        return self.max_linear_speed_m_s * self.substep_s
+
+
+class _DriveBody(pymunk.Body):
+    """A pymunk body that carries its drive command (pickled with it, as public attributes)."""
+
+    linear_m_s: float
+    angular_rad_s: float
+
+
+def _kinematic_drive(body: _DriveBody, gravity: Any, damping: float, dt: float) -> None:
+    """pymunk velocity callback: drive along the current heading at the commanded rates.
+
+    Called once per substep after positions are integrated and contacts found, before the contact
+    solver; the solver then removes any velocity into a wall. A module-level function so that the
+    body (and the space) pickle.
+    """
+    speed = body.linear_m_s
+    angle = body.angle
+    body.velocity = (speed * math.cos(angle), speed * math.sin(angle))
+    body.angular_velocity = body.angular_rad_s
+
+
+def _record_contact(arbiter: pymunk.Arbiter, space: pymunk.Space, data: dict[str, bool]) -> None:
+    """pymunk pre-solve callback: the robot touches a wall during this substep."""
+    data["bumped"] = True
+
+
+class Robot:
+    """A differential-drive disc robot with a bump sensor and odometry, among static walls.
+
+    Args:
+        wall_segments: array-like of shape (E, 4), rows ``[x0, y0, x1, y1]`` in metres (E may be 0).
+        config: robot parameters; ``None`` for the defaults.
+        pose: start pose ``(x, y, theta_rad)``; the disc must not overlap a wall line.
+        rng: source of the odometry noise (pass the environment's ``np_random``). May be ``None``
+            only when both odometry noise levels are zero.
+
+    Raises:
+        ConfigError: walls not of shape (E, 4) or not finite; pose not three finite numbers or
+            overlapping a wall; rng missing while odometry noise is on.
+
+    The robot pickles (and deep-copies) with its pymunk space and its rng: a copy continues exactly
+    like the original under the same commands.
+    """
+
+    def __init__(
+        self,
+        wall_segments: np.ndarray | Sequence[Sequence[float]],
+        config: RobotConfig | None = None,
+        pose: Sequence[float] = (0.0, 0.0, 0.0),
+        rng: np.random.Generator | None = None,
+    ) -> None:
+        if config is None:
+            config = RobotConfig()
+        if not isinstance(config, RobotConfig):
+            raise ConfigError(f"config must be a RobotConfig, got {type(config).__name__}")
+        noisy = config.odometry_translation_std > 0.0 or config.odometry_heading_std_rad > 0.0
+        if rng is None and noisy:
+            raise ConfigError("rng is required when odometry noise is on (pass env.np_random)")
+        if rng is not None and not isinstance(rng, np.random.Generator):
+            raise ConfigError(f"rng must be a numpy.random.Generator, got {type(rng).__name__}")
+        self._config = config
+        self._rng = rng
+        self._noisy = noisy
+        self._walls = _parse_walls(wall_segments)
+        self._walls.flags.writeable = False
+
+        dt = config.substep_s
+        space = pymunk.Space()
+        space.gravity = (0.0, 0.0)
+        space.collision_slop = _COLLISION_SLOP_M
+        # pymunk corrects overlaps by 1 - collision_bias**dt per step.
+        space.collision_bias = (1.0 - _OVERLAP_CORRECTION_PER_SUBSTEP) ** (1.0 / dt)
+        walls = []
+        for x0, y0, x1, y1 in self._walls.tolist():
+            seg = pymunk.Segment(space.static_body, (x0, y0), (x1, y1), config.wall_radius_m)
+            seg.friction = 0.0
+            seg.elasticity = 0.0
+            seg.collision_type = _WALL_COLLISION_TYPE
+            walls.append(seg)
+        if walls:
+            space.add(*walls)
+
+        body = _DriveBody(_ROBOT_MASS_KG, pymunk.moment_for_circle(_ROBOT_MASS_KG, 0, config.radius_m))
+        body.linear_m_s = 0.0
+        body.angular_rad_s = 0.0
+        body.velocity_func = _kinematic_drive
+        disc = pymunk.Circle(body, config.radius_m)
+        disc.friction = 0.0
+        disc.elasticity = 0.0
+        disc.collision_type = _ROBOT_COLLISION_TYPE
+        space.add(body, disc)
+        self._contact = {"bumped": False}
+        space.on_collision(
+            _ROBOT_COLLISION_TYPE, _WALL_COLLISION_TYPE, pre_solve=_record_contact, data=self._contact
+        )
+        self._space = space
+        self._body = body
+        self._disc = disc
+        self._odometry = (0.0, 0.0, 0.0)
+        self._bumped = False
+        self.reset(pose)
+
+    # ------------------------------------------------------------------ state
+
+    @property
+    def config(self) -> RobotConfig:
+        """The robot's configuration."""
+        return self._config
+
+    @property
+    def wall_segments(self) -> np.ndarray:
+        """The walls, shape (E, 4), read-only."""
+        return self._walls
+
+    @property
+    def pose(self) -> Pose:
+        """True pose ``(x, y, theta)``; theta wrapped to [-π, π]."""
+        x, y = self._body.position
+        return Pose(x, y, _wrap(self._body.angle))
+
+    @property
+    def odometry_pose(self) -> Pose:
+        """Odometry estimate ``(x, y, theta)``; theta wrapped to [-π, π]."""
+        x, y, theta = self._odometry
+        return Pose(x, y, _wrap(theta))
+
+    @property
+    def bumped(self) -> bool:
+        """Whether the robot touched a wall during the last step (False after `reset`)."""
+        return self._bumped
+
+    def reset(self, pose: Sequence[float]) -> Pose:
+        """Teleport the robot to ``pose`` at rest; odometry restarts at the same pose.
+
+        Args:
+            pose: ``(x, y, theta_rad)``; the disc must not overlap a wall line.
+
+        Returns:
+            The new true pose (theta wrapped).
+
+        Raises:
+            ConfigError: pose not three finite numbers, or overlapping a wall.
+        """
+        x, y, theta = _parse_pose(pose, "pose")
+        self._check_clearance(x, y)
+        body = self._body
+        body.position = (x, y)
+        body.angle = theta
+        body.velocity = (0.0, 0.0)
+        body.angular_velocity = 0.0
+        body.linear_m_s = 0.0
+        body.angular_rad_s = 0.0
+        self._space.reindex_shapes_for_body(body)
+        self._odometry = (x, y, theta)
+        self._bumped = False
+        return self.pose
+
+    # ------------------------------------------------------------------ motion
+
+    def step(self, linear_m_s: float, angular_rad_s: float) -> StepResult:
+        """Drive for one control period.
+
+        Commands are clipped to ``±max_linear_speed_m_s`` and ``±max_angular_speed_rad_s``
+        (infinities clip to the limit; negative speed drives backwards).
+
+        Args:
+            linear_m_s: forward speed command, m/s.
+            angular_rad_s: turn-rate command, rad/s (counter-clockwise positive).
+
+        Returns:
+            The step's outcome (true pose, odometry pose, bump, distance, applied commands).
+
+        Raises:
+            ConfigError: a command is NaN or not a number.
+        """
+        cfg = self._config
+        v = _command("linear_m_s", linear_m_s, cfg.max_linear_speed_m_s)
+        w = _command("angular_rad_s", angular_rad_s, cfg.max_angular_speed_rad_s)
+        body = self._body
+        x0, y0 = body.position
+        a0 = body.angle
+        body.linear_m_s = v
+        body.angular_rad_s = w
+        # The velocity callback runs after each substep's position update, so set the first one here.
+        body.velocity = (v * math.cos(a0), v * math.sin(a0))
+        body.angular_velocity = w
+        contact = self._contact
+        contact["bumped"] = False
+        space_step = self._space.step
+        dt = cfg.substep_s
+        for _ in range(cfg.physics_substeps):
+            space_step(dt)
+        bumped = contact["bumped"]
+        self._bumped = bumped
+        x1, y1 = body.position
+        a1 = body.angle
+
+        # Odometry: the true displacement in the robot's frame at the start of the step, plus noise.
+        dx, dy = x1 - x0, y1 - y0
+        c0, s0 = math.cos(a0), math.sin(a0)
+        forward = c0 * dx + s0 * dy
+        lateral = -s0 * dx + c0 * dy
+        turn = a1 - a0
+        distance = math.hypot(dx, dy)
+        if self._noisy:
+            assert self._rng is not None
+            e_f, e_l, e_t = self._rng.standard_normal(3)
+            trans_std = cfg.odometry_translation_std * distance
+            forward += trans_std * e_f
+            lateral += trans_std * e_l
+            turn += cfg.odometry_heading_std_rad * e_t
+        ox, oy, ot = self._odometry
+        co, so = math.cos(ot), math.sin(ot)
+        self._odometry = (ox + co * forward - so * lateral, oy + so * forward + co * lateral, ot + turn)
+        return StepResult(
+            pose=Pose(x1, y1, _wrap(a1)),
+            odometry_pose=self.odometry_pose,
+            bumped=bumped,
+            distance_m=distance,
+            linear_m_s=v,
+            angular_rad_s=w,
+        )
+
+    # ------------------------------------------------------------------ helpers
+
+    def _check_clearance(self, x: float, y: float) -> None:
+        if len(self._walls) == 0:
+            return
+        dist = _point_segment_distances(np.array([x, y]), self._walls)
+        i = int(np.argmin(dist))
+        if dist[i] < self._config.radius_m:
+            raise ConfigError(
+                f"pose ({x:g}, {y:g}) puts the robot's centre {dist[i]:.4f} m from wall segment {i} "
+                f"{self._walls[i].tolist()}, closer than its radius {self._config.radius_m} m"
+            )
+
+    def __repr__(self) -> str:
+        x, y, theta = self.pose
+        return (
+            f"Robot(pose=({x:.3f}, {y:.3f}, {theta:.3f}), walls={len(self._walls)}, "
+            f"bumped={self._bumped})"
+        )
+
+
+def _wrap(theta: float) -> float:
+    """Wrap an angle to [-π, π]."""
+    return math.remainder(theta, math.tau)
+
+
+def _command(name: str, value: Any, limit: float) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{name} must be a real number, got {value!r}") from None
+    if math.isnan(v):
+        raise ConfigError(f"{name} is NaN")
+    return min(max(v, -limit), limit)
+
+
+def _parse_pose(pose: Any, name: str) -> tuple[float, float, float]:
+    try:
+        arr = np.asarray(pose, dtype=float)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{name} must be (x, y, theta_rad) numbers, got {pose!r}") from None
+    if arr.shape != (3,):
+        raise ConfigError(f"{name} must be (x, y, theta_rad), got shape {arr.shape}")
+    if not np.isfinite(arr).all():
+        raise ConfigError(f"{name} must be finite, got {arr.tolist()}")
+    x, y, theta = arr.tolist()
+    return x, y, theta
+
+
+def _parse_walls(walls: Any) -> np.ndarray:
+    try:
+        arr = np.array(walls, dtype=float)
+    except (TypeError, ValueError):
+        raise ConfigError("wall_segments must be a numeric array of shape (E, 4)") from None
+    if arr.size == 0:
+        return np.zeros((0, 4))
+    if arr.ndim != 2 or arr.shape[1] != 4:
+        raise ConfigError(
+            f"wall_segments must have shape (E, 4) with rows [x0, y0, x1, y1], got {arr.shape}"
+        )
+    bad = ~np.isfinite(arr).all(axis=1)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise ConfigError(
+            f"wall_segments has {int(bad.sum())} non-finite row(s), first row {i}: {arr[i].tolist()}"
+        )
+    return arr
+
+
+def _point_segment_distances(p: np.ndarray, walls: np.ndarray) -> np.ndarray:
+    """Distance from point ``p`` (2,) to each segment of ``walls`` (E, 4)."""
+    a = walls[:, :2]
+    d = walls[:, 2:] - a
+    len2 = np.einsum("ij,ij->i", d, d)
+    t = np.einsum("ij,ij->i", p - a, d) / np.where(len2 > 0.0, len2, 1.0)
+    closest = a + np.clip(t, 0.0, 1.0)[:, None] * d
+    return np.hypot(*(p - closest).T)

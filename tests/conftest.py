@@ -1,0 +1,47 @@
+"""Shared fixtures: hand-made plans whose answers can be computed by hand, and the HouseExpo files."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from shapely.geometry import Polygon
+
+from sfw_gym.world.floorplan import Floorplan, floorplan_from_polygon
+
+HOUSEEXPO_DIR = Path(__file__).resolve().parents[1].parent / "shared" / "floorplans" / "houseexpo"
+
+
+def houseexpo_files() -> list[Path]:
+    """The shared HouseExpo plans, or an empty list when ../shared is absent."""
+    return sorted(HOUSEEXPO_DIR.glob("*.json")) if HOUSEEXPO_DIR.is_dir() else []
+
+
+@pytest.fixture
+def houseexpo_paths() -> list[Path]:
+    paths = houseexpo_files()
+    if not paths:
+        pytest.skip(f"HouseExpo floorplans not found at {HOUSEEXPO_DIR} (../shared is absent)")
+    return paths
+
+
+def two_rooms_polygon(door: bool = True) -> Polygon:
+    """10 × 5 m, a 0.1 m wall at x = 4.95–5.05 from the bottom up to y = 4 (a 1 m doorway above).
+
+    Without the doorway the wall reaches the top and the plan is two separate rooms; as a single
+    polygon that is only possible with the door, so ``door=False`` gives the left room only.
+    """
+    if not door:
+        return Polygon([(0, 0), (4.95, 0), (4.95, 5), (0, 5)])
+    return Polygon([(0, 0), (4.95, 0), (4.95, 4), (5.05, 4), (5.05, 0), (10, 0), (10, 5), (0, 5)])
+
+
+@pytest.fixture
+def two_rooms() -> Floorplan:
+    return floorplan_from_polygon(two_rooms_polygon(), name="two-rooms")
+
+
+@pytest.fixture
+def open_hall() -> Floorplan:
+    """20 × 10 m without interior walls."""
+    return floorplan_from_polygon(Polygon([(0, 0), (20, 0), (20, 10), (0, 10)]), name="hall")
