@@ -33,7 +33,9 @@ class TestCountWallsExact:
 
     def test_notch_is_one_wall_not_two_boundary_crossings(self):
         # A HouseExpo-style notch: the outline goes in and out around a 0.1 m wall.
-        notch = Polygon([(0, 0), (6, 0), (6, 4), (3.05, 4), (3.05, 1), (2.95, 1), (2.95, 4), (0, 4)])
+        notch = Polygon(
+            [(0, 0), (6, 0), (6, 4), (3.05, 4), (3.05, 1), (2.95, 1), (2.95, 4), (0, 4)]
+        )
         fp = floorplan_from_polygon(notch)
         assert k(fp, (1, 3), (5, 3)) == 1
         assert k(fp, (1, 0.5), (5, 0.5)) == 0  # below the notch's end
@@ -80,8 +82,10 @@ def _reference_count(fp: Floorplan, a, b, min_piece_m: float = 0.02) -> int:
     seg = LineString([a, b])
     outside = seg.difference(fp.free_space)
     pieces = [g for g in getattr(outside, "geoms", [outside]) if g.length >= min_piece_m]
-    pos = sorted((seg.project(g.interpolate(0)), seg.project(g.interpolate(1, normalized=True)))
-                 for g in pieces)
+    pos = sorted(
+        (seg.project(g.interpolate(0)), seg.project(g.interpolate(1, normalized=True)))
+        for g in pieces
+    )
     pos = [tuple(sorted(p)) for p in pos]
     count, last_end = 0, -np.inf
     for start, end in pos:
@@ -161,9 +165,14 @@ BAD_INPUTS = {
     "not a list": json.dumps({"verts": "abc"}),
     "strings": json.dumps({"verts": [["a", 0], [1, 0], [1, 1]]}),
     "array": "[1, 2, 3]",
-    "sfw without materials": json.dumps({"format": "sfw_gym.floorplan", "version": 1,
-                                         "free_space": {"exterior": [[0, 0], [5, 0], [5, 5]]},
-                                         "footprint": [[0, 0], [5, 0], [5, 5]]}),
+    "sfw without materials": json.dumps(
+        {
+            "format": "sfw_gym.floorplan",
+            "version": 1,
+            "free_space": {"exterior": [[0, 0], [5, 0], [5, 5]]},
+            "footprint": [[0, 0], [5, 0], [5, 5]],
+        }
+    ),
 }
 
 

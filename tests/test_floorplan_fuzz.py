@@ -17,7 +17,9 @@ numbers = st.one_of(
 )
 json_values = st.recursive(
     st.none() | st.booleans() | numbers | st.text(max_size=5),
-    lambda inner: st.lists(inner, max_size=6) | st.dictionaries(st.text(max_size=6), inner, max_size=4),
+    lambda inner: (
+        st.lists(inner, max_size=6) | st.dictionaries(st.text(max_size=6), inner, max_size=4)
+    ),
     max_leaves=20,
 )
 vertex = st.tuples(st.floats(-30, 30), st.floats(-30, 30)).map(list)
@@ -32,9 +34,25 @@ def _load_or_floorplan_error(data: object) -> None:
 
 
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(st.dictionaries(st.sampled_from(["verts", "id", "format", "version", "free_space",
-                                        "footprint", "edge_materials", "rooms", "room_category"]),
-                       json_values, max_size=6))
+@given(
+    st.dictionaries(
+        st.sampled_from(
+            [
+                "verts",
+                "id",
+                "format",
+                "version",
+                "free_space",
+                "footprint",
+                "edge_materials",
+                "rooms",
+                "room_category",
+            ]
+        ),
+        json_values,
+        max_size=6,
+    )
+)
 def test_garbage_dicts_raise_only_floorplan_error(data):
     _load_or_floorplan_error(data)
 
@@ -59,6 +77,11 @@ def test_garbage_bytes_raise_only_floorplan_error(tmp_path_factory, blob):
 @settings(max_examples=100, deadline=None)
 @given(st.lists(vertex, min_size=3, max_size=10))
 def test_sfw_format_with_random_rings(verts):
-    data = {"format": "sfw_gym.floorplan", "version": 1, "free_space": {"exterior": verts},
-            "footprint": verts, "edge_materials": ["generic"] * len(verts)}
+    data = {
+        "format": "sfw_gym.floorplan",
+        "version": 1,
+        "free_space": {"exterior": verts},
+        "footprint": verts,
+        "edge_materials": ["generic"] * len(verts),
+    }
     _load_or_floorplan_error(json.loads(json.dumps(data)))

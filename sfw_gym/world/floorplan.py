@@ -70,7 +70,9 @@ class Floorplan:
         _check_polygon(self.free_space, "free_space", self.name)
         _check_polygon(self.footprint, "footprint", self.name)
         if not self.footprint.buffer(1e-6).contains(self.free_space):
-            raise FloorplanError(f"floorplan {self.name!r}: the footprint does not contain the free space")
+            raise FloorplanError(
+                f"floorplan {self.name!r}: the footprint does not contain the free space"
+            )
         edges = _polygon_edges(self.free_space)
         if len(self.edge_materials) != len(edges):
             raise FloorplanError(
@@ -259,7 +261,8 @@ def floorplan_from_polygon(
 ) -> Floorplan:
     """A plan whose walls all share one material, its footprint the free space grown by a wall."""
     _check_polygon(free_space, "free_space", name)
-    grown = free_space.buffer(exterior_wall_m, join_style="mitre")
+    with np.errstate(divide="ignore", invalid="ignore"):  # GEOS on slivers; validated below
+        grown = free_space.buffer(exterior_wall_m, join_style="mitre")
     footprint = Polygon(grown.exterior)
     n_edges = len(_polygon_edges(free_space))
     return Floorplan(free_space, footprint, (material,) * n_edges, name=name, rooms=tuple(rooms))
@@ -300,7 +303,9 @@ def _from_sfw_dict(data: Mapping[str, Any]) -> Floorplan:
     for i, room in enumerate(data.get("rooms", [])):
         if not isinstance(room, Mapping) or "label" not in room or "box" not in room:
             raise FloorplanError(f"rooms[{i}] must be an object with 'label' and 'box'")
-        rooms.append(Room(str(room["label"]), tuple(_parse_numbers(room["box"], f"rooms[{i}].box", 4))))
+        rooms.append(
+            Room(str(room["label"]), tuple(_parse_numbers(room["box"], f"rooms[{i}].box", 4)))
+        )
     return Floorplan(
         Polygon(shell, hole_rings),
         Polygon(_parse_ring(data["footprint"], "footprint")),
@@ -323,7 +328,9 @@ def _parse_numbers(values: Any, what: str, n: int) -> list[float]:
 
 def _parse_ring(verts: Any, what: str) -> np.ndarray:
     if not isinstance(verts, list):
-        raise FloorplanError(f"{what} must be a list of [x, y] vertices, got {type(verts).__name__}")
+        raise FloorplanError(
+            f"{what} must be a list of [x, y] vertices, got {type(verts).__name__}"
+        )
     pts = np.array([_parse_numbers(v, f"{what}[{i}]", 2) for i, v in enumerate(verts)], np.float64)
     if len(pts) and np.array_equal(pts[0], pts[-1]):
         pts = pts[:-1]  # a closed ring: drop the repeated vertex

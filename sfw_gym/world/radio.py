@@ -35,8 +35,8 @@ def free_space_path_loss_db(distance_m: float, frequency_ghz: float) -> float:
     return 20.0 * math.log10(4.0 * math.pi * distance_m * frequency_ghz * 1e9 / _SPEED_OF_LIGHT_M_S)
 
 
-def _uniform_losses(loss_db: float) -> Mapping[str, float]:
-    return MappingProxyType(dict.fromkeys(MATERIALS, loss_db))
+def _uniform_losses(loss_db: float) -> dict[str, float]:
+    return dict.fromkeys(MATERIALS, loss_db)
 
 
 @dataclass(frozen=True)
@@ -61,19 +61,29 @@ class RadioConfig:
     sensitivity_dbm: float = -90.0
 
     def __post_init__(self) -> None:
-        positive = ("frequency_ghz", "reference_distance_m", "path_loss_exponent",
-                    "shadowing_correlation_m")
+        positive = (
+            "frequency_ghz",
+            "reference_distance_m",
+            "path_loss_exponent",
+            "shadowing_correlation_m",
+        )
         non_negative = ("max_total_wall_loss_db", "shadowing_sigma_db", "noise_sigma_db")
         for name in (*positive, *non_negative, "tx_power_dbm", "sensitivity_dbm"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, int | float)
+                or not math.isfinite(value)
+            ):
                 raise ConfigError(f"RadioConfig.{name} must be a finite number, got {value!r}")
             if name in positive and value <= 0:
                 raise ConfigError(f"RadioConfig.{name} must be > 0, got {value!r}")
             if name in non_negative and value < 0:
                 raise ConfigError(f"RadioConfig.{name} must be ≥ 0, got {value!r}")
         if self.path_loss_d0_db is not None and not math.isfinite(self.path_loss_d0_db):
-            raise ConfigError(f"RadioConfig.path_loss_d0_db must be finite, got {self.path_loss_d0_db!r}")
+            raise ConfigError(
+                f"RadioConfig.path_loss_d0_db must be finite, got {self.path_loss_d0_db!r}"
+            )
         if not isinstance(self.wall_loss_db, Mapping):
             raise ConfigError("RadioConfig.wall_loss_db must map material names to losses in dB")
         missing = sorted(set(MATERIALS) - set(self.wall_loss_db))
@@ -85,8 +95,13 @@ class RadioConfig:
             )
         for material, loss in self.wall_loss_db.items():
             if not (isinstance(loss, int | float) and math.isfinite(loss) and loss >= 0):
-                raise ConfigError(f"RadioConfig.wall_loss_db[{material!r}] must be ≥ 0, got {loss!r}")
-        object.__setattr__(self, "wall_loss_db", MappingProxyType(dict(self.wall_loss_db)))
+                raise ConfigError(
+                    f"RadioConfig.wall_loss_db[{material!r}] must be ≥ 0, got {loss!r}"
+                )
+        # A private plain copy: picklable, and safe from the caller's later edits.
+        object.__setattr__(
+            self, "wall_loss_db", {m: float(v) for m, v in self.wall_loss_db.items()}
+        )
 
     @classmethod
     def preset(cls, name: str = "default", band: str = "2.4", **overrides: Any) -> RadioConfig:
@@ -95,8 +110,11 @@ class RadioConfig:
 
         At 5 GHz only the frequency (hence PL(d0) ≈ 46.8 dB) changes; wall losses stay the preset's.
         """
-        losses = {"default": _uniform_losses(10.0), "thick": _uniform_losses(15.0),
-                  "residential": RESIDENTIAL_LOSS_DB}
+        losses = {
+            "default": _uniform_losses(10.0),
+            "thick": _uniform_losses(15.0),
+            "residential": RESIDENTIAL_LOSS_DB,
+        }
         if name not in losses:
             raise ConfigError(f"unknown radio preset {name!r}; choose one of {list(PRESETS)}")
         if band not in BANDS:
@@ -119,9 +137,7 @@ class RadioConfig:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-serialisable fields."""
-        out = asdict(self)
-        out["wall_loss_db"] = dict(self.wall_loss_db)
-        return out
+        return asdict(self)
 
 
 class ShadowingField:
@@ -166,7 +182,9 @@ class ShadowingField:
 
 
 @njit(cache=True)
-def _bilinear(tables: np.ndarray, origin: np.ndarray, spacing: float, pts: np.ndarray) -> np.ndarray:
+def _bilinear(
+    tables: np.ndarray, origin: np.ndarray, spacing: float, pts: np.ndarray
+) -> np.ndarray:
     """Bilinear interpolation of (R, ny, nx) node tables at points (M, 2), clamped to the grid."""
     n_r, ny, nx = tables.shape
     out = np.empty((pts.shape[0], n_r))
@@ -246,7 +264,10 @@ class RadioModel:
         """RSSI without temporal noise (path loss, capped walls, shadowing): (M, R) float dBm."""
         pts = self._points(points)
         walls = np.stack(
-            [self.floorplan.wall_loss_db(r, pts, self.config.wall_loss_db)[1] for r in self.routers],
+            [
+                self.floorplan.wall_loss_db(r, pts, self.config.wall_loss_db)[1]
+                for r in self.routers
+            ],
             axis=1,
         )
         rssi = (
@@ -285,4 +306,3 @@ def validate_routers(floorplan: Floorplan, routers: np.ndarray) -> np.ndarray:
             f"routers must stand in free space"
         )
     return arr
-

@@ -171,9 +171,15 @@ def _kinematic_drive(body: _DriveBody, gravity: Any, damping: float, dt: float) 
     body.angular_velocity = body.angular_rad_s
 
 
-def _record_contact(arbiter: pymunk.Arbiter, space: pymunk.Space, data: dict[str, bool]) -> None:
+class _WorldSpace(pymunk.Space):
+    """A pymunk space that records whether the robot touched a wall (pickled with it)."""
+
+    robot_touched: bool
+
+
+def _record_contact(arbiter: pymunk.Arbiter, space: _WorldSpace, data: Any) -> None:
     """pymunk pre-solve callback: the robot touches a wall during this substep."""
-    data["bumped"] = True
+    space.robot_touched = True
 
 
 class Robot:
@@ -217,11 +223,13 @@ class Robot:
         self._walls.flags.writeable = False
 
         dt = config.substep_s
-        space = pymunk.Space()
+        space = _WorldSpace()
+        space.robot_touched = False
         space.gravity = (0.0, 0.0)
         space.collision_slop = _COLLISION_SLOP_M
         # pymunk corrects overlaps by 1 - collision_bias**dt per step.
-        space.collision_bias = (1.0 - _OVERLAP_CORRECTION_PER_SUBSTEP) ** (1.0 / dt)
+        self._collision_bias = (1.0 - _OVERLAP_CORRECTION_PER_SUBSTEP) ** (1.0 / dt)
+        space.collision_bias = self._collision_bias
         walls = []
         for x0, y0, x1, y1 in self._walls.tolist():
             seg = pymunk.Segment(space.static_body, (x0, y0), (x1, y1), config.wall_radius_m)
@@ -241,10 +249,7 @@ class Robot:
         disc.elasticity = 0.0
         disc.collision_type = _ROBOT_COLLISION_TYPE
         space.add(body, disc)
-        self._contact = {"bumped": False}
-        space.on_collision(
-            _ROBOT_COLLISION_TYPE, _WALL_COLLISION_TYPE, pre_solve=_record_contact, data=self._contact
-        )
+        space.on_collision(_ROBOT_COLLISION_TYPE, _WALL_COLLISION_TYPE, pre_solve=_record_contact)
         self._space = space
         self._body = body
         self._disc = disc
@@ -336,13 +341,19 @@ class Robot:
         # The velocity callback runs after each substep's position update, so set the first one here.
         body.velocity = (v * math.cos(a0), v * math.sin(a0))
         body.angular_velocity = w
-        contact = self._contact
-        contact["bumped"] = False
-        space_step = self._space.step
+        space = self._space
+        space.robot_touched = False
+        space_step = space.step
         dt = cfg.substep_s
-        for _ in range(cfg.physics_substeps):
+        space.collision_bias = self._collision_bias
+        for _ in range(cfg.physics_substeps - 1):
             space_step(dt)
-        bumped = contact["bumped"]
+        # No overlap correction in the last substep: pymunk keeps that correction as a hidden
+        # "bias velocity" for the next step, which a pickle would lose. Ending every control step
+        # with none makes the state between steps complete, so a copy continues identically.
+        space.collision_bias = 1.0
+        space_step(dt)
+        bumped = space.robot_touched
         self._bumped = bumped
         x1, y1 = body.position
         a1 = body.angle
@@ -356,7 +367,7 @@ class Robot:
         distance = math.hypot(dx, dy)
         if self._noisy:
             assert self._rng is not None
-            e_f, e_l, e_t = self._rng.standard_normal(3)
+            e_f, e_l, e_t = self._rng.standard_normal(3).tolist()
             trans_std = cfg.odometry_translation_std * distance
             forward += trans_std * e_f
             lateral += trans_std * e_l

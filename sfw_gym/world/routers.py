@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import shapely
+from sklearn.cluster import KMeans
 
 from sfw_gym.errors import ConfigError
 from sfw_gym.world.floorplan import Floorplan
@@ -13,10 +14,11 @@ ROUTER_CLEARANCE_M = 0.3
 
 
 def place_routers(floorplan: Floorplan, n: int, rng: np.random.Generator) -> np.ndarray:
-    """``n`` router positions (n, 2) in free space, spread by farthest-point sampling.
+    """``n`` router positions (n, 2) in open free space, each central to the part it serves.
 
-    The first router stands near the middle of the plan (where one router serves a home best),
-    each next one as far as possible from those placed, among random open spots.
+    The free space is split into ``n`` parts by k-means over random open spots (one router serves
+    a home best from its middle; two serve best from the middles of its halves), and each router
+    stands at the open spot nearest its part's centre.
     """
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
         raise ConfigError(f"number of routers must be a positive integer, got {n!r}")
@@ -28,13 +30,11 @@ def place_routers(floorplan: Floorplan, n: int, rng: np.random.Generator) -> np.
     for _ in range(50):  # rejection sampling: keep drawing until there are enough open spots
         pts = rng.uniform((xmin, ymin), (xmax, ymax), size=(512, 2))
         candidates = np.vstack([candidates, pts[shapely.contains_xy(region, pts[:, 0], pts[:, 1])]])
-        if len(candidates) >= 128:
+        if len(candidates) >= 256:
             break
-    if len(candidates) == 0:
+    if len(candidates) < n:
         raise ConfigError(f"floorplan {floorplan.name!r} has no open spot for a router")
-    centre = np.asarray(floorplan.free_space.centroid.coords[0])
-    chosen = [candidates[np.argmin(np.linalg.norm(candidates - centre, axis=1))]]
-    while len(chosen) < n:
-        dist = np.min(np.linalg.norm(candidates[:, None] - np.array(chosen)[None], axis=2), axis=1)
-        chosen.append(candidates[np.argmax(dist)])
-    return np.array(chosen)
+    seed = int(rng.integers(2**31))
+    centres = KMeans(n_clusters=n, n_init=3, random_state=seed).fit(candidates).cluster_centers_
+    nearest = np.argmin(np.linalg.norm(candidates[:, None] - centres[None], axis=2), axis=0)
+    return candidates[nearest]

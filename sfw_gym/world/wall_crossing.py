@@ -122,7 +122,7 @@ def _cross_one(
 
 
 @njit(cache=True)
-def _cross_range(edges, edge_loss, a, b, min_piece_m, counts, losses, lo, hi):  # noqa: PLR0913
+def _cross_range(edges, edge_loss, a, b, min_piece_m, counts, losses, lo, hi):
     ts = np.empty(edges.shape[0] + 1, dtype=np.float64)  # scratch, once per range
     ids = np.empty(edges.shape[0] + 1, dtype=np.int64)
     for i in range(lo, hi):
@@ -160,6 +160,14 @@ def cross_walls_parallel(edges, edge_loss, a, b, min_piece_m):
     n_chunks = (m + _CHUNK - 1) // _CHUNK
     for c in prange(n_chunks):
         _cross_range(
-            edges, edge_loss, a, b, min_piece_m, counts, losses, c * _CHUNK, min(m, (c + 1) * _CHUNK)
+            edges,
+            edge_loss,
+            a,
+            b,
+            min_piece_m,
+            counts,
+            losses,
+            c * _CHUNK,
+            min(m, (c + 1) * _CHUNK),
         )
     return counts, losses

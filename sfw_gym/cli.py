@@ -1,0 +1,90 @@
+"""The ``sfw-gym`` command."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from collections.abc import Sequence
+
+import numpy as np
+
+from sfw_gym.errors import ConfigError, FloorplanError
+
+
+def parse_routers(text: str) -> np.ndarray | int:
+    """``"x1,y1;x2,y2"`` → (R, 2) array of positions; ``"3"`` → a router count."""
+    text = text.strip()
+    if text.isdigit():
+        return int(text)
+    try:
+        pts = [[float(v) for v in pair.split(",")] for pair in text.split(";") if pair.strip()]
+        arr = np.array(pts, dtype=np.float64)
+    except ValueError:
+        arr = np.empty((0,))
+    if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) == 0:
+        raise ConfigError(f"--routers: expected a count or 'x1,y1;x2,y2;…', got {text!r}")
+    return arr
+
+
+def _cmd_world(args: argparse.Namespace) -> int:
+    from sfw_gym.world import (
+        RadioConfig,
+        RadioModel,
+        load_floorplan,
+        place_routers,
+    )
+    from sfw_gym.world.picture import draw_world
+
+    start = time.perf_counter()
+    rng = np.random.default_rng(args.seed)
+    if args.floorplan:
+        plan = load_floorplan(args.floorplan)
+    else:
+        from sfw_gym.world.generator import generate_floorplan
+
+        plan = generate_floorplan(args.seed)
+    routers = parse_routers(args.routers)
+    if isinstance(routers, int):
+        routers = place_routers(plan, routers, rng)
+    radio = RadioModel(plan, routers, RadioConfig.preset(args.preset, band=args.band), rng)
+    out = draw_world(plan, radio, args.out, resolution_m=args.resolution)
+    took = time.perf_counter() - start
+    print(f"{plan.name}: {plan.area_m2:.1f} m², {len(plan.edges)} wall faces, routers at "
+          f"{np.round(radio.routers, 2).tolist()}")
+    print(f"wrote {out} in {took:.1f} s")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of every subcommand."""
+    parser = argparse.ArgumentParser(
+        prog="sfw-gym", description="Active WiFi exploration: worlds, mapping, agents."
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    world = sub.add_parser("world", help="draw a floorplan, its routers, RSSI and true k-regions")
+    source = world.add_mutually_exclusive_group()
+    source.add_argument("--seed", type=int, default=0, help="procedural floorplan seed (default 0)")
+    source.add_argument("--floorplan", help="a HouseExpo or sfw_gym JSON floorplan file")
+    world.add_argument("--routers", default="2", help="a count, or positions 'x1,y1;x2,y2'")
+    world.add_argument("--preset", default="default", help="radio preset: default, thick, residential")
+    world.add_argument("--band", default="2.4", help="2.4 or 5 (GHz)")
+    world.add_argument("--resolution", type=float, default=0.1, help="heat-map cell size, metres")
+    world.add_argument("--out", default="world.png", help="output PNG (default world.png)")
+    world.set_defaults(func=_cmd_world)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``sfw-gym``; bad input ends with a one-line error and exit status 2."""
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except (ConfigError, FloorplanError) as exc:
+        print(f"sfw-gym {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

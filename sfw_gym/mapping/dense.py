@@ -1,0 +1,93 @@
+"""Dense inverse k-visibility (Alg. 1 of Kim et al.): the oracle map from the true k of every cell.
+
+Along every ray from the router the k-value never decreases, and it steps up exactly where the
+ray crosses a wall. For each cell with a known k (``k >= 0``) the oracle walks from the cell
+towards the router to the first cell that also has a known k:
+
+- same k: no wall between them, the cell is free;
+- different k: a wall lies between them. If the walk passed cells without a known k
+  (``k < 0``, e.g. the wall's own cells), those are marked wall; if the two cells are
+  neighbours, the cell itself (the one farther from the router) is marked wall.
+
+Cells with unknown k that are never marked stay unknown (127).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from sfw_gym.errors import ConfigError
+from sfw_gym.mapping.grid import U8_FREE, U8_UNKNOWN, U8_WALL, GridSpec
+from sfw_gym.mapping.raycast import ray_buffer_size, traverse_grid
+
+
+@njit(cache=True)
+def _dense_kernel(k_grid, rgx, rgy, wall, free, rows, cols, t0, t1):
+    n_rows, n_cols = k_grid.shape
+    for i in range(n_rows):
+        for j in range(n_cols):
+            k = k_grid[i, j]
+            if k < 0:
+                continue
+            n = traverse_grid(j + 0.5, i + 0.5, rgx, rgy, n_rows, n_cols, rows, cols, t0, t1)
+            found = False
+            m_hit = n
+            for m in range(1, n):
+                if k_grid[rows[m], cols[m]] >= 0:
+                    found = True
+                    m_hit = m
+                    break
+            if not found or k_grid[rows[m_hit], cols[m_hit]] == k:
+                free[i, j] = True
+            elif m_hit == 1:
+                wall[i, j] = True
+            else:
+                for m in range(1, m_hit):
+                    wall[rows[m], cols[m]] = True
+
+
+def dense_inverse_k_visibility(grid: GridSpec, router_xy, k_grid) -> np.ndarray:
+    """Oracle map from the true k-value of every cell (Alg. 1).
+
+    Args:
+        grid: Map geometry.
+        router_xy: Router ``(x, y)`` in metres, or ``(R, 2)`` for several routers.
+        k_grid: int ``grid.shape`` array of k-values (``< 0`` = unknown, e.g. inside walls or
+            outside the plan), or ``(R, *grid.shape)`` with one layer per router.
+
+    Returns:
+        uint8 map: 0 wall, 255 free, 127 unknown. With several routers a cell is a wall if any
+        router's rays mark it, else free if any marks it free.
+    """
+    if not isinstance(grid, GridSpec):
+        raise ConfigError(f"grid must be a GridSpec, got {type(grid).__name__}")
+    routers = np.asarray(router_xy, dtype=np.float64)
+    k = np.asarray(k_grid)
+    if routers.shape == (2,):
+        routers = routers[None]
+        k = k[None] if k.ndim == 2 else k
+    if routers.ndim != 2 or routers.shape[1] != 2 or not np.isfinite(routers).all():
+        raise ConfigError(f"router_xy must be finite (x, y) or (R, 2), got shape {routers.shape}")
+    if k.shape != (routers.shape[0], *grid.shape):
+        raise ConfigError(
+            f"k_grid must have shape {grid.shape} (one router) or (R, *{grid.shape}), "
+            f"got {np.asarray(k_grid).shape} for {routers.shape[0]} router(s)"
+        )
+    if not np.issubdtype(k.dtype, np.integer):
+        raise ConfigError(f"k_grid must be an integer array, got dtype {k.dtype}")
+    k = k.astype(np.int64)
+    wall = np.zeros(grid.shape, np.bool_)
+    free = np.zeros(grid.shape, np.bool_)
+    size = ray_buffer_size(grid.shape)
+    rows = np.empty(size, np.int64)
+    cols = np.empty(size, np.int64)
+    t0 = np.empty(size, np.float64)
+    t1 = np.empty(size, np.float64)
+    g = grid.world_to_grid(routers)
+    for r in range(routers.shape[0]):
+        _dense_kernel(k[r], g[r, 0], g[r, 1], wall, free, rows, cols, t0, t1)
+    out = np.full(grid.shape, U8_UNKNOWN, np.uint8)
+    out[free] = U8_FREE
+    out[wall] = U8_WALL
+    return out

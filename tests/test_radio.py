@@ -1,0 +1,141 @@
+"""Radio model: the formula to 1e-9, walls, cap, shadowing, noise, bad routers."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from shapely.geometry import Polygon
+
+from sfw_gym.errors import ConfigError
+from sfw_gym.world.floorplan import Floorplan, floorplan_from_polygon
+from sfw_gym.world.radio import NOT_HEARD_DBM, RadioConfig, RadioModel
+
+
+def noiseless(**kw) -> RadioConfig:
+    return RadioConfig(**kw).noiseless()
+
+
+def test_line_of_sight_rssi_equals_the_formula(open_hall):
+    model = RadioModel(open_hall, [[2.0, 5.0]], noiseless(), np.random.default_rng(0))
+    pts = np.array([[12.0, 5.0], [2.0, 9.0], [2.5, 5.0], [17.0, 1.0]])
+    d = np.linalg.norm(pts - [2.0, 5.0], axis=1)
+    fspl_1m = 20 * math.log10(4 * math.pi * 2.437e9 / 299_792_458.0)
+    expected = 20.0 - (fspl_1m + 20.0 * np.log10(np.maximum(d, 1.0)))
+    assert fspl_1m == pytest.approx(40.18, abs=0.01)
+    np.testing.assert_allclose(model.mean_rssi(pts)[:, 0], expected, rtol=0, atol=1e-9)
+    assert model.true_k(pts).tolist() == [[0]] * 4
+
+
+def test_one_wall_costs_its_loss_and_the_total_is_capped(two_rooms):
+    for preset, per_wall in [("default", 10.0), ("thick", 15.0)]:
+        cfg = RadioConfig.preset(preset).noiseless()
+        model = RadioModel(two_rooms, [[2.0, 2.0]], cfg, np.random.default_rng(0))
+        across, free = np.array([[8.0, 2.0]]), np.array([[4.0, 4.5]])
+        los = cfg.tx_power_dbm - model.path_loss_db(across)[0, 0]
+        assert model.mean_rssi(across)[0, 0] == pytest.approx(los - per_wall, abs=1e-9)
+        assert model.true_k(across)[0, 0] == 1 and model.true_k(free)[0, 0] == 0
+    # Ten 0.1 m walls in a row: 100 dB of walls, capped at 45 dB.
+    ring = [(0, 0)]
+    for i in range(10):
+        x = 2.0 + 2.0 * i
+        ring += [(x, 0), (x, 4), (x + 0.1, 4), (x + 0.1, 0)]
+    ring += [(24, 0), (24, 5), (0, 5)]
+    comb = floorplan_from_polygon(Polygon(ring))
+    model = RadioModel(comb, [[1.0, 2.0]], noiseless(), np.random.default_rng(0))
+    far = np.array([[23.0, 2.0]])
+    assert model.true_k(far)[0, 0] == 10
+    los = 20.0 - model.path_loss_db(far)[0, 0]
+    assert model.mean_rssi(far)[0, 0] == pytest.approx(los - 45.0, abs=1e-9)
+
+
+def test_residential_losses_follow_the_wall_material():
+    shell = [(0, 0), (8, 0), (8, 6), (0, 6)]
+    pillar = [(3, 2), (4, 2), (4, 3), (3, 3)]  # a glass box in a brick room
+    fp = Floorplan(
+        Polygon(shell, [pillar]),
+        Polygon([(-0.2, -0.2), (8.2, -0.2), (8.2, 6.2), (-0.2, 6.2)]),
+        ("brick",) * 4 + ("glass",) * 4,
+    )
+    cfg = RadioConfig.preset("residential").noiseless()
+    model = RadioModel(fp, [[1.0, 2.5]], cfg, np.random.default_rng(0))
+    behind = np.array([[7.0, 2.5]])
+    assert model.mean_rssi(behind)[0, 0] == pytest.approx(
+        20 - model.path_loss_db(behind)[0, 0] - 2.0
+    )
+
+
+def test_shadowing_is_fixed_within_an_episode_and_differs_across_seeds(open_hall):
+    pts = np.random.default_rng(1).uniform((0.5, 0.5), (19.5, 9.5), (200, 2))
+    cfg = RadioConfig(noise_sigma_db=0.0)
+    a = RadioModel(open_hall, [[5.0, 5.0], [15.0, 5.0]], cfg, np.random.default_rng(7))
+    again = RadioModel(open_hall, [[5.0, 5.0], [15.0, 5.0]], cfg, np.random.default_rng(7))
+    other = RadioModel(open_hall, [[5.0, 5.0], [15.0, 5.0]], cfg, np.random.default_rng(8))
+    first = a.mean_rssi(pts)
+    np.testing.assert_array_equal(first, a.mean_rssi(pts))  # fixed within the episode
+    np.testing.assert_array_equal(first, again.mean_rssi(pts))  # deterministic per seed
+    assert np.abs(first - other.mean_rssi(pts)).mean() > 0.5
+
+
+def test_shadowing_statistics_match_the_config(open_hall):
+    """Across episodes: σ ≈ 4 dB at a point; correlation exp(-r/5 m) between points r apart."""
+    cfg = RadioConfig(noise_sigma_db=0.0)
+    pts = np.array([[10.0, 5.0], [11.0, 5.0], [15.0, 5.0]])
+    los = RadioModel(open_hall, [[2.0, 5.0]], cfg.noiseless(), np.random.default_rng(0)).mean_rssi(
+        pts
+    )
+    samples = (
+        np.array(
+            [
+                RadioModel(open_hall, [[2.0, 5.0]], cfg, np.random.default_rng(s)).mean_rssi(pts)[
+                    :, 0
+                ]
+                for s in range(600)
+            ]
+        )
+        - los[:, 0]
+    )
+    assert samples.std(axis=0) == pytest.approx([4.0] * 3, rel=0.15)
+    corr = np.corrcoef(samples.T)
+    assert corr[0, 1] == pytest.approx(math.exp(-1 / 5), abs=0.1)
+    assert corr[0, 2] == pytest.approx(math.exp(-5 / 5), abs=0.12)
+
+
+def test_measure_is_integer_noisy_and_reports_not_heard(open_hall):
+    cfg = RadioConfig(shadowing_sigma_db=0.0)
+    model = RadioModel(open_hall, [[1.0, 5.0]], cfg, np.random.default_rng(3))
+    near = np.array([6.0, 5.0])
+    readings = np.array([model.measure(near)[0] for _ in range(2000)])
+    assert readings.dtype.kind == "i"
+    assert readings.mean() == pytest.approx(model.mean_rssi(near)[0, 0], abs=0.15)
+    assert readings.std() == pytest.approx(math.hypot(2.0, 1 / math.sqrt(12)), rel=0.1)
+    weak = RadioConfig(tx_power_dbm=-40.0, shadowing_sigma_db=0.0, noise_sigma_db=0.0)
+    far = RadioModel(open_hall, [[1.0, 5.0]], weak, np.random.default_rng(0))
+    assert far.measure(np.array([19.0, 5.0])).tolist() == [NOT_HEARD_DBM]
+
+
+def test_routers_in_walls_or_outside_are_rejected(two_rooms):
+    with pytest.raises(ConfigError, match=r"router 1 at \(5\.000, 2\.000\) is inside a wall"):
+        RadioModel(two_rooms, [[1.0, 1.0], [5.0, 2.0]])
+    with pytest.raises(ConfigError, match="outside the building"):
+        RadioModel(two_rooms, [[50.0, 2.0]])
+    with pytest.raises(ConfigError, match="shape"):
+        RadioModel(two_rooms, [1.0, 2.0])
+    with pytest.raises(ConfigError, match="finite"):
+        RadioModel(two_rooms, [[np.nan, 2.0]])
+
+
+def test_config_validation_and_presets():
+    assert RadioConfig.preset("thick").wall_loss_db["brick"] == 15.0
+    assert RadioConfig.preset("residential").wall_loss_db["drywall"] == 3.0
+    assert RadioConfig.preset("default", band="5").d0_loss_db == pytest.approx(46.8, abs=0.1)
+    with pytest.raises(ConfigError, match="preset"):
+        RadioConfig.preset("swamp")
+    with pytest.raises(ConfigError, match="noise_sigma_db"):
+        RadioConfig(noise_sigma_db=-1.0)
+    with pytest.raises(ConfigError, match="wall_loss_db"):
+        RadioConfig(wall_loss_db={"brick": 3.0})
+    with pytest.raises(ConfigError, match="tx_power_dbm"):
+        RadioConfig(tx_power_dbm=float("nan"))
+    assert RadioConfig().to_dict()["wall_loss_db"]["generic"] == 10.0
