@@ -1,9 +1,15 @@
-"""sfw_gym: a Gymnasium environment for active WiFi exploration (Structure from WiFi)."""
+"""sfw_gym: a Gymnasium environment for active WiFi exploration (Structure from WiFi).
+
+``import sfw_gym`` registers the environments (``gym.make("SfW-Explore-v0")``).
+"""
 
 from __future__ import annotations
 
+from sfw_gym.envs import ENV_IDS, register_envs
 from sfw_gym.errors import ConfigError, FloorplanError
 
 __version__ = "0.1.0"
 
-__all__ = ["ConfigError", "FloorplanError", "__version__"]
+register_envs()
+
+__all__ = ["ENV_IDS", "ConfigError", "FloorplanError", "__version__"]

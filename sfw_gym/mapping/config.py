@@ -37,9 +37,18 @@ class MapperConfig:
         refit_growth: Geometric refit schedule: the next fit after ``n * refit_growth`` samples.
         refit_max_interval: Refit at least every this many samples, whatever the growth.
         fit_buffer_size: Most samples per router kept for fitting (a uniform, strided subsample).
-        prior_wall_loss_db: Threshold spacing of the prior used before the first fit.
+        prior_wall_loss_db: Expected loss per wall: the threshold spacing of the prior before
+            the first fit, and of thresholds extrapolated beyond the levels seen so far.
+        k0_level_dbm: Optional calibration (``"distance_aware"`` only): the distance-corrected
+            RSSI with no wall in between, i.e. ``P_tx - PL(1 m)``. With it, the strongest level
+            seen is not assumed to be k = 0 but gets ``round((k0_level_dbm - C_0) /
+            prior_wall_loss_db)``, so a router heard only through walls is read right. None:
+            the strongest level is k = 0 (the paper).
         min_cluster_gap_db: Adjacent sorted centroids closer than this are merged (so data with
             fewer than K + 1 levels is not split); 0 keeps exactly K + 1 clusters as the paper.
+        min_level_fraction: Clusters holding less than this fraction of the samples are merged
+            into their nearest neighbour (outliers, e.g. right beside a router, must not
+            become the k = 0 level); 0 disables.
         router_policy: ``"strongest"`` updates along the strongest router's ray only (the
             paper); ``"all"`` fuses the rays of every heard router.
         robot_radius_m: Footprint radius; footprint cells are observed free (rule 1).
@@ -51,6 +60,8 @@ class MapperConfig:
         wall_ref_length_m: Piece length up to which the Eq. 6 peak keeps its full height.
         wall_sigma_fraction: Eq. 6 width: sigma = fraction * piece length.
         wall_sigma_min_m: Lower bound on the Eq. 6 sigma.
+        wall_cap_factor: One piece's wall evidence lifts a cell's log-odds to at most this
+            multiple of its own Eq. 6 log-odds (repeated weak evidence stays weak).
         log_odds_min: Clamp for free evidence (keeps the map able to change its mind).
         log_odds_max: Clamp for wall evidence.
         trajectory_gap_max_m: Successive positions closer than this are joined when rasterising
@@ -71,7 +82,9 @@ class MapperConfig:
     refit_max_interval: int = 2000
     fit_buffer_size: int = 4096
     prior_wall_loss_db: float = 10.0
+    k0_level_dbm: float | None = None
     min_cluster_gap_db: float = 5.0
+    min_level_fraction: float = 0.02
     router_policy: str = "strongest"
     robot_radius_m: float = 0.17
     free_log_odds: float = -0.4
@@ -79,8 +92,9 @@ class MapperConfig:
     bump_log_odds: float = 3.0
     wall_peak_probability: float = 0.8
     wall_ref_length_m: float = 0.5
-    wall_sigma_fraction: float = 0.25
+    wall_sigma_fraction: float = 0.15
     wall_sigma_min_m: float = 0.05
+    wall_cap_factor: float = 2.0
     log_odds_min: float = -4.0
     log_odds_max: float = 4.0
     trajectory_gap_max_m: float = 1.0
@@ -112,6 +126,7 @@ class MapperConfig:
             "wall_ref_length_m",
             "wall_sigma_fraction",
             "wall_sigma_min_m",
+            "wall_cap_factor",
             "log_odds_max",
             "bump_log_odds",
         )
@@ -128,11 +143,22 @@ class MapperConfig:
             v = getattr(self, name)
             if not _is_number(v) or v >= 0:
                 raise ConfigError(f"{name} must be a finite number < 0, got {v!r}")
+        f = self.min_level_fraction
+        if not _is_number(f) or not 0.0 <= f < 0.5:
+            raise ConfigError(f"min_level_fraction must be in [0, 0.5), got {f!r}")
         if not _is_number(self.refit_growth) or self.refit_growth <= 1.0:
             raise ConfigError(f"refit_growth must be a number > 1, got {self.refit_growth!r}")
         p = self.wall_peak_probability
         if not _is_number(p) or not 0.5 < p < 1.0:
             raise ConfigError(f"wall_peak_probability must be in (0.5, 1), got {p!r}")
+        if self.k0_level_dbm is not None:
+            if not _is_number(self.k0_level_dbm):
+                raise ConfigError(f"k0_level_dbm must be None or finite, got {self.k0_level_dbm!r}")
+            if self.k_estimator != "distance_aware":
+                raise ConfigError(
+                    "k0_level_dbm needs k_estimator='distance_aware' (raw RSSI has no fixed "
+                    f"no-wall level), got k_estimator={self.k_estimator!r}"
+                )
         if not isinstance(self.extend_past_robot, bool):
             raise ConfigError(f"extend_past_robot must be a bool, got {self.extend_past_robot!r}")
         if self.outer_bounds_m is not None:

@@ -2,16 +2,30 @@
 
 Per router, each reading becomes a *feature*: the RSSI itself (``"kmeans"``, the paper) or the
 RSSI with the log-distance term removed, ``rssi + 10 n log10(d)`` (``"distance_aware"``).
-A sliding-window mean smooths the feature. Thresholds ``t_1 > ... > t_K`` come from 1-D k-means
-(scikit-learn) with ``K + 1`` clusters: with sorted centroids ``C_0 > ... > C_K``,
-``t_j = (C_{j-1} + C_j) / 2``, and ``k = #{j : t_j >= feature}`` (so ``k = 0`` above ``t_1``).
-Adjacent centroids closer than ``min_cluster_gap_db`` are merged first (weighted by cluster
-size), so data with fewer levels than ``K + 1`` is not split into spurious k-values.
+A sliding-window mean smooths the feature, and ``k = #{j : t_j >= feature}`` for descending
+thresholds ``t_1 > t_2 > ...`` (so ``k = 0`` above ``t_1``, ``k = K`` at or below ``t_K``).
 
-Before ``refit_min_samples`` samples a prior applies: ``t_j = f_max - (j - 0.5) * prior_wall_loss_db``
-with ``f_max`` the largest filtered feature so far (the strongest readings are taken as k = 0).
-Refits follow a geometric schedule (the next after ``n * refit_growth`` samples, at most
-``refit_max_interval`` apart) on a bounded, strided subsample, so their cost is amortised.
+Thresholds come from 1-D k-means (scikit-learn, single-threaded, deterministic quantile
+initialisation) with ``K + 1`` clusters on the router's samples. With sorted centroids
+``C_0 > C_1 > ...``:
+
+1. adjacent centroids closer than ``min_cluster_gap_db`` are merged (size-weighted), so data
+   holding fewer levels than ``K + 1`` is not split into spurious k-values, and clusters with
+   less than ``min_level_fraction`` of the samples join their nearest neighbour (outliers must
+   not become the k = 0 level); the remaining *levels* ``G_0 > ... > G_{m-1}``;
+2. the strongest level gets ``k_top = 0`` (the paper) or, with ``k0_level_dbm`` set,
+   ``round((k0_level_dbm - G_0) / prior_wall_loss_db)``; each following level one more;
+3. thresholds between levels are the midpoints ``(G_{i-1} + G_i) / 2`` (the paper's
+   ``t_k = (C_{k-1} + C_k) / 2``); thresholds above ``G_0`` (when ``k_top > 0``) and below
+   ``G_{m-1}`` (levels not seen yet) are spaced ``prior_wall_loss_db`` apart, half a wall
+   loss from the nearest level; at most ``K`` thresholds are kept.
+
+Before ``refit_min_samples`` samples a prior applies: ``t_j = top - (j - 0.5) * prior_wall_loss_db``
+with ``top`` the largest filtered feature so far (or ``k0_level_dbm``). Refits follow a
+geometric schedule (the next after ``n * refit_growth`` samples, at most ``refit_max_interval``
+apart) on a bounded, strided subsample, so their cost is amortised; a refit also comes early
+once ``refit_min_samples // 2`` samples have fallen more than half a wall loss outside the
+fitted centroids (a new level, e.g. the robot entered a room behind another wall).
 
 A reading of -100 dBm or less means "not heard": that router gets k = -1 and nothing is stored.
 """
@@ -23,11 +37,13 @@ import math
 import numpy as np
 from numba import njit
 from sklearn.cluster import KMeans
+from threadpoolctl import ThreadpoolController
 
 from sfw_gym.errors import ConfigError
 from sfw_gym.mapping.config import MapperConfig
 
 NOT_HEARD_DBM = -100.0
+_THREADPOOLS: ThreadpoolController | None = None
 
 
 @njit(cache=True)
@@ -50,6 +66,7 @@ def add_samples(
     path_loss_exponent,
     min_distance,
     prior_gap,
+    calibrated,
     ring,
     ring_pos,
     ring_count,
@@ -62,6 +79,9 @@ def add_samples(
     n_thr,
     fitted,
     max_feature,
+    fit_range,
+    novel,
+    novel_needed,
     out_feature,
     out_k,
 ):
@@ -102,56 +122,114 @@ def add_samples(
                 fit_buf[r, fit_n[r]] = f
                 fit_n[r] += 1
         n_seen[r] += 1
-        if not fitted[r]:
-            if f > max_feature[r]:
-                max_feature[r] = f
-                for j in range(max_k):
-                    thresholds[r, j] = f - (j + 0.5) * prior_gap
-                n_thr[r] = max_k
+        if fitted[r]:
+            if f > fit_range[r, 0] + 0.5 * prior_gap or f < fit_range[r, 1] - 0.5 * prior_gap:
+                novel[r] += 1
+                if novel[r] >= novel_needed:
+                    next_refit[r] = n_seen[r]
+        elif not calibrated and f > max_feature[r]:
+            max_feature[r] = f
+            for j in range(max_k):
+                thresholds[r, j] = f - (j + 0.5) * prior_gap
+            n_thr[r] = max_k
         out_k[r] = k_from_thresholds(f, thresholds[r], n_thr[r])
         if n_seen[r] >= next_refit[r]:
             due = True
     return due
 
 
-def thresholds_from_centroids(
-    centroids: np.ndarray, counts: np.ndarray, min_gap: float
+def merge_levels(
+    centroids: np.ndarray, counts: np.ndarray, min_gap: float, min_fraction: float = 0.0
 ) -> np.ndarray:
-    """Descending thresholds at midpoints of sorted centroids, after merging close ones.
+    """Sorted (descending) levels after merging close and small clusters.
 
-    Args:
-        centroids: 1-D cluster centres (any order).
-        counts: Cluster sizes (weights for merging), same length.
-        min_gap: Adjacent centroids closer than this are merged into their weighted mean,
-            closest pair first. 0 disables merging.
-
-    Returns:
-        1-D array ``t_1 > t_2 > ...`` of length (number of clusters left) - 1.
+    First, while the closest adjacent pair is nearer than ``min_gap``, it is merged into its
+    size-weighted mean. Then, while the smallest cluster holds less than ``min_fraction`` of the
+    samples, it is merged into its nearer neighbour. 0 disables either step.
     """
     order = np.argsort(-np.asarray(centroids, dtype=np.float64))
     c = list(np.asarray(centroids, dtype=np.float64)[order])
     w = list(np.maximum(np.asarray(counts, dtype=np.float64)[order], 1e-12))
+
+    def merge(i: int) -> None:
+        wt = w[i] + w[i + 1]
+        c[i] = (c[i] * w[i] + c[i + 1] * w[i + 1]) / wt
+        w[i] = wt
+        del c[i + 1], w[i + 1]
+
     while len(c) > 1:
         gaps = [c[i] - c[i + 1] for i in range(len(c) - 1)]
         i = int(np.argmin(gaps))
         if gaps[i] >= min_gap:
             break
-        wt = w[i] + w[i + 1]
-        c[i] = (c[i] * w[i] + c[i + 1] * w[i + 1]) / wt
-        w[i] = wt
-        del c[i + 1], w[i + 1]
-    c_arr = np.asarray(c)
-    return (c_arr[:-1] + c_arr[1:]) / 2.0
+        merge(i)
+    total = sum(w)
+    while len(c) > 1:
+        i = int(np.argmin(w))
+        if w[i] >= min_fraction * total:
+            break
+        if i == 0:
+            merge(0)
+        elif i == len(c) - 1 or c[i - 1] - c[i] <= c[i] - c[i + 1]:
+            merge(i - 1)
+        else:
+            merge(i)
+    return np.asarray(c)
+
+
+def thresholds_from_levels(
+    levels: np.ndarray, max_k: int, wall_loss_db: float, k_top: int = 0
+) -> np.ndarray:
+    """Descending thresholds for descending levels whose first has k-value ``k_top``.
+
+    See the module docstring (step 3). Returns at most ``max_k`` thresholds.
+    """
+    g = np.asarray(levels, dtype=np.float64)
+    above = g[0] + (k_top - np.arange(1, k_top + 1) + 0.5) * wall_loss_db
+    between = (g[:-1] + g[1:]) / 2.0
+    n_below = max(0, max_k - k_top - (g.size - 1))
+    below = g[-1] - (np.arange(n_below) + 0.5) * wall_loss_db
+    return np.concatenate([above, between, below])[:max_k]
+
+
+def fit_levels(data: np.ndarray, max_k: int, min_gap_db: float, min_fraction: float = 0.0):
+    """1-D k-means with ``max_k + 1`` clusters on ``data``.
+
+    Returns:
+        ``(levels, (lowest, highest))``: the merged descending levels and the extreme raw
+        centroids, or None when the data has fewer than 2 distinct values.
+    """
+    global _THREADPOOLS
+    x = np.asarray(data, dtype=np.float64)
+    uniq = np.unique(x)
+    if uniq.size < 2:
+        return None
+    n_clusters = min(max_k + 1, uniq.size)
+    init = np.quantile(x, (np.arange(n_clusters) + 0.5) / n_clusters)
+    if np.unique(init).size < n_clusters:
+        init = np.quantile(uniq, (np.arange(n_clusters) + 0.5) / n_clusters)
+    km = KMeans(n_clusters=n_clusters, init=init[:, None], n_init=1, max_iter=100)
+    if _THREADPOOLS is None:
+        _THREADPOOLS = ThreadpoolController()
+    # One thread: the fit is tiny, and OpenMP spin-waits on a shared machine cost milliseconds.
+    with _THREADPOOLS.limit(limits=1, user_api="openmp"):
+        labels = km.fit_predict(x[:, None])
+    counts = np.bincount(labels, minlength=n_clusters)
+    keep = counts > 0
+    cents = km.cluster_centers_[keep, 0]
+    levels = merge_levels(cents, counts[keep], min_gap_db, min_fraction)
+    return levels, (float(cents.min()), float(cents.max()))
 
 
 class KEstimator:
     """Per-router RSSI -> k estimator (see the module docstring for the method).
 
-    Use :meth:`update` (add a reading and get k), or :meth:`add` then :meth:`estimate`.
+    Use :meth:`update` (add a reading and get its k-values), or :meth:`add` then
+    :meth:`estimate` / :attr:`last_k`.
 
     Args:
         n_routers: Number of routers R.
-        config: Mapper configuration (k-estimation fields are used).
+        config: Mapper configuration (its k-estimation fields are used).
     """
 
     def __init__(self, n_routers: int, config: MapperConfig | None = None) -> None:
@@ -178,8 +256,16 @@ class KEstimator:
         self._next_refit = np.full(n, cfg.refit_min_samples, np.int64)
         self._thresholds = np.full((n, cfg.max_k), -np.inf)
         self._n_thr = np.zeros(n, np.int64)
+        if cfg.k0_level_dbm is not None:
+            prior = thresholds_from_levels(
+                np.array([cfg.k0_level_dbm]), cfg.max_k, cfg.prior_wall_loss_db
+            )
+            self._thresholds[:] = prior
+            self._n_thr[:] = prior.size
         self._fitted = np.zeros(n, np.bool_)
         self._max_feature = np.full(n, -np.inf)
+        self._fit_range = np.zeros((n, 2))
+        self._novel = np.zeros(n, np.int64)
         self._feature = np.full(n, np.nan)
         self._k = np.full(n, -1, np.int64)
         self.n_refits = 0
@@ -192,6 +278,7 @@ class KEstimator:
             float(cfg.path_loss_exponent),
             float(cfg.min_distance_m),
             float(cfg.prior_wall_loss_db),
+            cfg.k0_level_dbm is not None,
             self._ring,
             self._ring_pos,
             self._ring_count,
@@ -204,6 +291,9 @@ class KEstimator:
             self._n_thr,
             self._fitted,
             self._max_feature,
+            self._fit_range,
+            self._novel,
+            max(2, cfg.refit_min_samples // 2),
         )
 
     def _check(self, name: str, values) -> np.ndarray:
@@ -222,8 +312,8 @@ class KEstimator:
             distances_m: ``(R,)`` robot-router distances in metres (ignored by ``"kmeans"``).
 
         Returns:
-            ``(R,)`` filtered features (NaN where not heard). The k-values of this reading are
-            available from :meth:`estimate` or :attr:`last_k`.
+            ``(R,)`` filtered features (NaN where not heard). The reading's k-values, under the
+            thresholds after any refit, are in :attr:`last_k`.
         """
         rssi = self._check("rssi_dbm", rssi_dbm)
         dist = self._check("distances_m", distances_m)
@@ -263,7 +353,7 @@ class KEstimator:
         return self._thresholds[router, : self._n_thr[router]].copy()
 
     def refit(self, force: bool = False) -> None:
-        """Refit the thresholds of every router whose schedule is due (all heard ones if forced)."""
+        """Refit every router whose schedule is due (every router with samples if forced)."""
         cfg = self.config
         for r in range(self.n_routers):
             n_seen = int(self._n_seen[r])
@@ -271,35 +361,20 @@ class KEstimator:
                 continue
             growth = math.ceil(n_seen * (cfg.refit_growth - 1.0))
             self._next_refit[r] = n_seen + max(1, min(growth, cfg.refit_max_interval))
-            if n_seen < cfg.refit_min_samples and not force:
-                continue
+            self._novel[r] = 0
             data = self._fit_buf[r, : self._fit_n[r]]
-            thr = fit_thresholds(data, cfg.max_k, cfg.min_cluster_gap_db)
-            if thr is None:
+            fit = fit_levels(data, cfg.max_k, cfg.min_cluster_gap_db, cfg.min_level_fraction)
+            if fit is None:
                 continue
+            levels, (lowest, highest) = fit
+            k_top = 0
+            if cfg.k0_level_dbm is not None:
+                k_top = round((cfg.k0_level_dbm - levels[0]) / cfg.prior_wall_loss_db)
+                k_top = min(max(k_top, 0), cfg.max_k)
+            thr = thresholds_from_levels(levels, cfg.max_k, cfg.prior_wall_loss_db, k_top)
             self._thresholds[r, :] = -np.inf
             self._thresholds[r, : thr.size] = thr
             self._n_thr[r] = thr.size
+            self._fit_range[r] = (highest, lowest)
             self._fitted[r] = True
             self.n_refits += 1
-
-
-def fit_thresholds(data: np.ndarray, max_k: int, min_gap_db: float) -> np.ndarray | None:
-    """Thresholds from 1-D k-means with ``max_k + 1`` clusters (None if < 2 distinct values).
-
-    The initial centroids are the data's quantiles at ``(i + 0.5) / (max_k + 1)``, so the fit
-    is deterministic.
-    """
-    x = np.asarray(data, dtype=np.float64)
-    uniq = np.unique(x)
-    if uniq.size < 2:
-        return None
-    n_clusters = min(max_k + 1, uniq.size)
-    init = np.quantile(x, (np.arange(n_clusters) + 0.5) / n_clusters)
-    if np.unique(init).size < n_clusters:
-        init = np.quantile(uniq, (np.arange(n_clusters) + 0.5) / n_clusters)
-    km = KMeans(n_clusters=n_clusters, init=init[:, None], n_init=1, max_iter=100)
-    labels = km.fit_predict(x[:, None])
-    counts = np.bincount(labels, minlength=n_clusters)
-    keep = counts > 0
-    return thresholds_from_centroids(km.cluster_centers_[keep, 0], counts[keep], min_gap_db)

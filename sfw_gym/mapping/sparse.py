@@ -15,15 +15,22 @@ router and, in one compiled kernel:
 4. updates every piece between consecutive anchors by its Delta k:
 
    - Delta k = 0 (rules 2, 4): every cell strictly inside the piece gets ``free_log_odds``;
-   - Delta k = 1 (rule 3, Eq. 6): cell at arc position ``s`` gets ``logit(P(s))`` with
+   - Delta k = 1 (rule 3, Eq. 6): the wall lies in the piece shortened by ``robot_radius_m`` at
+     each end that is a trajectory point (a robot centre keeps that far from walls; the router
+     end is not shortened); with ``L`` that length and ``s`` the arc position from its start,
+     a cell gets ``logit(P(s))``,
      ``P(s) = 0.5 + (p_peak - 0.5) * min(1, L_ref / L) * exp(-(s - L/2)^2 / (2 sigma^2))``,
-     ``sigma = max(sigma_min, sigma_fraction * L)``, ``L`` the piece length: a peak at the midpoint
-     that lowers and widens as the piece grows; cells where the excess is below 1e-3 are skipped;
+     ``sigma = max(sigma_min, sigma_fraction * L)``: a peak at the midpoint that lowers and
+     widens as the piece grows; cells where the excess is below 1e-3 are skipped. The interval
+     is also trimmed of the cells already classified free at either end (the wall cannot be
+     there), so the estimate sharpens as the map fills in;
+     One piece lifts a cell to at most ``wall_cap_factor * logit(P(s))``: successive readings
+     along one ray are far from independent, and summing many flat, long-piece likelihoods
+     would otherwise build confident walls out of weak evidence;
    - Delta k = m > 1: the piece is cut into m equal sub-pieces, each updated as Delta k = 1
      (m peaks at the sub-piece midpoints);
-   - Delta k < 0, or Delta k > 0 on a piece shorter than ``2 * robot_radius_m`` between two
-     trajectory points (two robot centres cannot have a wall between them closer than that):
-     inconsistent, skipped;
+   - Delta k < 0, or Delta k > 0 on a piece with no room for a wall (robot centres closer than
+     ``2 * robot_radius_m``, or every cell known free): inconsistent, skipped;
 
 5. fuses by adding log-odds (Eq. 7), clamped to ``[log_odds_min, log_odds_max]``, and keeps the
    map entropy, the uint8 map and the cell classes up to date for the touched cells only.
@@ -63,7 +70,8 @@ _S_ENTROPY, _S_UID, _S_PREV_X, _S_PREV_Y, _S_HAS_PREV, _S_N_TOUCHED, _S_N_CHANGE
     _P_LMIN,
     _P_LMAX,
     _P_GAP,
-) = range(12)
+    _P_CAP,
+) = range(13)
 # Cell classes kept in `cls`.
 CLASS_UNKNOWN, CLASS_FREE, CLASS_WALL = 0, 1, 2
 
@@ -79,9 +87,9 @@ def cell_entropy_bits(lo):
 @njit(cache=True)
 def log_odds_to_u8(lo):
     """``floor(255 * P(free))``: 0 wall ... 255 free, 127 at log-odds 0."""
-    p_free = 1.0 / (1.0 + np.exp(lo))
-    v = int(np.floor(255.0 * p_free))
-    return min(max(v, 0), 255)
+    e = np.exp(-abs(lo))
+    p_free = e / (1.0 + e) if lo >= 0.0 else 1.0 / (1.0 + e)
+    return min(int(255.0 * p_free), 255)
 
 
 @njit(cache=True)
@@ -93,92 +101,103 @@ def _u8_class(v):
     return CLASS_UNKNOWN
 
 
-@njit(cache=True)
-def _apply(cell, delta, lo, cls, inside, stamp, touched, old_cls, state, lmin, lmax):
-    """Add ``delta`` to one cell's log-odds; returns the entropy decrease (bits)."""
+@njit(cache=True, inline="always")
+def _apply(cell, delta, cap, lmin, maps, track):
+    """Add ``delta`` to one cell's log-odds; returns the entropy decrease (bits).
+
+    The result is clamped below at ``lmin``; a positive ``delta`` never lifts the cell above
+    ``cap`` (nor lowers one already above it). Keeps the cell's entropy and uint8 value current
+    and records the cell (with its class before this update) the first time it is touched.
+    """
+    lo, ent, u8, cls, classified, inside, stamp = maps
+    touched, old_cls, changed, state = track
     if not inside[cell]:
+        return 0.0
+    old = lo[cell]
+    if delta > 0.0:
+        new = np.float32(min(old + delta, max(old, cap)))
+    else:
+        new = np.float32(max(old + delta, lmin))
+    if new == old:
         return 0.0
     uid = np.int64(state[_S_UID])
     if stamp[cell] != uid:
         n = np.int64(state[_S_N_TOUCHED])
-        if n >= touched.shape[0]:
-            return 0.0
         stamp[cell] = uid
         touched[n] = cell
         old_cls[n] = cls[cell]
         state[_S_N_TOUCHED] = n + 1
-    old = lo[cell]
-    new = np.float32(min(max(old + delta, lmin), lmax))
-    if new == old:
-        return 0.0
     lo[cell] = new
-    return cell_entropy_bits(old) - cell_entropy_bits(new)
+    a = abs(np.float64(new))
+    e = np.exp(-a)
+    h = (np.log1p(e) + a * e / (1.0 + e)) / _LN2
+    gain = ent[cell] - h
+    ent[cell] = h
+    p_free = e / (1.0 + e) if new >= 0.0 else 1.0 / (1.0 + e)
+    u8[cell] = min(int(255.0 * p_free), 255)
+    return gain
 
 
 @njit(cache=True)
-def _wall_piece(
-    s_a, s_b, dk, j0, j1, rows, cols, t0, t1, l_tot, n_cols, params, arrays_lo, cls, inside,
-    stamp, touched, old_cls, state,
-):  # fmt: skip
-    """Eq. 6 over cells ``j0..j1-1`` of a piece ``[s_a, s_b]`` (cell units) holding ``dk`` walls."""
+def _wall_piece(s_a, s_b, dk, j0, j1, ray, l_tot, n_cols, params, maps, track):
+    """Eq. 6 over ray cells ``j0..j1-1`` for an interval ``[s_a, s_b]`` holding ``dk`` walls."""
+    rows, cols, t0, t1 = ray
     res = params[_P_RES]
     sub = (s_b - s_a) / dk
     sigma = max(params[_P_SMIN] / res, params[_P_SFRAC] * sub)
     amp = (params[_P_PEAK] - 0.5) * min(1.0, params[_P_LREF] / (sub * res))
     inv2s2 = 1.0 / (2.0 * sigma * sigma)
+    lmin = params[_P_LMIN]
+    lmax = params[_P_LMAX]
+    cap_factor = params[_P_CAP]
     gain = 0.0
     for j in range(j0, j1):
         s = 0.5 * (t0[j] + t1[j]) * l_tot
-        q = int(np.floor((s - s_a) / sub))
-        q = min(max(q, 0), dk - 1)
+        q = min(max(int(np.floor((s - s_a) / sub)), 0), dk - 1)
         c = s_a + (q + 0.5) * sub
         x = amp * np.exp(-(s - c) * (s - c) * inv2s2)
         if x < 1e-3:
             continue
         p = 0.5 + x
         delta = np.log(p / (1.0 - p))
-        cell = rows[j] * n_cols + cols[j]
-        gain += _apply(
-            cell, delta, arrays_lo, cls, inside, stamp, touched, old_cls, state,
-            params[_P_LMIN], params[_P_LMAX],
-        )  # fmt: skip
+        cap = min(lmax, cap_factor * delta)
+        gain += _apply(rows[j] * n_cols + cols[j], delta, cap, lmin, maps, track)
     return gain
 
 
 @njit(cache=True)
 def _ray_update(
-    r, k_robot, gx, gy, rgx, rgy, extend, n_rows, n_cols, params, raster, thresholds, n_thr,
-    lo, cls, inside, stamp, touched, old_cls, state, rows, cols, t0, t1, anc_j, anc_s, anc_k,
+    r, k_robot, gx, gy, rgx, rgy, extend, params, raster, thresholds, n_thr, maps, track, ray,
+    anchors,
 ):  # fmt: skip
     """Segment the ray of router ``r`` at earlier trajectory points and update every piece."""
+    rows, cols, t0, t1 = ray
+    anc_j, anc_s, anc_k = anchors
+    cls = maps[3]
+    n_rows = raster.shape[1]
+    n_cols = raster.shape[2]
     dx = gx - rgx
     dy = gy - rgy
     dist = np.sqrt(dx * dx + dy * dy)
     if dist < 1e-9:
         return 0.0
+    ex, ey = gx, gy
     if extend:
         ext = (n_rows + n_cols + 2.0) / dist
         ex = gx + dx * ext
         ey = gy + dy * ext
-    else:
-        ex = gx
-        ey = gy
     n = traverse_grid(rgx, rgy, ex, ey, n_rows, n_cols, rows, cols, t0, t1)
     if n == 0:
         return 0.0
     l_tot = np.sqrt((ex - rgx) ** 2 + (ey - rgy) ** 2)
     t_robot = dist / l_tot
-    # Robot's cell on the ray: the first whose exit parameter reaches the robot.
+    # The robot's cell on the ray: the first whose exit parameter reaches the robot.
     i_r = n - 1
     for j in range(n):
         if t1[j] >= t_robot:
             i_r = j
             break
-    lmin = params[_P_LMIN]
-    lmax = params[_P_LMAX]
-    min_wall_piece = 2.0 * params[_P_RADIUS] / params[_P_RES]
     # Anchors: router (k = 0), earlier trajectory cells, robot, first trajectory cell beyond.
-    n_anc = 0
     anc_j[0] = -1
     anc_s[0] = 0.0
     anc_k[0] = 0
@@ -203,6 +222,10 @@ def _ray_update(
                 anc_k[n_anc] = k_from_thresholds(f, thresholds[r], n_thr[r])
                 n_anc += 1
                 break
+    rad = params[_P_RADIUS] / params[_P_RES]
+    lmin = params[_P_LMIN]
+    lmax = params[_P_LMAX]
+    free = params[_P_FREE]
     gain = 0.0
     for a in range(n_anc - 1):
         j0 = anc_j[a] + 1
@@ -212,31 +235,46 @@ def _ray_update(
         dk = anc_k[a + 1] - anc_k[a]
         if dk == 0:
             for j in range(j0, j1):
-                cell = rows[j] * n_cols + cols[j]
-                gain += _apply(
-                    cell, params[_P_FREE], lo, cls, inside, stamp, touched, old_cls, state,
-                    lmin, lmax,
-                )  # fmt: skip
+                gain += _apply(rows[j] * n_cols + cols[j], free, lmax, lmin, maps, track)
         elif dk > 0:
-            s_a = anc_s[a]
-            s_b = anc_s[a + 1]
-            if a > 0 and s_b - s_a < min_wall_piece:
+            # A wall keeps a robot radius from every trajectory point (the router is none),
+            # and lies beyond the cells already known free at either end of the piece.
+            s_a = anc_s[a] + (rad if a > 0 else 0.0)
+            s_b = anc_s[a + 1] - rad
+            j_lo = j0
+            while j_lo < j1 and cls[rows[j_lo] * n_cols + cols[j_lo]] == CLASS_FREE:
+                j_lo += 1
+            j_hi = j1
+            while j_hi > j_lo and cls[rows[j_hi - 1] * n_cols + cols[j_hi - 1]] == CLASS_FREE:
+                j_hi -= 1
+            if j_hi == j_lo:
                 continue
-            gain += _wall_piece(
-                s_a, s_b, dk, j0, j1, rows, cols, t0, t1, l_tot, n_cols, params, lo, cls,
-                inside, stamp, touched, old_cls, state,
-            )  # fmt: skip
+            s_a = max(s_a, t0[j_lo] * l_tot)
+            s_b = min(s_b, t1[j_hi - 1] * l_tot)
+            if s_b - s_a <= 1e-9:
+                continue
+            gain += _wall_piece(s_a, s_b, dk, j0, j1, ray, l_tot, n_cols, params, maps, track)
     return gain
 
 
 @njit(cache=True)
 def _update_kernel(
-    gx, gy, rssi, bumped, heading, routers_g, policy_all, extend, params, kest_da, kest_n,
-    kest_dmin, kest_gap, ring, ring_pos, ring_count, fit_buf, fit_n, fit_stride, n_seen,
-    next_refit, thresholds, n_thr, fitted, max_feature, feature, k_out, selected, dist_buf,
-    lo, u8, cls, classified, inside, raster, stamp, touched, old_cls, changed, state,
-    rows, cols, t0, t1, anc_j, anc_s, anc_k,
+    gx, gy, rssi, bumped, heading, routers_g, policy_all, extend, params, kest, feature, k_out,
+    selected, dist_buf, raster, maps, track, ray, anchors,
 ):  # fmt: skip
+    """One full update; returns ``(gain_bits, refit_due)``, or ``(nan, False)`` untouched if an
+    RSSI value is not finite."""
+    for r in range(rssi.shape[0]):
+        if not np.isfinite(rssi[r]):
+            return np.nan, False
+    (
+        kest_da, kest_n, kest_dmin, kest_gap, kest_cal, ring, ring_pos, ring_count, fit_buf,
+        fit_n, fit_stride, n_seen, next_refit, thresholds, n_thr, fitted, max_feature,
+        fit_range, novel, novel_needed,
+    ) = kest  # fmt: skip
+    lo, ent, u8, cls, classified, inside, stamp = maps
+    touched, old_cls, changed, state = track
+    rows, cols, t0, t1 = ray
     n_rows = raster.shape[1]
     n_cols = raster.shape[2]
     n_r = rssi.shape[0]
@@ -249,9 +287,9 @@ def _update_kernel(
     for r in range(n_r):
         dist_buf[r] = res * np.sqrt((gx - routers_g[r, 0]) ** 2 + (gy - routers_g[r, 1]) ** 2)
     due = add_samples(
-        rssi, dist_buf, kest_da, kest_n, kest_dmin, kest_gap, ring, ring_pos, ring_count,
-        fit_buf, fit_n, fit_stride, n_seen, next_refit, thresholds, n_thr, fitted, max_feature,
-        feature, k_out,
+        rssi, dist_buf, kest_da, kest_n, kest_dmin, kest_gap, kest_cal, ring, ring_pos,
+        ring_count, fit_buf, fit_n, fit_stride, n_seen, next_refit, thresholds, n_thr, fitted,
+        max_feature, fit_range, novel, novel_needed, feature, k_out,
     )  # fmt: skip
     gain = 0.0
     # Rule 1: footprint free; a bump marks the contact cell ahead occupied.
@@ -262,24 +300,19 @@ def _update_kernel(
     r_hi = min(int(np.floor(gy + rad)) + 1, n_rows - 1)
     c_lo = max(int(np.floor(gx - rad)) - 1, 0)
     c_hi = min(int(np.floor(gx + rad)) + 1, n_cols - 1)
+    foot = params[_P_FOOT]
     for i in range(r_lo, r_hi + 1):
         for j in range(c_lo, c_hi + 1):
             ddx = j + 0.5 - gx
             ddy = i + 0.5 - gy
             if ddx * ddx + ddy * ddy <= rad * rad or (i == rr and j == rc):
-                gain += _apply(
-                    i * n_cols + j, params[_P_FOOT], lo, cls, inside, stamp, touched, old_cls,
-                    state, lmin, lmax,
-                )  # fmt: skip
+                gain += _apply(i * n_cols + j, foot, lmax, lmin, maps, track)
     if bumped and heading == heading:
         reach = rad + 0.5
         bc = int(np.floor(gx + reach * np.cos(heading)))
         br = int(np.floor(gy + reach * np.sin(heading)))
         if 0 <= br < n_rows and 0 <= bc < n_cols and not (br == rr and bc == rc):
-            gain += _apply(
-                br * n_cols + bc, params[_P_BUMP], lo, cls, inside, stamp, touched, old_cls,
-                state, lmin, lmax,
-            )  # fmt: skip
+            gain += _apply(br * n_cols + bc, params[_P_BUMP], lmax, lmin, maps, track)
     # Router selection: the strongest raw RSSI (the paper), or every heard router.
     n_sel = 0
     if policy_all:
@@ -298,9 +331,8 @@ def _update_kernel(
     for q in range(n_sel):
         r = selected[q]
         gain += _ray_update(
-            r, k_out[r], gx, gy, routers_g[r, 0], routers_g[r, 1], extend, n_rows, n_cols,
-            params, raster, thresholds, n_thr, lo, cls, inside, stamp, touched, old_cls, state,
-            rows, cols, t0, t1, anc_j, anc_s, anc_k,
+            r, k_out[r], gx, gy, routers_g[r, 0], routers_g[r, 1], extend, params, raster,
+            thresholds, n_thr, maps, track, ray, anchors,
         )  # fmt: skip
     # Trajectory raster (after the rays, so this reading is not its own anchor).
     n_traj = 0
@@ -319,14 +351,11 @@ def _update_kernel(
     state[_S_PREV_X] = gx
     state[_S_PREV_Y] = gy
     state[_S_HAS_PREV] = 1.0
-    # Refresh the uint8 map and classes of touched cells; record class changes.
-    n_t = np.int64(state[_S_N_TOUCHED])
+    # Classes of the touched cells; record those whose class changed.
     n_c = 0
-    for i in range(n_t):
+    for i in range(np.int64(state[_S_N_TOUCHED])):
         cell = touched[i]
-        v = log_odds_to_u8(lo[cell])
-        u8[cell] = v
-        c = _u8_class(v)
+        c = _u8_class(u8[cell])
         cls[cell] = c
         classified[cell] = c != CLASS_UNKNOWN
         if c != old_cls[i]:
@@ -352,9 +381,7 @@ class SparseInverseKVisibility:
         ConfigError: On a malformed grid, router array or config.
     """
 
-    def __init__(
-        self, grid: GridSpec, routers_xy, config: MapperConfig | None = None
-    ) -> None:
+    def __init__(self, grid: GridSpec, routers_xy, config: MapperConfig | None = None) -> None:
         if not isinstance(grid, GridSpec):
             raise ConfigError(f"grid must be a GridSpec, got {type(grid).__name__}")
         cfg = config if config is not None else MapperConfig()
@@ -369,7 +396,7 @@ class SparseInverseKVisibility:
         self.config = cfg
         self.routers_xy = routers.copy()
         self.routers_xy.flags.writeable = False
-        self.n_routers = routers.shape[0]
+        self.n_routers = n_r = routers.shape[0]
         self._routers_g = grid.world_to_grid(routers)
         self._params = np.array(
             [
@@ -385,39 +412,49 @@ class SparseInverseKVisibility:
                 cfg.log_odds_min,
                 cfg.log_odds_max,
                 cfg.trajectory_gap_max_m,
+                cfg.wall_cap_factor,
             ],
             dtype=np.float64,
         )
-        self._k_estimator = KEstimator(self.n_routers, cfg)
+        self._policy_all = cfg.router_policy == "all"
+        self._k_estimator = KEstimator(n_r, cfg)
         h, w = grid.shape
-        self._inside = np.ones(h * w, np.bool_)
+        n_cells = h * w
+        inside = np.ones(n_cells, np.bool_)
         if cfg.outer_bounds_m is not None:
             xs, ys = grid.cell_centres()
             xmin, ymin, xmax, ymax = cfg.outer_bounds_m
-            self._inside[:] = ((xs >= xmin) & (xs <= xmax) & (ys >= ymin) & (ys <= ymax)).ravel()
+            inside[:] = ((xs >= xmin) & (xs <= xmax) & (ys >= ymin) & (ys <= ymax)).ravel()
         ray_n = ray_buffer_size(grid.shape)
         rad_cells = math.ceil(cfg.robot_radius_m / grid.resolution_m) + 2
-        touched_cap = (2 * rad_cells + 1) ** 2 + 2 + self.n_routers * ray_n
-        self._rows = np.empty(ray_n, np.int64)
-        self._cols = np.empty(ray_n, np.int64)
-        self._t0 = np.empty(ray_n, np.float64)
-        self._t1 = np.empty(ray_n, np.float64)
-        self._anc_j = np.empty(ray_n + 2, np.int64)
-        self._anc_s = np.empty(ray_n + 2, np.float64)
-        self._anc_k = np.empty(ray_n + 2, np.int64)
-        self._touched = np.empty(touched_cap, np.int64)
-        self._old_cls = np.empty(touched_cap, np.int8)
+        touched_cap = (2 * rad_cells + 1) ** 2 + 2 + n_r * ray_n
+        self._lo = np.zeros(n_cells, np.float32)
+        self._ent = np.ones(n_cells, np.float64)
+        self._u8 = np.full(n_cells, U8_UNKNOWN, np.uint8)
+        self._cls = np.zeros(n_cells, np.int8)
+        self._classified = np.zeros(n_cells, np.bool_)
+        self._inside = inside
+        self._stamp = np.zeros(n_cells, np.int64)
+        self._maps = (
+            self._lo, self._ent, self._u8, self._cls, self._classified, inside, self._stamp,
+        )  # fmt: skip
         self._changed = np.empty(touched_cap, np.int64)
-        self._selected = np.empty(self.n_routers, np.int64)
-        self._dist = np.empty(self.n_routers, np.float64)
-        h, w = grid.shape
-        self._lo = np.zeros(h * w, np.float32)
-        self._u8 = np.full(h * w, U8_UNKNOWN, np.uint8)
-        self._cls = np.zeros(h * w, np.int8)
-        self._classified = np.zeros(h * w, np.bool_)
-        self._raster = np.full((self.n_routers, h, w), np.nan, np.float32)
-        self._stamp = np.zeros(h * w, np.int64)
         self._state = np.zeros(7, np.float64)
+        self._track = (
+            np.empty(touched_cap, np.int64), np.empty(touched_cap, np.int8), self._changed,
+            self._state,
+        )  # fmt: skip
+        self._ray = (
+            np.empty(ray_n, np.int64), np.empty(ray_n, np.int64), np.empty(ray_n, np.float64),
+            np.empty(ray_n, np.float64),
+        )  # fmt: skip
+        self._anchors = (
+            np.empty(ray_n + 2, np.int64), np.empty(ray_n + 2, np.float64),
+            np.empty(ray_n + 2, np.int64),
+        )  # fmt: skip
+        self._raster = np.full((n_r, h, w), np.nan, np.float32)
+        self._selected = np.zeros(n_r, np.int64)
+        self._dist = np.empty(n_r, np.float64)
         self._lo_view = self._read_only(self._lo)
         self._u8_view = self._read_only(self._u8)
         self._classified_view = self._read_only(self._classified)
@@ -426,6 +463,7 @@ class SparseInverseKVisibility:
     def reset(self) -> None:
         """Forget the map, the trajectory and the k-estimator (in place: views stay valid)."""
         self._lo.fill(0.0)
+        self._ent.fill(1.0)
         self._u8.fill(U8_UNKNOWN)
         self._cls.fill(CLASS_UNKNOWN)
         self._classified.fill(False)
@@ -434,6 +472,7 @@ class SparseInverseKVisibility:
         self._state.fill(0.0)
         self._state[_S_ENTROPY] = float(self._inside.sum())
         self._k_estimator.reset()
+        self._kest = self._k_estimator._kernel_args()
         self.n_updates = 0
 
     def _read_only(self, flat: np.ndarray) -> np.ndarray:
@@ -465,30 +504,26 @@ class SparseInverseKVisibility:
                 wrong vector length or a non-finite heading. The map is left untouched.
         """
         try:
+            n_pos = len(position_xy)
             x = float(position_xy[0])
             y = float(position_xy[1])
-            n_pos = len(position_xy)
         except (TypeError, ValueError, IndexError) as exc:
             raise ConfigError(f"position_xy must be (x, y), got {position_xy!r}") from exc
         if n_pos != 2 or not (math.isfinite(x) and math.isfinite(y)):
             raise ConfigError(f"position_xy must be two finite numbers, got {position_xy!r}")
-        ox, oy = self.grid.origin_xy
-        res = self.grid.resolution_m
-        gx = (x - ox) / res
-        gy = (y - oy) / res
-        if not (0.0 <= gx < self.grid.n_cols and 0.0 <= gy < self.grid.n_rows):
-            raise ConfigError(
-                f"position_xy {position_xy!r} lies outside the grid bounds {self.grid.bounds}"
-            )
+        grid = self.grid
+        gx = (x - grid.origin_xy[0]) / grid.resolution_m
+        gy = (y - grid.origin_xy[1]) / grid.resolution_m
+        if not (0.0 <= gx < grid.shape[1] and 0.0 <= gy < grid.shape[0]):
+            raise ConfigError(f"position_xy {position_xy!r} lies outside the grid {grid.bounds}")
         rssi = rssi_dbm
-        if not (isinstance(rssi, np.ndarray) and rssi.dtype == np.float64):
-            rssi = np.asarray(rssi_dbm, dtype=np.float64)
+        if type(rssi) is not np.ndarray or rssi.dtype != np.float64:
+            try:
+                rssi = np.asarray(rssi_dbm, dtype=np.float64)
+            except (TypeError, ValueError) as exc:
+                raise ConfigError(f"rssi_dbm must be numbers, got {rssi_dbm!r}") from exc
         if rssi.shape != (self.n_routers,):
             raise ConfigError(f"rssi_dbm must have shape ({self.n_routers},), got {rssi.shape}")
-        if not np.isfinite(rssi).all():
-            raise ConfigError(
-                f"rssi_dbm must be finite (use -100 dBm for 'not heard'), got {rssi.tolist()}"
-            )
         if heading_rad is None:
             heading = math.nan
         else:
@@ -497,17 +532,19 @@ class SparseInverseKVisibility:
                 raise ConfigError(f"heading_rad must be finite or None, got {heading_rad!r}")
         ke = self._k_estimator
         gain, due = _update_kernel(
-            gx, gy, rssi, bool(bumped), heading, self._routers_g,
-            self.config.router_policy == "all", self.config.extend_past_robot, self._params,
-            *ke._kernel_args(), ke._feature, ke._k, self._selected, self._dist,
-            self._lo, self._u8, self._cls, self._classified, self._inside, self._raster,
-            self._stamp, self._touched, self._old_cls, self._changed, self._state,
-            self._rows, self._cols, self._t0, self._t1, self._anc_j, self._anc_s, self._anc_k,
+            gx, gy, rssi, bool(bumped), heading, self._routers_g, self._policy_all,
+            self.config.extend_past_robot, self._params, self._kest, ke._feature, ke._k,
+            self._selected, self._dist, self._raster, self._maps, self._track, self._ray,
+            self._anchors,
         )  # fmt: skip
+        if gain != gain:
+            raise ConfigError(
+                f"rssi_dbm must be finite (use -100 dBm for 'not heard'), got {rssi.tolist()}"
+            )
         if due:
             ke.refit()
         self.n_updates += 1
-        return float(gain)
+        return gain
 
     # -- read-only views and summaries ------------------------------------------------------
     @property

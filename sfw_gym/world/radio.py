@@ -18,6 +18,14 @@ from shapely.geometry import Point
 
 from sfw_gym.errors import ConfigError
 from sfw_gym.world.floorplan import MATERIALS, Floorplan
+from sfw_gym.world.wall_crossing import (
+    DEFAULT_MIN_PIECE_M,
+    cross_walls_from_sources,
+    cross_walls_from_sources_parallel,
+)
+
+#: Above this many points, wall counting runs on all cores.
+_PARALLEL_MIN_POINTS = 256
 
 #: Sentinel RSSI of a router that is not heard.
 NOT_HEARD_DBM = -100
@@ -224,6 +232,8 @@ class RadioModel:
         self.routers = validate_routers(floorplan, routers)
         self.rng = rng if rng is not None else np.random.default_rng()
         self._d0_loss_db = self.config.d0_loss_db
+        losses = self.config.wall_loss_db
+        self._edge_loss_db = np.array([losses[m] for m in floorplan.edge_materials], np.float64)
         self._shadowing = (
             ShadowingField(
                 floorplan.bounds,
@@ -255,21 +265,22 @@ class RadioModel:
         ratio = np.log10(d / self.config.reference_distance_m)
         return self._d0_loss_db + 10.0 * self.config.path_loss_exponent * ratio
 
+    def _walls(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        kernel = (
+            cross_walls_from_sources_parallel
+            if len(pts) >= _PARALLEL_MIN_POINTS
+            else cross_walls_from_sources
+        )
+        return kernel(self.floorplan.edges, self._edge_loss_db, self.routers, pts, DEFAULT_MIN_PIECE_M)
+
     def true_k(self, points: np.ndarray) -> np.ndarray:
         """Number of walls between each router and each point: (M, R) int."""
-        pts = self._points(points)
-        return np.stack([self.floorplan.count_walls(r, pts) for r in self.routers], axis=1)
+        return self._walls(self._points(points))[0]
 
     def mean_rssi(self, points: np.ndarray) -> np.ndarray:
         """RSSI without temporal noise (path loss, capped walls, shadowing): (M, R) float dBm."""
         pts = self._points(points)
-        walls = np.stack(
-            [
-                self.floorplan.wall_loss_db(r, pts, self.config.wall_loss_db)[1]
-                for r in self.routers
-            ],
-            axis=1,
-        )
+        walls = self._walls(pts)[1]
         rssi = (
             self.config.tx_power_dbm
             - self.path_loss_db(pts)
@@ -281,12 +292,24 @@ class RadioModel:
 
     def measure(self, point: np.ndarray) -> np.ndarray:
         """One reading at ``point`` (2,): (R,) integer dBm, ``NOT_HEARD_DBM`` below sensitivity."""
-        rssi = self.mean_rssi(point)[0]
+        return self.measure_with_k(point)[0]
+
+    def measure_with_k(self, point: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """One reading at ``point`` and the true k of each router there (one wall traversal)."""
+        pts = self._points(point)[:1]
+        k, walls = self._walls(pts)
+        rssi = (
+            self.config.tx_power_dbm
+            - self.path_loss_db(pts)[0]
+            - np.minimum(walls[0], self.config.max_total_wall_loss_db)
+        )
+        if self._shadowing is not None:
+            rssi += self._shadowing(pts)[0]
         if self.config.noise_sigma_db > 0:
-            rssi = rssi + self.rng.normal(0.0, self.config.noise_sigma_db, rssi.shape)
+            rssi += self.rng.normal(0.0, self.config.noise_sigma_db, rssi.shape)
         reading = np.rint(rssi).astype(np.int32)
         reading[reading < self.config.sensitivity_dbm] = NOT_HEARD_DBM
-        return reading
+        return reading, k[0]
 
 
 def validate_routers(floorplan: Floorplan, routers: np.ndarray) -> np.ndarray:

@@ -5,18 +5,24 @@ control step) and integrates odometry (its true motion in its own frame, plus op
 drift). The walls are plain segments ``[x0, y0, x1, y1]`` in metres, so this module does not depend
 on :class:`~sfw_gym.world.Floorplan`.
 
-Physics. Each control step lasts ``control_period_s`` and is split into ``physics_substeps`` pymunk
-steps. The drive is kinematic: a pymunk velocity callback sets, every substep, the body's velocity to
-the commanded forward speed along its current heading and its angular velocity to the commanded turn
-rate. pymunk's contact solver then removes the part of that velocity that would push into a wall
-(frictionless, inelastic contact), so the robot slides along walls it meets at an angle and stops at
-walls it meets head-on; collision impulses never make it spin or bounce. A wall is a static
-``pymunk.Segment`` of radius ``wall_radius_m`` (a thin skin around the wall line). A contact starts
-only once the disc overlaps that skin, so the deepest the disc can get before the solver pushes it
-back is one substep's travel: the robot's centre stays at least
+Physics. Each control step lasts ``control_period_s`` and is split into ``physics_substeps``
+pymunk steps. The drive is kinematic: a pymunk velocity callback sets, every substep, the body's
+velocity to the commanded forward speed along its current heading and its angular velocity to the
+commanded turn rate. pymunk's contact solver then removes the part of that velocity that would push
+into a wall (frictionless, inelastic contact), so the robot slides along walls it meets at an angle
+and stops at walls it meets head-on; collision impulses never make it spin or bounce. A wall is a
+static ``pymunk.Segment`` of radius ``wall_radius_m`` (a thin skin around the wall line). A contact
+starts only once the disc overlaps that skin, so the deepest the disc can get before the solver
+pushes it back is one substep's travel: the robot's centre stays at least
 ``radius_m + wall_radius_m - max_linear_speed_m_s * control_period_s / physics_substeps`` from every
 wall line (``radius_m`` with the defaults), and it rests ``radius_m + wall_radius_m`` from a wall it
-presses against.
+presses against. pymunk's solver acts only after a substep's move, so at the start of each control
+step the part of the new command that points into a wall the disc already touches is removed by
+hand. When no wall is within reach of the coming step, the same motion is produced without the
+Python velocity callback (about twice as fast, identical to the last bit).
+
+Bump: a pymunk pre-solve handler (a module-level function, so the space pickles) flags every
+substep in which the robot's disc touches a wall.
 """
 
 from __future__ import annotations
@@ -39,6 +45,11 @@ MAX_SUBSTEP_TRAVEL_M = 0.025
 
 _ROBOT_COLLISION_TYPE = 1
 _WALL_COLLISION_TYPE = 2
+_ROBOT_CATEGORY = 0b01
+_WALL_CATEGORY = 0b10
+_WALL_QUERY = pymunk.ShapeFilter(mask=_WALL_CATEGORY)
+# Extra distance at which a wall counts as within reach of the robot in the coming step.
+_REACH_MARGIN_M = 1e-3
 # The drive is kinematic and the walls static, so the mass only scales the solver's impulses.
 _ROBOT_MASS_KG = 5.0
 # Overlap that pymunk leaves uncorrected (its default, 0.1, assumes pixels, not metres).
@@ -87,9 +98,11 @@ class RobotConfig:
         control_period_s: duration of one `Robot.step`.
         physics_substeps: pymunk steps per control step. At full speed a substep may move the robot
             at most ``MAX_SUBSTEP_TRAVEL_M`` (2.5 cm); the default moves it 1 cm.
-        odometry_translation_std: standard deviation of the odometry's translation error per step, as
-            a fraction of the distance travelled in that step (on each axis of the robot frame).
-        odometry_heading_std_rad: standard deviation of the odometry's heading error added each step.
+        odometry_translation_std: standard deviation of the odometry's translation error per
+            step, as a fraction of the distance travelled in that step (on each axis of the robot
+            frame).
+        odometry_heading_std_rad: standard deviation of the odometry's heading error, added every
+            step (moving or not).
         wall_radius_m: radius of the static wall segments (a skin around each wall line). Keep it at
             least one substep's travel at full speed so that the robot's centre never comes closer
             than ``radius_m`` to a wall line.
@@ -236,18 +249,23 @@ class Robot:
             seg.friction = 0.0
             seg.elasticity = 0.0
             seg.collision_type = _WALL_COLLISION_TYPE
+            seg.filter = pymunk.ShapeFilter(categories=_WALL_CATEGORY)
             walls.append(seg)
         if walls:
             space.add(*walls)
 
-        body = _DriveBody(_ROBOT_MASS_KG, pymunk.moment_for_circle(_ROBOT_MASS_KG, 0, config.radius_m))
+        body = _DriveBody(
+            _ROBOT_MASS_KG, pymunk.moment_for_circle(_ROBOT_MASS_KG, 0, config.radius_m)
+        )
         body.linear_m_s = 0.0
         body.angular_rad_s = 0.0
         body.velocity_func = _kinematic_drive
+        self._callback_on = True
         disc = pymunk.Circle(body, config.radius_m)
         disc.friction = 0.0
         disc.elasticity = 0.0
         disc.collision_type = _ROBOT_COLLISION_TYPE
+        disc.filter = pymunk.ShapeFilter(categories=_ROBOT_CATEGORY)
         space.add(body, disc)
         space.on_collision(_ROBOT_COLLISION_TYPE, _WALL_COLLISION_TYPE, pre_solve=_record_contact)
         self._space = space
@@ -334,25 +352,44 @@ class Robot:
         v = _command("linear_m_s", linear_m_s, cfg.max_linear_speed_m_s)
         w = _command("angular_rad_s", angular_rad_s, cfg.max_angular_speed_rad_s)
         body = self._body
+        space = self._space
         x0, y0 = body.position
         a0 = body.angle
         body.linear_m_s = v
         body.angular_rad_s = w
-        # The velocity callback runs after each substep's position update, so set the first one here.
-        body.velocity = (v * math.cos(a0), v * math.sin(a0))
+        # The velocity callback runs after each substep's position update, so the first substep's
+        # velocity is set here, with the part into walls that the robot touches removed.
+        vx, vy = v * math.cos(a0), v * math.sin(a0)
+        if self._bumped:
+            vx, vy = self._slide_along_contacts(vx, vy)
+        body.velocity = (vx, vy)
         body.angular_velocity = w
-        space = self._space
         space.robot_touched = False
         space_step = space.step
         dt = cfg.substep_s
-        space.collision_bias = self._collision_bias
-        for _ in range(cfg.physics_substeps - 1):
+        substeps = cfg.physics_substeps
+        if self._open_space_shortcut and not self._may_touch_wall(
+            x0, y0, abs(v) * cfg.control_period_s
+        ):
+            # No wall within reach this step, hence no contact: setting the velocity before each
+            # substep gives bit for bit what the velocity callback would, without its cost.
+            self._drive_by_callback(False)
             space_step(dt)
-        # No overlap correction in the last substep: pymunk keeps that correction as a hidden
-        # "bias velocity" for the next step, which a pickle would lose. Ending every control step
-        # with none makes the state between steps complete, so a copy continues identically.
-        space.collision_bias = 1.0
-        space_step(dt)
+            for _ in range(substeps - 1):
+                if w != 0.0:
+                    a = body.angle
+                    body.velocity = (v * math.cos(a), v * math.sin(a))
+                space_step(dt)
+        else:
+            self._drive_by_callback(True)
+            space.collision_bias = self._collision_bias
+            for _ in range(substeps - 1):
+                space_step(dt)
+            # No overlap correction in the last substep: pymunk keeps that correction as a hidden
+            # "bias velocity" for the next step, which a pickle would lose. Ending every control
+            # step with none makes the state between steps complete, so a copy continues exactly.
+            space.collision_bias = 1.0
+            space_step(dt)
         bumped = space.robot_touched
         self._bumped = bumped
         x1, y1 = body.position
@@ -374,7 +411,11 @@ class Robot:
             turn += cfg.odometry_heading_std_rad * e_t
         ox, oy, ot = self._odometry
         co, so = math.cos(ot), math.sin(ot)
-        self._odometry = (ox + co * forward - so * lateral, oy + so * forward + co * lateral, ot + turn)
+        self._odometry = (
+            ox + co * forward - so * lateral,
+            oy + so * forward + co * lateral,
+            ot + turn,
+        )
         return StepResult(
             pose=Pose(x1, y1, _wrap(a1)),
             odometry_pose=self.odometry_pose,
@@ -386,6 +427,35 @@ class Robot:
 
     # ------------------------------------------------------------------ helpers
 
+    #: Skip the velocity callback when no wall is within reach (same result, faster).
+    _open_space_shortcut = True
+
+    def _may_touch_wall(self, x: float, y: float, travel_m: float) -> bool:
+        """Whether a wall lies within ``travel_m`` (plus a margin) of the robot's disc."""
+        reach = self._config.radius_m + travel_m + _REACH_MARGIN_M
+        return self._space.point_query_nearest((x, y), reach, _WALL_QUERY) is not None
+
+    def _drive_by_callback(self, on: bool) -> None:
+        """Switch the kinematic velocity callback on or off (off: pymunk keeps the velocity)."""
+        if on != self._callback_on:
+            self._body.velocity_func = _kinematic_drive if on else pymunk.Body.update_velocity
+            self._callback_on = on
+
+    def _slide_along_contacts(self, vx: float, vy: float) -> tuple[float, float]:
+        """Remove from velocity (vx, vy) the components into the walls the disc overlaps now."""
+        normals = []
+        for info in self._space.shape_query(self._disc):
+            if info.shape is not None and info.shape.collision_type == _WALL_COLLISION_TYPE:
+                normals.append(tuple(info.contact_point_set.normal))
+        for _ in range(2):
+            for nx, ny in normals:
+                into = vx * nx + vy * ny
+                if into > 0.0:
+                    vx, vy = vx - into * nx, vy - into * ny
+        if any(vx * nx + vy * ny > 1e-12 for nx, ny in normals):
+            return 0.0, 0.0  # wedged into a corner
+        return vx, vy
+
     def _check_clearance(self, x: float, y: float) -> None:
         if len(self._walls) == 0:
             return
@@ -393,8 +463,8 @@ class Robot:
         i = int(np.argmin(dist))
         if dist[i] < self._config.radius_m:
             raise ConfigError(
-                f"pose ({x:g}, {y:g}) puts the robot's centre {dist[i]:.4f} m from wall segment {i} "
-                f"{self._walls[i].tolist()}, closer than its radius {self._config.radius_m} m"
+                f"pose ({x:g}, {y:g}) puts the robot's centre {dist[i]:.4f} m from wall segment "
+                f"{i} {self._walls[i].tolist()}, closer than its radius {self._config.radius_m} m"
             )
 
     def __repr__(self) -> str:
@@ -448,7 +518,8 @@ def _parse_walls(walls: Any) -> np.ndarray:
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise ConfigError(
-            f"wall_segments has {int(bad.sum())} non-finite row(s), first row {i}: {arr[i].tolist()}"
+            f"wall_segments has {int(bad.sum())} non-finite row(s); first: row {i} = "
+            f"{arr[i].tolist()}"
         )
     return arr
 

@@ -1,0 +1,41 @@
+"""The Gymnasium environments; registration happens on ``import sfw_gym``."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+
+ENTRY_POINT = "sfw_gym.envs.explore:SfWExploreEnv"
+
+#: Every registered id with its kwargs (also the parametrisation of the env test suite).
+ENV_IDS: dict[str, dict[str, Any]] = {
+    "SfW-Explore-v0": {},
+    "SfW-ExploreDiscrete-v0": {"action_type": "discrete"},
+    "SfW-ExploreThick-v0": {"radio_preset": "thick"},
+    "SfW-ExploreResidential-v0": {"radio_preset": "residential"},
+    # Small and quick, for tests and smoke runs: small plans, coarse grid, short episodes.
+    "SfW-ExploreSmall-v0": {
+        "generator": {"area_m2": 45.0},
+        "resolution_m": 0.2,
+        "map_px": 36,
+        "crop_px": 36,
+        "max_episode_steps": 300,
+    },
+}
+
+
+def register_envs() -> None:
+    """Register every id in ENV_IDS (idempotent)."""
+    for env_id, kwargs in ENV_IDS.items():
+        if env_id not in gym.registry:
+            gym.register(id=env_id, entry_point=ENTRY_POINT, kwargs=dict(kwargs),
+                         max_episode_steps=None, disable_env_checker=False)
+
+
+def __getattr__(name: str) -> Any:
+    if name == "SfWExploreEnv":
+        from sfw_gym.envs.explore import SfWExploreEnv
+
+        return SfWExploreEnv
+    raise AttributeError(name)

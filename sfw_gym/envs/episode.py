@@ -1,0 +1,107 @@
+"""One episode's world: the floorplan, its routers and radio, the robot and the ground-truth grid."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from scipy import ndimage
+
+from sfw_gym.errors import ConfigError
+from sfw_gym.world import (
+    Floorplan,
+    RadioConfig,
+    RadioModel,
+    Robot,
+    RobotConfig,
+    generate_floorplan,
+    load_floorplan,
+    place_routers,
+)
+
+#: Start poses keep this much more than the robot's radius from every wall.
+START_CLEARANCE_MARGIN_M = 0.05
+
+
+@dataclass
+class EpisodeScene:
+    """Ground truth of one episode (never shown to agents, only to the env and its info)."""
+
+    floorplan: Floorplan
+    radio: RadioModel
+    robot: Robot
+    truth_u8: np.ndarray  # 0 wall, 255 free, 127 outside
+    grid_origin: tuple[float, float]
+
+
+def resolve_floorplan(source: Any, generator_params: dict[str, Any] | None = None) -> Floorplan:
+    """A Floorplan from a Floorplan, a generator seed (int) or a JSON file path."""
+    if isinstance(source, Floorplan):
+        return source
+    if isinstance(source, int | np.integer) and not isinstance(source, bool):
+        return generate_floorplan(int(source), **(generator_params or {}))
+    if isinstance(source, str | Path):
+        return load_floorplan(source)
+    raise ConfigError(
+        f"floorplan must be a Floorplan, a generator seed (int) or a JSON path, got {source!r:.80}"
+    )
+
+
+def build_scene(
+    floorplan: Any,
+    *,
+    routers: Any,
+    max_routers: int,
+    start_pose: Any,
+    radio_config: RadioConfig,
+    robot_config: RobotConfig,
+    resolution_m: float,
+    rng: np.random.Generator,
+    generator_params: dict[str, Any] | None = None,
+) -> EpisodeScene:
+    """Assemble an episode; every random choice comes from ``rng``."""
+    plan = resolve_floorplan(floorplan, generator_params)
+    truth, origin = plan.rasterize(resolution_m)
+    if isinstance(routers, int | np.integer) and not isinstance(routers, bool):
+        if not 1 <= routers <= max_routers:
+            raise ConfigError(f"routers: a count must be in [1, {max_routers}], got {routers}")
+        routers = place_routers(plan, int(routers), rng)
+    routers = np.asarray(routers, dtype=np.float64)
+    if routers.ndim == 2 and len(routers) > max_routers:
+        raise ConfigError(
+            f"routers: {len(routers)} positions given, the env was made for at most {max_routers} "
+            f"(its observation has {max_routers} router slots; pass n_routers to gym.make)"
+        )
+    radio = RadioModel(plan, routers, radio_config, rng)
+    pose = _start_pose(plan, truth, origin, resolution_m, robot_config.radius_m, start_pose, rng)
+    robot = Robot(plan.edges, robot_config, pose, rng)
+    return EpisodeScene(plan, radio, robot, truth, origin)
+
+
+def _start_pose(
+    plan: Floorplan,
+    truth: np.ndarray,
+    origin: tuple[float, float],
+    resolution_m: float,
+    radius_m: float,
+    start_pose: Any,
+    rng: np.random.Generator,
+) -> tuple[float, float, float]:
+    if start_pose is not None:
+        pose = np.asarray(start_pose, dtype=np.float64)
+        if pose.shape != (3,) or not np.isfinite(pose).all():
+            raise ConfigError(f"start_pose must be three finite numbers (x, y, θ), got {start_pose!r}")
+        if not plan.is_free(pose[:2]):
+            raise ConfigError(f"start_pose {pose[:2].tolist()} is not in the free space of {plan.name!r}")
+        return float(pose[0]), float(pose[1]), float(pose[2])
+    clearance = ndimage.distance_transform_edt(truth == 255) * resolution_m
+    rows, cols = np.nonzero(clearance >= radius_m + START_CLEARANCE_MARGIN_M + resolution_m)
+    if len(rows) == 0:
+        raise ConfigError(f"floorplan {plan.name!r} has no spot wide enough for the robot")
+    i = int(rng.integers(len(rows)))
+    x = origin[0] + (cols[i] + 0.5) * resolution_m
+    y = origin[1] + (rows[i] + 0.5) * resolution_m
+    return x, y, float(rng.uniform(-math.pi, math.pi))

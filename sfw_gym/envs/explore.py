@@ -1,0 +1,395 @@
+"""SfW-Explore: map a building from WiFi RSSI alone, rewarded by the map's information gain."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from sfw_gym.envs.episode import EpisodeScene, build_scene
+from sfw_gym.envs.map_tracker import MapTracker
+from sfw_gym.envs.observation import ObservationBuilder, observation_space
+from sfw_gym.errors import ConfigError
+from sfw_gym.mapping import GridSpec, MapperConfig, SparseInverseKVisibility
+from sfw_gym.world import NOT_HEARD_DBM, Floorplan, RadioConfig, Robot, RobotConfig
+
+ACTION_TYPES = ("continuous", "discrete")
+#: Discrete actions: (linear, angular) as fractions of the robot's limits.
+DISCRETE_ACTIONS = ((1.0, 0.0), (0.0, 1.0), (0.0, -1.0))
+DISCRETE_ACTION_NAMES = ("forward", "turn_left", "turn_right")
+RESET_OPTIONS = ("floorplan", "routers", "start_pose")
+
+
+class SfWExploreEnv(gym.Env):
+    """Active WiFi exploration: a robot maps walls from RSSI by sparse inverse k-visibility.
+
+    ## Description
+    A differential-drive disc robot (pymunk) drives through an indoor floorplan. It has no camera
+    and no LiDAR: each step it hears the RSSI of the WiFi routers (log-distance path loss, a loss per
+    wall crossed, correlated shadowing, noise) and feels whether it bumped into a wall. From these
+    and its odometry, a sparse inverse k-visibility mapper (Kim et al., arXiv:2408.07757) estimates
+    how many walls separate it from each router and updates an occupancy belief map along the
+    router–robot rays. The task: make that map complete and right, fast.
+
+    ## Action Space
+    ``action_type="continuous"``: ``Box(-1, 1, (2,), float32)`` = (linear, angular) velocity as
+    fractions of the robot's limits (0.5 m/s, 1.5 rad/s by default). Out-of-range values are
+    clipped to [-1, 1]; NaN or inf raise ``ValueError``.
+    ``action_type="discrete"``: ``Discrete(3)``: 0 forward, 1 turn left, 2 turn right (in place).
+
+    ## Observation Space
+    ``Dict`` accepted by stable-baselines3's ``MultiInputPolicy``:
+    - ``map``: ``uint8 (3, M, M)``, M = ``map_px`` (64): the belief map fitted to the image (0 wall,
+      255 free, 127 unknown), the trajectory (128) with the robot (255), the routers (255);
+    - ``local``: ``uint8 (1, C, C)``, C = ``crop_px`` (48): the belief around the robot at full
+      resolution (north up);
+    - ``state``: ``float32 (2R + 6,)``: per router the normalised RSSI ((dBm + 100) / 80, 0 when not
+      heard) and a heard flag; bump; odometry x, y in [0, 1] over the map; sin and cos of the
+      odometry heading; the fraction of the map the robot believes known.
+
+    ## Rewards
+    ``reward_scale`` × information gain of the map this step (bits; the entropy decrease of the
+    belief), minus ``collision_penalty`` on a bump. With the defaults (0.01 per bit, 0.1 m cells)
+    the reward is about the square metres of map resolved.
+
+    ## Starting State
+    A fresh procedural floorplan from the env's RNG each episode (or the ``floorplan`` kwarg or
+    option), ``n_routers`` routers placed where a person would (k-means centres of the free space),
+    the robot at a random free pose with clearance, the map unknown.
+
+    ## Episode End
+    Terminated when the ground-truth coverage (fraction of free cells the map has classified)
+    reaches ``coverage_target`` (0.95). Truncated after ``max_episode_steps`` (3,000 by default:
+    300 m of driving at full speed, room for a typical 100 m² plan; see BENCHMARKS.md).
+
+    ## Arguments
+    ``gym.make("SfW-Explore-v0", **kwargs)`` with, all JSON-serialisable:
+    ``action_type`` ("continuous" | "discrete"), ``floorplan`` (None: procedural each episode; an
+    int: that generator seed every episode; a path: a HouseExpo or sfw_gym JSON file; a folder:
+    one of its JSON files each episode), ``generator`` (dict of `generate_floorplan` params),
+    ``n_routers`` (2), ``radio_preset`` ("default" | "thick" | "residential"), ``radio_band``
+    ("2.4" | "5"), ``radio`` / ``robot`` / ``mapper`` (dicts of RadioConfig / RobotConfig /
+    MapperConfig overrides), ``resolution_m`` (0.1), ``map_px`` (64), ``crop_px`` (48),
+    ``coverage_target`` (0.95), ``collision_penalty`` (0.1), ``reward_scale`` (0.01),
+    ``max_episode_steps`` (3000), ``render_mode`` (None | "rgb_array" | "human").
+    ``reset(options=…)``: ``floorplan`` (a Floorplan, a path or a generator seed), ``routers``
+    (positions (R, 2) or a count ≤ n_routers), ``start_pose`` ((x, y, θ)).
+
+    ## Version History
+    - v0: initial release.
+    """
+
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 10}
+
+    def __init__(
+        self,
+        action_type: str = "continuous",
+        floorplan: int | str | None = None,
+        generator: dict[str, Any] | None = None,
+        n_routers: int = 2,
+        radio_preset: str = "default",
+        radio_band: str = "2.4",
+        radio: dict[str, Any] | None = None,
+        robot: dict[str, Any] | None = None,
+        mapper: dict[str, Any] | None = None,
+        resolution_m: float = 0.1,
+        map_px: int = 64,
+        crop_px: int = 48,
+        coverage_target: float = 0.95,
+        collision_penalty: float = 0.1,
+        reward_scale: float = 0.01,
+        max_episode_steps: int = 3000,
+        render_mode: str | None = None,
+    ) -> None:
+        if action_type not in ACTION_TYPES:
+            raise ConfigError(f"action_type must be one of {ACTION_TYPES}, got {action_type!r}")
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ConfigError(
+                f"render_mode must be None or one of {self.metadata['render_modes']}, "
+                f"got {render_mode!r}"
+            )
+        _check_int("n_routers", n_routers, 1, 16)
+        _check_int("map_px", map_px, 36, 512)
+        _check_int("crop_px", crop_px, 36, 512)
+        _check_int("max_episode_steps", max_episode_steps, 1, 10**7)
+        _check_number("resolution_m", resolution_m, 0.02, 1.0)
+        _check_number("coverage_target", coverage_target, 0.0, 1.0)
+        _check_number("collision_penalty", collision_penalty, 0.0, 1e6)
+        _check_number("reward_scale", reward_scale, 0.0, 1e6)
+        self.action_type = action_type
+        self.floorplan_source = floorplan
+        self.generator_params = dict(generator or {})
+        self.n_routers = n_routers
+        self.radio_config = _make_config(
+            "radio", radio, lambda **kw: RadioConfig.preset(radio_preset, band=radio_band, **kw)
+        )
+        self.robot_config = _make_config("robot", robot, RobotConfig)
+        self.mapper_config = _make_config(
+            "mapper", {"robot_radius_m": self.robot_config.radius_m, **(mapper or {})}, MapperConfig
+        )
+        self.resolution_m = float(resolution_m)
+        self.map_px, self.crop_px = map_px, crop_px
+        self.coverage_target = float(coverage_target)
+        self.collision_penalty = float(collision_penalty)
+        self.reward_scale = float(reward_scale)
+        self.max_episode_steps = max_episode_steps
+        self.render_mode = render_mode
+        self._folder_plans = _folder_plans(floorplan)
+
+        self.observation_space = observation_space(n_routers, map_px, crop_px)
+        if action_type == "continuous":
+            self.action_space = spaces.Box(-1.0, 1.0, (2,), np.float32)
+        else:
+            self.action_space = spaces.Discrete(len(DISCRETE_ACTIONS))
+        self.scene: EpisodeScene | None = None
+        self._renderer: Any = None
+
+    # ------------------------------------------------------------------------------ episode
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        """Start an episode: a floorplan, routers, a start pose, an empty map (see the class doc)."""
+        super().reset(seed=seed)
+        options = dict(options or {})
+        unknown = sorted(set(options) - set(RESET_OPTIONS))
+        if unknown:
+            raise ConfigError(f"unknown reset option(s) {unknown}; valid: {list(RESET_OPTIONS)}")
+        plan = options.get("floorplan", self._default_floorplan())
+        self.scene = build_scene(
+            plan,
+            routers=options.get("routers", self.n_routers),
+            max_routers=self.n_routers,
+            start_pose=options.get("start_pose"),
+            radio_config=self.radio_config,
+            robot_config=self.robot_config,
+            resolution_m=self.resolution_m,
+            rng=self.np_random,
+            generator_params=self.generator_params,
+        )
+        s = self.scene
+        self.grid = GridSpec(s.grid_origin, self.resolution_m, s.truth_u8.shape)
+        self.mapper = SparseInverseKVisibility(self.grid, s.radio.routers, self.mapper_config)
+        self.tracker = MapTracker(s.truth_u8)
+        self.obs_builder = ObservationBuilder(
+            self.grid, s.radio.routers, self.n_routers, self.map_px, self.crop_px
+        )
+        self.steps = 0
+        self.path_length_m = 0.0
+        self.collisions = 0
+        self.k_correct = 0
+        self.k_total = 0
+        self.steps_to = {0.5: -1, 0.9: -1}
+        self.rssi_history: list[np.ndarray] = []
+        self.trajectory: list[tuple[float, float]] = []
+        self.odometry_trajectory: list[tuple[float, float]] = []
+        self.last_gain_bits = 0.0
+        self.last_rays: np.ndarray = np.zeros(0, np.int64)
+        obs = self._sense_and_map(bumped=False)
+        return obs, self._info(terminal=False)
+
+    def step(
+        self, action: Any
+    ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        """Drive for one control period, hear the routers, update the map, reward the gain."""
+        if self.scene is None:
+            raise gym.error.ResetNeeded("call reset() before step()")
+        linear, angular = self._command(action)
+        result = self.scene.robot.step(linear, angular)
+        self.steps += 1
+        self.path_length_m += result.distance_m
+        self.collisions += int(result.bumped)
+        obs = self._sense_and_map(bumped=result.bumped)
+        reward = self.reward_scale * self.last_gain_bits - self.collision_penalty * result.bumped
+        coverage = self.tracker.coverage
+        for level in self.steps_to:
+            if self.steps_to[level] < 0 and coverage >= level:
+                self.steps_to[level] = self.steps
+        terminated = coverage >= self.coverage_target
+        truncated = not terminated and self.steps >= self.max_episode_steps
+        info = self._info(terminal=terminated or truncated)
+        if self.render_mode == "human":
+            self.render()
+        return obs, float(reward), terminated, truncated, info
+
+    def _default_floorplan(self) -> Floorplan | int | str:
+        source = self.floorplan_source
+        if self._folder_plans:
+            return str(self._folder_plans[int(self.np_random.integers(len(self._folder_plans)))])
+        if source is None:
+            return int(self.np_random.integers(2**31 - 1))
+        return source
+
+    def _command(self, action: Any) -> tuple[float, float]:
+        cfg = self.robot_config
+        if self.action_type == "discrete":
+            a = np.asarray(action)
+            if a.shape != () or a.dtype.kind not in "iu" or not 0 <= int(a) < len(DISCRETE_ACTIONS):
+                raise ValueError(
+                    f"action must be an integer in [0, {len(DISCRETE_ACTIONS)}) "
+                    f"({', '.join(DISCRETE_ACTION_NAMES)}), got {action!r}"
+                )
+            lin, ang = DISCRETE_ACTIONS[int(a)]
+        else:
+            a = np.asarray(action, dtype=np.float64)
+            if a.shape != (2,):
+                raise ValueError(f"action must have shape (2,) = (linear, angular), got {a.shape}")
+            if not np.isfinite(a).all():
+                raise ValueError(f"action must be finite, got {a.tolist()}")
+            lin, ang = np.clip(a, -1.0, 1.0)
+        return float(lin) * cfg.max_linear_speed_m_s, float(ang) * cfg.max_angular_speed_rad_s
+
+    def _sense_and_map(self, *, bumped: bool) -> dict[str, np.ndarray]:
+        s = self.scene
+        assert s is not None
+        true_pose = s.robot.pose
+        odom = s.robot.odometry_pose
+        rssi, true_k = s.radio.measure_with_k(np.array(true_pose[:2]))
+        self.rssi_history.append(rssi)
+        self.trajectory.append((true_pose.x, true_pose.y))
+        self.odometry_trajectory.append((odom.x, odom.y))
+        if self.grid.contains(np.array(odom[:2])):
+            self.last_gain_bits = self.mapper.update(
+                odom[:2], rssi.astype(np.float64), bumped=bumped, heading_rad=odom.theta
+            )
+            self.tracker.apply(self.mapper.last_changed_cells, self.mapper.occupancy_u8)
+            est_k = self.mapper.last_k
+            heard = (rssi > NOT_HEARD_DBM) & (est_k >= 0)
+            self.k_correct += int((est_k[heard] == true_k[heard]).sum())
+            self.k_total += int(heard.sum())
+        else:  # odometry drifted off the map: nothing to update (documented in the info)
+            self.last_gain_bits = 0.0
+        self.obs_builder.mark_visited(odom.x, odom.y)
+        rssi_slots = np.full(self.n_routers, float(NOT_HEARD_DBM))
+        rssi_slots[: len(rssi)] = rssi
+        return self.obs_builder.build(
+            self.mapper.occupancy_u8, rssi_slots, bumped, odom, self.tracker.known_fraction
+        )
+
+    def _info(self, *, terminal: bool) -> dict[str, Any]:
+        s = self.scene
+        assert s is not None
+        t = self.tracker
+        info: dict[str, Any] = {
+            "coverage": t.coverage,
+            "map_iou": t.map_iou,
+            "free_iou": t.free_iou,
+            "wall_precision": t.wall_precision,
+            "interior_wall_recall": t.interior_wall_recall,
+            "k_accuracy": self.k_correct / self.k_total if self.k_total else 0.0,
+            "path_length_m": self.path_length_m,
+            "collisions": self.collisions,
+            "true_pose": np.array(s.robot.pose, np.float64),
+            "odometry_pose": np.array(s.robot.odometry_pose, np.float64),
+            "entropy_bits": self.mapper.entropy_bits,
+            "info_gain_bits": self.last_gain_bits,
+            "steps_to_coverage_50": self.steps_to[0.5],
+            "steps_to_coverage_90": self.steps_to[0.9],
+            "floorplan": s.floorplan.name,
+        }
+        if terminal:
+            info["summary"] = {k: v for k, v in info.items() if np.isscalar(v)} | {
+                "steps": self.steps,
+                "map_mse": t.map_mse(self.mapper.occupancy_u8),
+            }
+        return info
+
+    # ------------------------------------------------------------------------------ robot's view
+    def robot_view(self) -> dict[str, Any]:
+        """What the robot knows, for classical agents: never the ground truth.
+
+        Returns a dict with ``belief_u8`` (a copy of the belief map: 0 wall, 255 free, 127
+        unknown), ``probability`` (P(occupied)), ``grid`` (the GridSpec), ``odometry_pose``
+        (x, y, θ), ``routers_xy`` (R, 2), ``rssi_history`` (T, R) dBm, ``bumped`` (last step),
+        the robot's ``radius_m``, its speed limits and the control period.
+        """
+        s = self.scene
+        if s is None:
+            raise gym.error.ResetNeeded("call reset() before robot_view()")
+        cfg = self.robot_config
+        return {
+            "belief_u8": self.mapper.occupancy_u8.copy(),
+            "probability": self.mapper.probability,
+            "grid": self.grid,
+            "odometry_pose": tuple(s.robot.odometry_pose),
+            "routers_xy": np.array(s.radio.routers),
+            "rssi_history": np.array(self.rssi_history),
+            "bumped": bool(s.robot.bumped),
+            "radius_m": cfg.radius_m,
+            "max_linear_speed_m_s": cfg.max_linear_speed_m_s,
+            "max_angular_speed_rad_s": cfg.max_angular_speed_rad_s,
+            "control_period_s": cfg.control_period_s,
+            "action_type": self.action_type,
+        }
+
+    # ------------------------------------------------------------------------------ rendering
+    def render(self) -> np.ndarray | None:
+        """``rgb_array``: an (H, W, 3) uint8 picture, ground truth left, belief right.
+        ``human``: the same picture in a matplotlib window."""
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode to gym.make")
+            return None
+        if self.scene is None:
+            raise gym.error.ResetNeeded("call reset() before render()")
+        from sfw_gym.envs.rendering import draw_frame, show_frame
+
+        frame = draw_frame(self)
+        if self.render_mode == "human":
+            self._renderer = show_frame(frame, self._renderer, self.metadata["render_fps"])
+            return None
+        return frame
+
+    def close(self) -> None:
+        """Close the human-mode window, if any."""
+        if self._renderer is not None:
+            from sfw_gym.envs.rendering import close_window
+
+            close_window(self._renderer)
+            self._renderer = None
+
+    def config_dict(self) -> dict[str, Any]:
+        """The effective configuration (JSON-serialisable), for logs and reproducibility."""
+        return {
+            "action_type": self.action_type,
+            "radio": self.radio_config.to_dict(),
+            "robot": asdict(self.robot_config),
+            "mapper": self.mapper_config.to_dict(),
+            "resolution_m": self.resolution_m,
+            "max_episode_steps": self.max_episode_steps,
+        }
+
+
+def _check_int(name: str, value: Any, lo: int, hi: int) -> None:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or not lo <= value <= hi:
+        raise ConfigError(f"{name} must be an integer in [{lo}, {hi}], got {value!r}")
+
+
+def _check_number(name: str, value: Any, lo: float, hi: float) -> None:
+    ok = isinstance(value, int | float | np.number) and not isinstance(value, bool)
+    if not ok or not math.isfinite(value) or not lo <= value <= hi:
+        raise ConfigError(f"{name} must be a number in [{lo}, {hi}], got {value!r}")
+
+
+def _make_config(name: str, overrides: dict[str, Any] | None, factory: Any) -> Any:
+    if overrides is not None and not isinstance(overrides, dict):
+        raise ConfigError(f"{name} must be a dict of overrides, got {type(overrides).__name__}")
+    try:
+        return factory(**(overrides or {}))
+    except TypeError as exc:
+        raise ConfigError(f"{name}: {exc}") from None
+
+
+def _folder_plans(source: Any) -> list[Path]:
+    if isinstance(source, str | Path) and Path(source).is_dir():
+        plans = sorted(Path(source).glob("*.json"))
+        if not plans:
+            raise ConfigError(f"floorplan folder {source} holds no .json file")
+        return plans
+    return []
+
+
+__all__ = ["DISCRETE_ACTION_NAMES", "SfWExploreEnv"]

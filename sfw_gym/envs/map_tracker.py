@@ -1,0 +1,157 @@
+"""Map-quality metrics kept up to date cell by cell, so that every step's info is cheap.
+
+The figures equal `sfw_gym.metrics` on the full maps (a test holds them to it); here they cost
+O(cells changed this step) instead of O(grid).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+from scipy import ndimage
+
+from sfw_gym import metrics
+from sfw_gym.mapping import classify_u8
+
+UNKNOWN, FREE, WALL = 0, 1, 2
+# Counter slots.
+_N_KNOWN, _N_EST_FREE, _N_EST_WALL, _COVERED, _AGREE, _KNOWN_BOTH = range(6)
+_FREE_INTER, _WALL_NEAR, _INTERIOR_FOUND = 6, 7, 8
+
+
+@njit(cache=True)
+def _u8_class(v: int) -> int:
+    if v <= 84:
+        return WALL
+    if v >= 171:
+        return FREE
+    return UNKNOWN
+
+
+@njit(cache=True)
+def _account(cell, cls, sign, truth_cls, near_wall, interior, found_by, offsets, n_rows, n_cols,
+             counts):  # fmt: skip
+    """Add (sign=+1) or remove (-1) one cell's estimated class from the counters."""
+    if cls == UNKNOWN:
+        return
+    t = truth_cls[cell]
+    counts[_N_KNOWN] += sign
+    if t == FREE:
+        counts[_COVERED] += sign
+    if t != UNKNOWN:
+        counts[_KNOWN_BOTH] += sign
+        if t == cls:
+            counts[_AGREE] += sign
+    if cls == FREE:
+        counts[_N_EST_FREE] += sign
+        if t == FREE:
+            counts[_FREE_INTER] += sign
+        return
+    counts[_N_EST_WALL] += sign
+    if near_wall[cell]:
+        counts[_WALL_NEAR] += sign
+    r0 = cell // n_cols
+    c0 = cell % n_cols
+    for j in range(offsets.shape[0]):  # an estimated wall vouches for interior walls nearby
+        r = r0 + offsets[j, 0]
+        c = c0 + offsets[j, 1]
+        if 0 <= r < n_rows and 0 <= c < n_cols and interior[r * n_cols + c]:
+            other = r * n_cols + c
+            before = found_by[other]
+            found_by[other] += sign
+            if before == 0 and sign > 0:
+                counts[_INTERIOR_FOUND] += 1
+            elif before == 1 and sign < 0:
+                counts[_INTERIOR_FOUND] -= 1
+
+
+@njit(cache=True)
+def _apply(changed, est_u8, est_cls, truth_cls, near_wall, interior, found_by, offsets, n_cols,
+           counts):  # fmt: skip
+    n_rows = est_cls.shape[0] // n_cols
+    for i in range(changed.shape[0]):
+        cell = changed[i]
+        new = _u8_class(est_u8[cell])
+        old = est_cls[cell]
+        if new == old:
+            continue
+        _account(cell, old, -1, truth_cls, near_wall, interior, found_by, offsets, n_rows, n_cols,
+                 counts)  # fmt: skip
+        _account(cell, new, 1, truth_cls, near_wall, interior, found_by, offsets, n_rows, n_cols,
+                 counts)  # fmt: skip
+        est_cls[cell] = new
+
+
+class MapTracker:
+    """Coverage, paper IoU, free IoU, wall precision and interior-wall recall of a belief map.
+
+    Args:
+        truth_u8: the ground-truth grid (0 wall, 255 free, 127 outside).
+        tolerance_cells: wall tolerance of precision and recall (as in `sfw_gym.metrics`).
+    """
+
+    def __init__(self, truth_u8: np.ndarray, tolerance_cells: float = 2) -> None:
+        self.truth_u8 = truth_u8
+        wall, free = classify_u8(truth_u8)
+        self._truth_cls = np.where(wall, WALL, np.where(free, FREE, UNKNOWN)).astype(np.int8).ravel()
+        dist = ndimage.distance_transform_edt(~wall) if wall.any() else np.full(wall.shape, np.inf)
+        self._near_wall = (dist <= tolerance_cells).ravel()
+        self._interior = metrics.interior_wall_cells(truth_u8).ravel()
+        t = int(np.floor(tolerance_cells))
+        dr, dc = np.mgrid[-t : t + 1, -t : t + 1]
+        keep = dr**2 + dc**2 <= tolerance_cells**2
+        self._offsets = np.stack([dr[keep], dc[keep]], axis=1).astype(np.int64)
+        self._found_by = np.zeros(truth_u8.size, np.int32)
+        self._est_cls = np.zeros(truth_u8.size, np.int8)
+        self._counts = np.zeros(9, np.int64)
+        self._n_cells = truth_u8.size
+        self._n_truth_free = int(free.sum())
+        self._n_interior = int(self._interior.sum())
+
+    def apply(self, changed_cells: np.ndarray, est_u8: np.ndarray) -> None:
+        """Account for the cells whose class changed in the last map update."""
+        if len(changed_cells):
+            _apply(
+                np.asarray(changed_cells, np.int64), est_u8.ravel(), self._est_cls,
+                self._truth_cls, self._near_wall, self._interior, self._found_by, self._offsets,
+                self.truth_u8.shape[1], self._counts,
+            )  # fmt: skip
+
+    @staticmethod
+    def _ratio(num: int, den: int) -> float:
+        return num / den if den else float("nan")
+
+    @property
+    def known_fraction(self) -> float:
+        """Fraction of the grid the belief classifies (free or wall): the robot's own view."""
+        return self._counts[_N_KNOWN] / self._n_cells
+
+    @property
+    def coverage(self) -> float:
+        """`sfw_gym.metrics.coverage`."""
+        return self._ratio(self._counts[_COVERED], self._n_truth_free)
+
+    @property
+    def map_iou(self) -> float:
+        """`sfw_gym.metrics.map_iou` (the paper's)."""
+        return self._ratio(self._counts[_AGREE], self._counts[_KNOWN_BOTH])
+
+    @property
+    def free_iou(self) -> float:
+        """`sfw_gym.metrics.free_iou`."""
+        inter = self._counts[_FREE_INTER]
+        return self._ratio(inter, self._counts[_N_EST_FREE] + self._n_truth_free - inter)
+
+    @property
+    def wall_precision(self) -> float:
+        """`sfw_gym.metrics.wall_precision`."""
+        return self._ratio(self._counts[_WALL_NEAR], self._counts[_N_EST_WALL])
+
+    @property
+    def interior_wall_recall(self) -> float:
+        """`sfw_gym.metrics.interior_wall_recall`."""
+        return self._ratio(self._counts[_INTERIOR_FOUND], self._n_interior)
+
+    def map_mse(self, est_u8: np.ndarray) -> float:
+        """`sfw_gym.metrics.map_mse` (graded values: computed on the full map, at episode end)."""
+        return metrics.map_mse(est_u8, self.truth_u8)

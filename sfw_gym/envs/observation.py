@@ -1,0 +1,132 @@
+"""Observations: channel-first uint8 images of the belief map and a float32 state vector.
+
+Everything here is what the robot knows (belief map, odometry, router positions, RSSI, bump);
+nothing is ground truth.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from gymnasium import spaces
+
+from sfw_gym.mapping import GridSpec
+
+UNKNOWN_U8 = 127
+#: RSSI is normalised as (rssi − floor) / span into [0, 1].
+RSSI_FLOOR_DBM, RSSI_SPAN_DB = -100.0, 80.0
+#: Channels of the global "map" image.
+MAP_CHANNELS = ("belief", "trajectory_and_robot", "routers")
+TRAJECTORY_U8, ROBOT_U8 = 128, 255
+
+
+def observation_space(n_routers: int, map_px: int, crop_px: int) -> spaces.Dict:
+    """The Dict space: ``map`` (3, map_px, map_px), ``local`` (1, crop_px, crop_px), ``state``."""
+    return spaces.Dict(
+        {
+            "map": spaces.Box(0, 255, (len(MAP_CHANNELS), map_px, map_px), np.uint8),
+            "local": spaces.Box(0, 255, (1, crop_px, crop_px), np.uint8),
+            "state": spaces.Box(-1.0, 1.0, (state_size(n_routers),), np.float32),
+        }
+    )
+
+
+def state_size(n_routers: int) -> int:
+    """Length of the state vector: RSSI and heard flag per router, bump, x, y, sin, cos, known."""
+    return 2 * n_routers + 6
+
+
+class ObservationBuilder:
+    """Builds observations for one episode's grid; precomputes the sampling indices once.
+
+    ``map``: the whole grid fitted into map_px × map_px (aspect kept, centred, nearest-cell
+    sampling; padding reads unknown). ``local``: an axis-aligned crop_px × crop_px window of the
+    belief at full resolution centred on the odometry pose (outside the grid reads unknown).
+    """
+
+    def __init__(
+        self, grid: GridSpec, routers_xy: np.ndarray, n_router_slots: int, map_px: int, crop_px: int
+    ) -> None:
+        self.grid = grid
+        self.map_px = map_px
+        self.crop_px = crop_px
+        self.n_router_slots = n_router_slots
+        rows, cols = grid.shape
+        self.cells_per_px = max(rows, cols) / map_px
+        pad_r = (map_px - rows / self.cells_per_px) / 2
+        pad_c = (map_px - cols / self.cells_per_px) / 2
+        src_r = np.floor((np.arange(map_px) - pad_r + 0.5) * self.cells_per_px).astype(np.int64)
+        src_c = np.floor((np.arange(map_px) - pad_c + 0.5) * self.cells_per_px).astype(np.int64)
+        valid = ((src_r >= 0) & (src_r < rows))[:, None] & ((src_c >= 0) & (src_c < cols))[None, :]
+        flat = np.clip(src_r, 0, rows - 1)[:, None] * cols + np.clip(src_c, 0, cols - 1)[None, :]
+        self._flat_index = flat
+        self._pad = ~valid
+        self._pad_r, self._pad_c = pad_r, pad_c
+        self._trajectory = np.zeros((map_px, map_px), np.uint8)
+        self._routers = np.zeros((map_px, map_px), np.uint8)
+        for x, y in routers_xy:
+            r, c = self.pixel_of(x, y)
+            self._routers[max(r - 1, 0) : r + 2, max(c - 1, 0) : c + 2] = 255
+        self._padded = np.full((rows + crop_px, cols + crop_px), UNKNOWN_U8, np.uint8)
+        self._routers_xy = np.asarray(routers_xy, np.float64)
+
+    def pixel_of(self, x: float, y: float) -> tuple[int, int]:
+        """Map-image pixel (row, col) of a world point, clamped to the image."""
+        ox, oy = self.grid.origin_xy
+        res = self.grid.resolution_m
+        r = int(math.floor((y - oy) / res / self.cells_per_px + self._pad_r))
+        c = int(math.floor((x - ox) / res / self.cells_per_px + self._pad_c))
+        return min(max(r, 0), self.map_px - 1), min(max(c, 0), self.map_px - 1)
+
+    def mark_visited(self, x: float, y: float) -> None:
+        """Add a pose to the trajectory channel."""
+        r, c = self.pixel_of(x, y)
+        self._trajectory[r, c] = TRAJECTORY_U8
+
+    def build(
+        self,
+        belief_u8: np.ndarray,
+        rssi_dbm: np.ndarray,
+        bumped: bool,
+        odometry_pose: tuple[float, float, float],
+        known_fraction: float,
+    ) -> dict[str, np.ndarray]:
+        """The observation dict for the current belief and readings."""
+        x, y, theta = odometry_pose
+        belief = belief_u8.ravel().take(self._flat_index)
+        belief[self._pad] = UNKNOWN_U8
+        robot = self._trajectory.copy()
+        r, c = self.pixel_of(x, y)
+        robot[max(r - 1, 0) : r + 2, max(c - 1, 0) : c + 2] = ROBOT_U8
+        image = np.stack([belief, robot, self._routers])
+
+        half = self.crop_px // 2
+        rows, cols = self.grid.shape
+        self._padded[half : half + rows, half : half + cols] = belief_u8
+        ox, oy = self.grid.origin_xy
+        cr = min(max(int((y - oy) / self.grid.resolution_m), 0), rows - 1)
+        cc = min(max(int((x - ox) / self.grid.resolution_m), 0), cols - 1)
+        local = self._padded[None, cr : cr + self.crop_px, cc : cc + self.crop_px].copy()
+
+        n = len(rssi_dbm)
+        state = np.zeros(state_size(self.n_router_slots), np.float32)
+        heard = rssi_dbm > RSSI_FLOOR_DBM
+        state[:n] = np.clip((rssi_dbm - RSSI_FLOOR_DBM) / RSSI_SPAN_DB, 0.0, 1.0) * heard
+        state[self.n_router_slots : self.n_router_slots + n] = heard
+        k = 2 * self.n_router_slots
+        (x0, y0), (w, h) = self.grid.origin_xy, self._extent()
+        state[k : k + 6] = (
+            float(bumped),
+            np.clip((x - x0) / w, 0.0, 1.0),
+            np.clip((y - y0) / h, 0.0, 1.0),
+            math.sin(theta),
+            math.cos(theta),
+            known_fraction,
+        )
+        return {"map": image, "local": local, "state": state}
+
+    def _extent(self) -> tuple[float, float]:
+        rows, cols = self.grid.shape
+        return cols * self.grid.resolution_m, rows * self.grid.resolution_m
+

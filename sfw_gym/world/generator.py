@@ -1,0 +1,782 @@
+"""Procedural floorplans: apartments and offices with rooms, corridors, doorways and wall materials.
+
+The package's embedded default world. A plan is laid out as axis-aligned room *tiles* that exactly
+cover the building's interior (tile sides are wall centre lines), on a 5 cm grid in integer
+centimetres, so every shapely operation is exact and no slivers arise:
+
+- **apartment**, "hall" style: a living zone (optionally split into living room and kitchen) at one
+  end, a hall along the long axis with bands of rooms (bedrooms, bathroom, …) on both sides, and
+  optionally a full-depth room closing the hall. "bsp" style: a binary space partition of the
+  interior, the living room being the hub.
+- **office**: a central corridor with offices on both sides, optionally meeting rooms closing its
+  ends; one bathroom and often a kitchen among the band rooms.
+
+An L-shaped footprint removes one corner room. Every pair of adjacent rooms is separated by a wall
+rectangle (centred on the shared side, one thickness and material per straight wall line),
+except "open" pairs (hall↔living room, kitchen↔living room). Doorways are gaps in those
+rectangles, chosen by a breadth-first spanning tree from the hub (bathrooms are leaves) plus a few
+extra doors that close loops, so every room is reachable. Free space = interior minus the union
+of the wall rectangles; the footprint is the interior grown by the exterior wall. Each free-space
+edge takes the material of the wall it faces (its midpoint pushed 3 cm outward). Extra doors
+close loops, each around an island of walls: a hole in the free-space polygon.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import shapely
+from shapely.geometry import Polygon
+from shapely.geometry.polygon import orient
+
+from sfw_gym.errors import ConfigError, FloorplanError
+from sfw_gym.world.floorplan import Floorplan, Room
+
+#: Kinds of building the generator makes ("random" picks one from the seed).
+KINDS = ("apartment", "office")
+#: Footprint shapes ("random" picks one from the seed).
+SHAPES = ("rectangle", "L")
+#: Materials allowed for the exterior walls.
+EXTERIOR_MATERIALS = ("brick", "concrete")
+#: Free-area range (m²) of generated plans.
+MIN_AREA_M2, MAX_AREA_M2 = 40.0, 200.0
+#: Radius (m) of the robot disc that must pass every doorway.
+ROBOT_RADIUS_M = 0.17
+#: Range (m) accepted for ``door_width_m``.
+MIN_DOOR_M, MAX_DOOR_M = 0.8, 1.2
+
+_PARAMS: dict[str, Any] = {
+    "kind": "random",
+    "area_m2": None,
+    "shape": "random",
+    "exterior_material": None,
+    "door_width_m": None,
+    "extra_door_prob": None,
+    "name": None,
+}
+_GRID = 5  # cm: room tiles snap to this grid
+_DOOR_CLEAR = 20  # cm: doorway jamb to the wall line's junction (centre line)
+_MIN_DOOR = 80  # cm
+_PUSH = 3  # cm: edge midpoints pushed into the facing wall (less than half the thinnest wall)
+_MAX_ATTEMPTS = 200
+_FREE_FRACTION = {"apartment": 0.955, "office": 0.965}  # free area / interior area (measured)
+# Interior wall materials: probability and thickness choices (cm, even so half is an integer).
+_INTERIOR = {
+    "apartment": (("drywall", 0.75, (10, 12)), ("brick", 0.25, (12, 14))),
+    "office": (("drywall", 0.65, (10, 12)), ("glass", 0.2, (10,)), ("brick", 0.15, (12, 14))),
+}
+_BATH, _LIVING, _KITCHEN, _CORRIDOR = "Bathroom", "Living_Room", "Kitchen", "Corridor"
+
+
+@dataclass
+class _Layout:
+    """Room tiles in integer cm (x0, y0, x1, y1) covering [0, width] × [0, height] minus ``cut``."""
+
+    tiles: list[tuple[int, int, int, int]]
+    labels: list[str]
+    hub: int
+    width: int
+    height: int
+    open_pairs: set[tuple[int, int]] = field(default_factory=set)
+    cut: tuple[int, int, int, int] | None = None
+
+
+# ------------------------------------------------------------------------------------------ API
+def generate_floorplan(seed: int, **params: Any) -> Floorplan:
+    """Generate a realistic apartment or office floorplan, deterministically from ``seed``.
+
+    Args:
+        seed: non-negative integer; the only source of randomness (``np.random.default_rng``).
+        **params: optional overrides:
+            kind: "apartment", "office" or "random" (default: drawn from the seed).
+            area_m2: target free area, 40–200 m² (default: drawn; apartments ~42–160,
+                offices ~60–195). The result lies within ±15 % of it and always in 40–200 m².
+            shape: "rectangle", "L" or "random" (default: drawn, about one in three is L-shaped).
+            exterior_material: "brick" or "concrete" (default: drawn).
+            door_width_m: doorway width, 0.8–1.2 m, rounded to 5 cm (default: drawn per door,
+                0.8–1.0 m); a doorway in a short wall is narrowed to fit, never below 0.8 m.
+            extra_door_prob: probability, 0–1, that two adjacent rooms already connected
+                otherwise get a door too (loops); default 0.2 (apartments), 0.1 (offices).
+            name: the plan's name (default ``"gen-<kind>-<seed>"``).
+
+    Returns:
+        A valid :class:`Floorplan`: one free-space polygon, labelled rooms, every free cell
+        reachable and every doorway passable by a robot of radius 0.17 m.
+
+    Raises:
+        ConfigError: a bad seed or parameter (naming it), or an unknown parameter.
+    """
+    p = _validate(seed, params)
+    rng = np.random.default_rng(int(seed))
+    # Top-level draws always happen, so an explicit value leaves the rest of the stream unchanged.
+    kind = KINDS[int(rng.integers(len(KINDS)))]
+    shape = "L" if rng.random() < 0.35 else "rectangle"
+    u_material = rng.random()
+    kind = kind if p["kind"] == "random" else p["kind"]
+    ext_material = EXTERIOR_MATERIALS[int(u_material < (0.6 if kind == "office" else 0.4))]
+    drawn_area = math.exp(rng.uniform(*np.log((42.0, 160.0) if kind == "apartment" else (60, 195))))
+    shape = shape if p["shape"] == "random" else p["shape"]
+    ext_material = p["exterior_material"] or ext_material
+    area = float(p["area_m2"] if p["area_m2"] is not None else drawn_area)
+    extra = p["extra_door_prob"]
+    extra = (0.2 if kind == "apartment" else 0.1) if extra is None else float(extra)
+    door_cm = None if p["door_width_m"] is None else _snap(100.0 * p["door_width_m"])
+    name = p["name"] if p["name"] is not None else f"gen-{kind}-{int(seed)}"
+
+    lo, hi = max(MIN_AREA_M2, 0.85 * area), min(MAX_AREA_M2, 1.15 * area)
+    aim = float(np.clip(area, MIN_AREA_M2 * 1.04, MAX_AREA_M2 / 1.04))
+    gross = aim / _FREE_FRACTION[kind] * 1e4  # interior area, cm²
+    inflate = rng.uniform(1.08, 1.16)  # L-shapes: the removed corner room's share, learnt below
+    for _ in range(_MAX_ATTEMPTS):
+        if shape == "L":
+            layout = _layout(rng, kind, gross * inflate)
+            layout = _cut_corner(layout, gross) if layout is not None else None
+            if layout is not None:
+                got = layout.width * layout.height - _area(layout.cut)  # type: ignore[arg-type]
+                inflate = float(np.clip(inflate * gross / got, 1.0, 1.6))
+                if abs(got / gross - 1.0) > 0.08:
+                    continue
+        else:
+            layout = _layout(rng, kind, gross)
+        if layout is None:
+            continue
+        layout = _symmetry(layout, int(rng.integers(8)))  # any orientation, mirrored or not
+        plan = _build(rng, layout, kind, ext_material, door_cm, extra, name)
+        if plan is not None and lo <= plan.area_m2 <= hi:
+            return plan
+    raise FloorplanError(  # pragma: no cover - never seen over many thousand seeds
+        f"generate_floorplan(seed={seed}): no valid plan after {_MAX_ATTEMPTS} attempts"
+    )
+
+
+def _validate(seed: Any, params: dict[str, Any]) -> dict[str, Any]:
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
+        raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
+    unknown = sorted(set(params) - set(_PARAMS))
+    if unknown:
+        raise ConfigError(
+            f"generate_floorplan: unknown parameter(s) {unknown}; valid: {sorted(_PARAMS)}"
+        )
+    p = {**_PARAMS, **params}
+    if p["kind"] not in (*KINDS, "random"):
+        raise ConfigError(f"kind must be one of {[*KINDS, 'random']}, got {p['kind']!r}")
+    if p["shape"] not in (*SHAPES, "random"):
+        raise ConfigError(f"shape must be one of {[*SHAPES, 'random']}, got {p['shape']!r}")
+    if p["exterior_material"] is not None and p["exterior_material"] not in EXTERIOR_MATERIALS:
+        raise ConfigError(
+            f"exterior_material must be one of {list(EXTERIOR_MATERIALS)} or None, "
+            f"got {p['exterior_material']!r}"
+        )
+    for key, lo, hi in (
+        ("area_m2", MIN_AREA_M2, MAX_AREA_M2),
+        ("door_width_m", MIN_DOOR_M, MAX_DOOR_M),
+        ("extra_door_prob", 0.0, 1.0),
+    ):
+        v = p[key]
+        if v is None:
+            continue
+        if isinstance(v, bool) or not isinstance(v, numbers.Real) or not lo <= float(v) <= hi:
+            raise ConfigError(f"{key} must be a number in [{lo:g}, {hi:g}] or None, got {v!r}")
+    if p["name"] is not None and not isinstance(p["name"], str):
+        raise ConfigError(f"name must be a string or None, got {p['name']!r}")
+    return p
+
+
+# --------------------------------------------------------------------------------------- layouts
+def _snap(v: float) -> int:
+    return round(v / _GRID) * _GRID
+
+
+def _uniform_snap(rng: np.random.Generator, lo: float, hi: float) -> int:
+    """A grid value drawn uniformly in [lo, hi] (grid-rounded bounds)."""
+    a, b = math.ceil(lo / _GRID), math.floor(hi / _GRID)
+    return int(rng.integers(a, max(a, b) + 1)) * _GRID
+
+
+def _partition(rng: np.random.Generator, length: int, lo: int, hi: int) -> list[int]:
+    """Split ``length`` cm into grid-multiple parts within [lo, hi] where possible."""
+    n, lo_n, hi_n = length // _GRID, math.ceil(lo / _GRID), hi // _GRID
+    k_min, k_max = max(1, math.ceil(n / hi_n)), max(1, n // lo_n)
+    k = int(rng.integers(k_min, max(k_min, k_max) + 1))
+    parts, rem = [], n
+    for i in range(k - 1):
+        left = k - i - 1
+        a, b = max(lo_n, rem - left * hi_n), min(hi_n, rem - left * lo_n)
+        if a > b:
+            a = b = rem // (k - i)
+        w = int(rng.integers(a, b + 1))
+        parts.append(w)
+        rem -= w
+    parts.append(rem)
+    return [w * _GRID for w in parts]
+
+
+def _band(
+    rng: np.random.Generator,
+    x0: int,
+    x1: int,
+    special: list[tuple[str, int, int]],
+    lo: int,
+    hi: int,
+) -> list[tuple[int, int, str]]:
+    """Rooms (x0, x1, label) along [x0, x1]: the special (label, min, max) slots that fit, the rest
+    split in [lo, hi] and labelled "" (to be named by the caller)."""
+    length = x1 - x0
+    slots: list[tuple[int, str]] = []
+    for label, a, b in special:
+        room = length - sum(w for w, _ in slots) - lo  # leave at least one ordinary room
+        if room >= a:
+            slots.append((_uniform_snap(rng, a, min(b, room)), label))
+    rest = length - sum(w for w, _ in slots)
+    widths = [(w, "") for w in _partition(rng, rest, lo, hi)]
+    for slot in slots:
+        widths.insert(int(rng.integers(len(widths) + 1)), slot)
+    out, x = [], x0
+    for w, label in widths:
+        out.append((x, x + w, label))
+        x += w
+    return out
+
+
+def _layout(rng: np.random.Generator, kind: str, gross: float) -> _Layout | None:
+    if kind == "office":
+        return _office(rng, gross)
+    return _apartment_hall(rng, gross) if rng.random() < 0.65 else _apartment_bsp(rng, gross)
+
+
+def _depths(rng: np.random.Generator, total: float, lo: int, hi: int) -> tuple[int, int]:
+    total = _snap(float(np.clip(total, 2 * lo, 2 * hi)))
+    a = _uniform_snap(rng, max(lo, total - hi), min(hi, total - lo))
+    return a, total - a
+
+
+def _apartment_hall(rng: np.random.Generator, gross: float) -> _Layout | None:
+    hw = _uniform_snap(rng, 140, 170)
+    aspect = rng.uniform(1.1, 1.8)
+    da, db = _depths(rng, math.sqrt(gross / aspect) - hw, 270, 480)
+    h = da + hw + db
+    w = _snap(gross / h)
+    lw = _uniform_snap(rng, 320, 560)
+    lw = min(lw, w - 250)
+    if lw < 300:
+        return None
+    tiles: list[tuple[int, int, int, int]] = []
+    labels: list[str] = []
+
+    def add(box: tuple[int, int, int, int], label: str) -> int:
+        tiles.append(box)
+        labels.append(label)
+        return len(tiles) - 1
+
+    open_pairs: set[tuple[int, int]] = set()
+    # Living zone at x in [0, lw], full depth; optionally a kitchen on one band's side.
+    kitchen = None
+    if h >= 800 and rng.random() < 0.6:
+        if rng.random() < 0.5:
+            kitchen = add((0, 0, lw, da), _KITCHEN)
+            living = add((0, da, lw, h), _LIVING)
+        else:
+            living = add((0, 0, lw, da + hw), _LIVING)
+            kitchen = add((0, da + hw, lw, h), _KITCHEN)
+        if rng.random() < 0.5:
+            open_pairs.add((min(kitchen, living), max(kitchen, living)))
+    else:
+        living = add((0, 0, lw, h), _LIVING)
+    # Optional full-depth room closing the hall.
+    x_end = w
+    if w - lw >= 300 + 250 + 250 and rng.random() < 0.35:
+        e = _uniform_snap(rng, 300, min(450, w - lw - 250))
+        x_end = w - e
+        add((x_end, 0, w, h), "Bedroom")
+    hall = add((lw, da, x_end, da + hw), _CORRIDOR)
+    if rng.random() < 0.6:
+        open_pairs.add((min(hall, living), max(hall, living)))
+    bath_band = int(rng.integers(2))
+    band_rooms = []
+    for band, (y0, y1) in enumerate(((0, da), (da + hw, h))):
+        special = [(_BATH, 170, 240)] if band == bath_band else []
+        if band != bath_band and kitchen is None:
+            special.append((_KITCHEN, 250, 380))
+        for x0, x1, label in _band(rng, lw, x_end, special, 250, 480):
+            band_rooms.append(add((x0, y0, x1, y1), label))
+    # Name the unnamed band rooms: a bathroom first, then a kitchen next to the living zone if
+    # rooms are left for bedrooms (in a small flat the kitchen is part of the living room).
+    unnamed = [i for i in band_rooms if not labels[i]]
+    if _BATH not in labels and unnamed:
+        bath = min(unnamed, key=lambda i: _area(tiles[i]))
+        labels[bath] = _BATH
+        unnamed.remove(bath)
+    near = [i for i in unnamed if tiles[i][0] == lw]
+    if _KITCHEN not in labels and near and len(unnamed) >= 2:
+        labels[near[0]] = _KITCHEN
+    unnamed = [i for i in band_rooms if not labels[i]]
+    for n, i in enumerate(unnamed):
+        labels[i] = "Office" if n == 2 and len(unnamed) >= 4 else "Bedroom"
+    return _Layout(tiles, labels, hall, w, h, open_pairs)
+
+
+def _apartment_bsp(rng: np.random.Generator, gross: float) -> _Layout | None:
+    aspect = rng.uniform(1.0, 1.6)
+    h = _snap(math.sqrt(gross / aspect))
+    w = _snap(gross / h)
+    leaves: list[tuple[int, int, int, int]] = []
+    stack = [(0, 0, w, h)]
+    while stack:
+        x0, y0, x1, y1 = stack.pop()
+        sx, sy = x1 - x0, y1 - y0
+        big = max(sx, sy)
+        if big < 2 * 250 or (sx * sy <= rng.uniform(9e4, 2.2e5) and big <= 600):
+            leaves.append((x0, y0, x1, y1))
+            continue
+        cut = _uniform_snap(rng, max(250, 0.3 * big), min(big - 250, 0.7 * big))
+        if sx >= sy:
+            stack += [(x0, y0, x0 + cut, y1), (x0 + cut, y0, x1, y1)]
+        else:
+            stack += [(x0, y0, x1, y0 + cut), (x0, y0 + cut, x1, y1)]
+    if len(leaves) < 3:
+        return None
+    order = sorted(range(len(leaves)), key=lambda i: _area(leaves[i]))
+    bath = order[0]
+    if _area(leaves[bath]) > 10e4:
+        # No small room: carve a bathroom strip off the narrowest room that has space for it.
+        roomy = [i for i in order[:-1] if max(_sides(leaves[i])) >= 170 + 250]
+        if roomy:
+            i = min(roomy, key=lambda i: min(_sides(leaves[i])))
+            x0, y0, x1, y1 = leaves[i]
+            strip = _uniform_snap(rng, 170, 240)
+            if x1 - x0 >= y1 - y0:
+                leaves[i], extra = (x0 + strip, y0, x1, y1), (x0, y0, x0 + strip, y1)
+            else:
+                leaves[i], extra = (x0, y0 + strip, x1, y1), (x0, y0, x1, y0 + strip)
+            leaves.append(extra)
+            order = sorted(range(len(leaves)), key=lambda i: _area(leaves[i]))
+            bath = len(leaves) - 1
+    order.remove(bath)
+    order.insert(0, bath)
+    labels = ["Bedroom"] * len(leaves)
+    labels[order[-1]] = _LIVING
+    labels[bath] = _BATH
+    if len(leaves) >= 4:  # else the kitchen is part of the living room
+        labels[order[-2]] = _KITCHEN
+    if len(leaves) >= 6 and _area(leaves[order[1]]) <= 9e4:
+        labels[order[1]] = _BATH
+    elif len(leaves) >= 6:
+        labels[order[1]] = "Office"
+    return _Layout(leaves, labels, order[-1], w, h)
+
+
+def _office(rng: np.random.Generator, gross: float) -> _Layout | None:
+    cw = _uniform_snap(rng, 150, 220)
+    aspect = rng.uniform(1.4, 2.6)
+    da, db = _depths(rng, math.sqrt(gross / aspect) - cw, 280, 560)
+    h = da + cw + db
+    w = _snap(gross / h)
+    if w < 300:
+        return None
+    tiles: list[tuple[int, int, int, int]] = []
+    labels: list[str] = []
+    x0, x1 = 0, w
+    if w >= 1100 and rng.random() < 0.45:
+        x0 = _uniform_snap(rng, 400, 650)
+        tiles.append((0, 0, x0, h))
+        labels.append("Meeting_Room")
+    if w - x0 >= 1100 and rng.random() < 0.25:
+        x1 = w - _uniform_snap(rng, 400, 650)
+        tiles.append((x1, 0, w, h))
+        labels.append("Meeting_Room" if x0 == 0 else "Office")
+    hub = len(tiles)
+    tiles.append((x0, da, x1, da + cw))
+    labels.append(_CORRIDOR)
+    bath_band = int(rng.integers(2))
+    band_rooms = []
+    for band, (y0, y1) in enumerate(((0, da), (da + cw, h))):
+        special = [(_BATH, 180, 260)] if band == bath_band else [("Kitchen", 250, 350)]
+        for a, b, label in _band(rng, x0, x1, special, 250, 500):
+            tiles.append((a, y0, b, y1))
+            labels.append(label)
+            band_rooms.append(len(tiles) - 1)
+    if "Meeting_Room" not in labels:
+        wide = [i for i in band_rooms if not labels[i] and tiles[i][2] - tiles[i][0] >= 420]
+        if wide:
+            labels[wide[int(rng.integers(len(wide)))]] = "Meeting_Room"
+    for i in band_rooms:
+        labels[i] = labels[i] or "Office"
+    return _Layout(tiles, labels, hub, w, h)
+
+
+def _symmetry(layout: _Layout, which: int) -> _Layout:
+    """One of the 8 symmetries of the rectangle: bit 0 mirrors x, bit 1 mirrors y, bit 2 swaps
+    the axes."""
+    w, h = layout.width, layout.height
+
+    def move(box: tuple[int, int, int, int]) -> tuple[int, int, int, int]:
+        x0, y0, x1, y1 = box
+        if which & 1:
+            x0, x1 = w - x1, w - x0
+        if which & 2:
+            y0, y1 = h - y1, h - y0
+        return (y0, x0, y1, x1) if which & 4 else (x0, y0, x1, y1)
+
+    return _Layout(
+        [move(t) for t in layout.tiles],
+        layout.labels,
+        layout.hub,
+        h if which & 4 else w,
+        w if which & 4 else h,
+        layout.open_pairs,
+        None if layout.cut is None else move(layout.cut),
+    )
+
+
+def _area(box: tuple[int, int, int, int]) -> int:
+    return (box[2] - box[0]) * (box[3] - box[1])
+
+
+def _sides(box: tuple[int, int, int, int]) -> tuple[int, int]:
+    return box[2] - box[0], box[3] - box[1]
+
+
+def _cut_corner(layout: _Layout, gross: float) -> _Layout | None:
+    """Remove one corner room (L-shaped footprint), the one leaving an interior closest to gross."""
+    w, h = layout.width, layout.height
+    spare = ("Bedroom", "Office", "Meeting_Room")  # one of these may go if another remains
+    if sum(label in spare for label in layout.labels) < 2:
+        return None
+    best, best_err = None, math.inf
+    for i, (x0, y0, x1, y1) in enumerate(layout.tiles):
+        if i == layout.hub or layout.labels[i] not in spare:
+            continue
+        sides = (x0 == 0) + (x1 == w) + (y0 == 0) + (y1 == h)
+        corner = (x0 == 0 or x1 == w) and (y0 == 0 or y1 == h)
+        if sides != 2 or not corner or _area((x0, y0, x1, y1)) < 6e4:
+            continue
+        err = abs(w * h - _area(layout.tiles[i]) - gross)
+        if err < best_err:
+            best, best_err = i, err
+    if best is None:
+        return None
+    index = [i for i in range(len(layout.tiles)) if i != best]
+    new = {old: n for n, old in enumerate(index)}
+    return _Layout(
+        [layout.tiles[i] for i in index],
+        [layout.labels[i] for i in index],
+        new[layout.hub],
+        w,
+        h,
+        {(new[a], new[b]) for a, b in layout.open_pairs if best not in (a, b)},
+        layout.tiles[best],
+    )
+
+
+# -------------------------------------------------------------------------------------- geometry
+def _adjacencies(
+    tiles: list[tuple[int, int, int, int]],
+) -> list[tuple[int, int, bool, int, int, int]]:
+    """(i, j, vertical, coord, s0, s1) for every pair of tiles sharing a side of positive length."""
+    t = np.asarray(tiles, dtype=np.int64)
+    x0, y0, x1, y1 = (t[:, k] for k in range(4))
+    out = []
+    for vertical, lo, hi, a0, a1 in ((True, x0, x1, y0, y1), (False, y0, y1, x0, x1)):
+        touch = hi[:, None] == lo[None, :]  # tile i's high side on tile j's low side
+        s0 = np.maximum(a0[:, None], a0[None, :])
+        s1 = np.minimum(a1[:, None], a1[None, :])
+        for i, j in zip(*np.nonzero(touch & (s1 > s0)), strict=True):
+            a, b = (int(i), int(j)) if i < j else (int(j), int(i))
+            out.append((a, b, vertical, int(hi[i]), int(s0[i, j]), int(s1[i, j])))
+    return out
+
+
+def _spanning_doors(
+    rng: np.random.Generator,
+    layout: _Layout,
+    adj: list[tuple[int, int, bool, int, int, int]],
+    extra: float,
+) -> tuple[list[int], list[int]] | None:
+    """Adjacency indices that get a doorway: a BFS tree from the hub, and extra doors."""
+    n = len(layout.tiles)
+    nbrs: list[list[tuple[int, int]]] = [[] for _ in range(n)]
+    for k, (i, j, _, _, s0, s1) in enumerate(adj):
+        if (i, j) in layout.open_pairs or s1 - s0 >= _MIN_DOOR + 2 * _DOOR_CLEAR:
+            nbrs[i].append((j, k))
+            nbrs[j].append((i, k))
+    seen = [False] * n
+    doors: list[int] = []
+    queue: deque[int] = deque()
+    late: deque[int] = deque()  # bathrooms: expanded only if nothing else reaches a room
+
+    partners: list[list[int]] = [[] for _ in range(n)]
+    for i, j in layout.open_pairs:
+        partners[i].append(j)
+        partners[j].append(i)
+
+    def visit(v: int) -> None:
+        """Mark v and the rooms open to it (no door needed between them) as reached."""
+        stack = [v]
+        while stack:
+            u = stack.pop()
+            if not seen[u]:
+                seen[u] = True
+                (late if layout.labels[u] == _BATH else queue).append(u)
+                stack += partners[u]
+
+    visit(layout.hub)
+    while queue or late:
+        u = queue.popleft() if queue else late.popleft()
+        for o in rng.permutation(len(nbrs[u])):
+            v, k = nbrs[u][o]
+            if not seen[v]:
+                doors.append(k)
+                visit(v)
+    if not all(seen):
+        return None
+    tree, extra_doors = set(doors), []
+    for k, (i, j, *_rest) in enumerate(adj):
+        if (
+            k in tree
+            or (i, j) in layout.open_pairs
+            or _BATH in (layout.labels[i], layout.labels[j])
+        ):
+            continue
+        if adj[k][5] - adj[k][4] >= _MIN_DOOR + 2 * _DOOR_CLEAR and rng.random() < extra:
+            extra_doors.append(k)
+    return doors, extra_doors
+
+
+def _build(
+    rng: np.random.Generator,
+    layout: _Layout,
+    kind: str,
+    ext_material: str,
+    door_cm: int | None,
+    extra: float,
+    name: str,
+) -> Floorplan | None:
+    adj = _adjacencies(layout.tiles)
+    doors = _spanning_doors(rng, layout, adj, extra)
+    if doors is None:
+        return None
+    walls = [k for k, a in enumerate(adj) if (a[0], a[1]) not in layout.open_pairs]
+    seg = np.array([adj[k][2:] for k in walls], dtype=np.int64)  # vertical, coord, s0, s1
+    vert, coord, s0, s1 = seg[:, 0].astype(bool), seg[:, 1], seg[:, 2], seg[:, 3]
+    n = len(walls)
+
+    # One material and thickness per straight wall line (touching collinear segments).
+    chain = np.zeros(n, dtype=np.int64)
+    order = np.lexsort((s0, coord, vert))
+    c, end = -1, None
+    for k in order:
+        key = (vert[k], coord[k])
+        if end is None or key != end[0] or s0[k] > end[1]:
+            c += 1
+            end = (key, s1[k])
+        else:
+            end = (key, max(end[1], s1[k]))
+        chain[k] = c
+    choices = _INTERIOR[kind]
+    probs = np.array([p for _, p, _ in choices])
+    picks = rng.choice(len(choices), size=c + 1, p=probs / probs.sum())
+    thick = np.array([int(rng.choice(choices[q][2])) for q in picks], dtype=np.int64)
+    materials = [choices[q][0] for q in picks]
+    half = thick[chain] // 2
+
+    # Extend each segment end into the perpendicular walls meeting there (fills L-corners);
+    # no extension on the building's boundary.
+    ext = np.zeros((n, 2), dtype=np.int64)
+    for e, s in enumerate((s0, s1)):
+        hit = (
+            (vert[None, :] != vert[:, None])
+            & (coord[None, :] == s[:, None])
+            & (s0[None, :] <= coord[:, None])
+            & (s1[None, :] >= coord[:, None])
+        )
+        ext[:, e] = np.where(hit, half[None, :], 0).max(axis=1)
+    px = np.where(vert[:, None], coord[:, None], np.stack([s0, s1], 1))
+    py = np.where(vert[:, None], np.stack([s0, s1], 1), coord[:, None])
+    on_edge = _on_boundary(layout, px, py)
+    ext[on_edge] = 0
+
+    # Doorway positions, redrawn until every wall piece is still anchored to the building's
+    # exterior through other walls (no free-standing pillars).
+    # Doorways of the spanning tree, redrawn until every wall piece is still anchored to the
+    # exterior through other walls (no free-standing pillar); then the extra doors, each of which
+    # closes a loop around an island of walls, kept if no island is shorter than 0.5 m.
+    tree, extra_doors = doors
+    seg_of = {k: m for m, k in enumerate(walls)}
+    span = np.stack([s0 - ext[:, 0], s1 + ext[:, 1]], 1).tolist()
+    for _ in range(10):
+        gaps = {
+            seg_of[k]: _door_gap(rng, int(s0[seg_of[k]]), int(s1[seg_of[k]]), door_cm) for k in tree
+        }
+        if not _islands(px, py, on_edge, span, gaps):
+            break
+    else:
+        return None
+    for k in extra_doors:
+        m = seg_of[k]
+        for _ in range(2):
+            trial = {**gaps, m: _door_gap(rng, int(s0[m]), int(s1[m]), door_cm)}
+            if min(_islands(px, py, on_edge, span, trial), default=math.inf) >= 50:
+                gaps = trial
+                break
+
+    # Wall rectangles with the doorway gaps.
+    rects: list[tuple[int, int, int, int]] = []
+    rect_mat: list[str] = []
+    for m in range(n):
+        a, b = int(s0[m] - ext[m, 0]), int(s1[m] + ext[m, 1])
+        pieces = [(a, gaps[m][0]), (gaps[m][1], b)] if m in gaps else [(a, b)]
+        hv, cv = int(half[m]), int(coord[m])
+        for p0, p1 in pieces:
+            rects.append((cv - hv, p0, cv + hv, p1) if vert[m] else (p0, cv - hv, p1, cv + hv))
+            rect_mat.append(materials[chain[m]])
+
+    region = shapely.box(0, 0, layout.width, layout.height)
+    if layout.cut is not None:
+        region = region.difference(shapely.box(*layout.cut))
+    r = np.asarray(rects, dtype=np.float64)
+    wall_union = shapely.union_all(shapely.box(r[:, 0], r[:, 1], r[:, 2], r[:, 3]))
+    free = shapely.simplify(region.difference(wall_union), 0)
+    if not isinstance(free, Polygon) or not free.is_valid:
+        return None
+    eroded = free.buffer(-100 * ROBOT_RADIUS_M, quad_segs=2)
+    if not isinstance(eroded, Polygon) or eroded.is_empty:
+        return None
+    free = orient(free, sign=1.0)  # exterior CCW, holes CW: free space on each edge's left
+
+    # Material of each free-space edge: the wall its midpoint, pushed outward, lands in.
+    pts = [np.asarray(ring.coords) for ring in (free.exterior, *free.interiors)]
+    p0 = np.vstack([q[:-1] for q in pts])
+    d = np.vstack([q[1:] - q[:-1] for q in pts])
+    normal = np.stack([d[:, 1], -d[:, 0]], 1) / np.hypot(d[:, 0], d[:, 1])[:, None]
+    probe = p0 + 0.5 * d + _PUSH * normal
+    inside = _in_region(layout, probe[:, 0], probe[:, 1])
+    hit = (
+        (probe[:, 0:1] >= r[None, :, 0])
+        & (probe[:, 0:1] <= r[None, :, 2])
+        & (probe[:, 1:2] >= r[None, :, 1])
+        & (probe[:, 1:2] <= r[None, :, 3])
+    )
+    if not hit[inside].any(axis=1).all():
+        return None  # an edge facing no wall: should not happen
+    first = hit.argmax(axis=1)
+    edge_materials = tuple(
+        rect_mat[first[e]] if inside[e] else ext_material for e in range(len(probe))
+    )
+
+    # Geometry in metres, footprint's lower-left corner at the origin.
+    t_ext = int(rng.integers(20, 31))
+    footprint = region.buffer(t_ext, join_style="mitre")
+    to_m = lambda xy: (xy + t_ext) / 100.0  # noqa: E731
+    rooms = _rooms(layout, vert, coord, s0, s1, half, t_ext)
+    return Floorplan(
+        shapely.transform(free, to_m),
+        shapely.transform(footprint, to_m),
+        edge_materials,
+        name=name,
+        rooms=rooms,
+    )
+
+
+def _door_gap(rng: np.random.Generator, s0: int, s1: int, door_cm: int | None) -> tuple[int, int]:
+    """A doorway (d0, d1) in the wall segment [s0, s1], clear of the junctions at its ends."""
+    dw = door_cm if door_cm is not None else _uniform_snap(rng, 80, 100)
+    dw = min(dw, (s1 - s0 - 2 * _DOOR_CLEAR) // _GRID * _GRID)
+    lo, hi = s0 + _DOOR_CLEAR, s1 - _DOOR_CLEAR - dw
+    if rng.random() < 0.6:  # near a corner, as doors usually are
+        near = (lo, min(hi, lo + 30)) if rng.random() < 0.5 else (max(lo, hi - 30), hi)
+        d0 = _uniform_snap(rng, *near)
+    else:
+        d0 = _uniform_snap(rng, lo, hi)
+    d0 = min(max(d0, lo), hi)
+    return d0, d0 + dw
+
+
+def _islands(
+    px: np.ndarray,
+    py: np.ndarray,
+    on_edge: np.ndarray,
+    span: list[list[int]],
+    gaps: dict[int, tuple[int, int]],
+) -> list[int]:
+    """Lengths (cm) of the groups of wall pieces not connected to the exterior wall.
+
+    Piece ``2m + e`` is the piece of segment m holding its end e (one piece, ``2m``, without a
+    doorway); pieces meet where segment ends coincide; ends on the boundary meet the exterior.
+    """
+    n = len(px)
+    xs, ys, edge = px.tolist(), py.tolist(), on_edge.tolist()
+    parent = list(range(2 * n + 1))  # the last node is the exterior
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    at: dict[tuple[int, int], int] = {}
+    length = [0] * (2 * n)
+    for m in range(n):
+        a, b = span[m]
+        if m in gaps:
+            length[2 * m], length[2 * m + 1] = gaps[m][0] - a, b - gaps[m][1]
+        else:
+            length[2 * m] = b - a
+        for e in (0, 1):
+            node = 2 * m + (e if m in gaps else 0)
+            parent[find(node)] = find(at.setdefault((xs[m][e], ys[m][e]), node))
+            if edge[m][e]:
+                parent[find(node)] = find(2 * n)
+    root = find(2 * n)
+    islands: dict[int, int] = {}
+    for node in range(2 * n):
+        if length[node] and find(node) != root:
+            islands[find(node)] = islands.get(find(node), 0) + length[node]
+    return list(islands.values())
+
+
+def _in_region(layout: _Layout, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    inside = (x > 0) & (x < layout.width) & (y > 0) & (y < layout.height)
+    if layout.cut is not None:
+        cx0, cy0, cx1, cy1 = layout.cut
+        inside &= ~((x >= cx0) & (x <= cx1) & (y >= cy0) & (y <= cy1))
+    return inside
+
+
+def _on_boundary(layout: _Layout, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    on = (x == 0) | (x == layout.width) | (y == 0) | (y == layout.height)
+    if layout.cut is not None:
+        cx0, cy0, cx1, cy1 = layout.cut
+        in_x, in_y = (x >= cx0) & (x <= cx1), (y >= cy0) & (y <= cy1)
+        on |= (in_x & ((y == cy0) | (y == cy1))) | (in_y & ((x == cx0) | (x == cx1)))
+    return on
+
+
+def _rooms(
+    layout: _Layout,
+    vert: np.ndarray,
+    coord: np.ndarray,
+    s0: np.ndarray,
+    s1: np.ndarray,
+    half: np.ndarray,
+    offset: int,
+) -> tuple[Room, ...]:
+    """Room boxes in metres: each tile shrunk by the half-thickness of the walls on its sides."""
+    rooms = []
+    for (x0, y0, x1, y1), label in zip(layout.tiles, layout.labels, strict=True):
+        shrink = []
+        for vertical, c, a, b in (
+            (1, x0, y0, y1),
+            (0, y0, x0, x1),
+            (1, x1, y0, y1),
+            (0, y1, x0, x1),
+        ):
+            on = (vert == bool(vertical)) & (coord == c) & (s0 < b) & (s1 > a)
+            shrink.append(int(half[on].max()) if on.any() else 0)
+        box = (x0 + shrink[0], y0 + shrink[1], x1 - shrink[2], y1 - shrink[3])
+        rooms.append(Room(label, tuple((v + offset) / 100.0 for v in box)))  # type: ignore[arg-type]
+    return tuple(rooms)
