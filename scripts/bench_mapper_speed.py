@@ -4,18 +4,22 @@ The world is built here from plain numpy, independent of ``sfw_gym.world``: a 15
 room split by one interior wall at x = 7.5 m with a 1 m door (y in [10, 11]); two routers; k by
 segment crossing; RSSI from the log-distance model (20 dBm, PL(1 m) = 40.2 dB, n = 2) with
 10 dB per wall and N(0, 2) dB noise, rounded to integers. The robot (radius 0.17 m) surveys the
-left room with a lawnmower (0.5 m pass spacing, 0.05 m steps), crosses the door, then surveys the
-right room.
+left room with a lawnmower (0.3 m pass spacing, 0.05 m steps, 0.1 m from the walls), crosses the
+door, then surveys the right room.
 
 Prints median / mean / p95 microseconds per ``update()`` (k-means refits included) for a 0.05 m
 grid and 2 routers, for ``router_policy="strongest"`` and ``"all"``, and the map metrics.
 
+Rows "+k0" give the distance-aware estimator its calibration (``k0_level_dbm = P_tx - PL(1 m)``).
+
 Usage: python scripts/bench_mapper_speed.py [--seed 0] [--repeats 3] [--noise-db 2]
+                                            [--clearance 0.1] [--spacing 0.3]
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import time
 from dataclasses import replace
 
@@ -56,7 +60,7 @@ def count_walls(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def polyline(points: list[tuple[float, float]], step: float) -> np.ndarray:
     """Points every ``step`` metres along a polyline."""
     out = []
-    for (x0, y0), (x1, y1) in zip(points[:-1], points[1:], strict=True):
+    for (x0, y0), (x1, y1) in itertools.pairwise(points):
         n = max(1, int(np.ceil(np.hypot(x1 - x0, y1 - y0) / step)))
         t = np.arange(n) / n
         out.append(np.stack([x0 + t * (x1 - x0), y0 + t * (y1 - y0)], axis=1))
@@ -73,14 +77,14 @@ def lawnmower(x0: float, x1: float, y0: float, y1: float, spacing: float, down: 
     return pts
 
 
-def trajectory(step: float = 0.05, clearance_m: float = 0.1) -> np.ndarray:
+def trajectory(step: float = 0.05, clearance_m: float = 0.1, spacing_m: float = 0.3) -> np.ndarray:
     """Left-room survey, door crossing, right-room survey, ``clearance_m`` from the walls."""
     m = ROBOT_R + clearance_m
     half = WALL_THICK_M / 2
-    left = lawnmower(m, WALL_X - half - m, m, SIDE_M - m, 0.5, down=False)
+    left = lawnmower(m, WALL_X - half - m, m, SIDE_M - m, spacing_m, down=False)
     door_y = sum(DOOR) / 2
     transit = [(WALL_X - half - m, door_y), (WALL_X + half + m, door_y)]
-    right = lawnmower(WALL_X + half + m, SIDE_M - m, m, SIDE_M - m, 0.5, down=True)
+    right = lawnmower(WALL_X + half + m, SIDE_M - m, m, SIDE_M - m, spacing_m, down=True)
     return polyline(left + transit + right, step)
 
 
@@ -136,11 +140,13 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=3, help="timed runs per configuration")
     ap.add_argument("--noise-db", type=float, default=2.0)
     ap.add_argument("--resolution", type=float, default=0.05)
+    ap.add_argument("--clearance", type=float, default=0.1, help="robot-wall gap of the survey, m")
+    ap.add_argument("--spacing", type=float, default=0.3, help="lawnmower pass spacing, m")
     args = ap.parse_args()
 
     grid = GridSpec.covering((0.0, 0.0, SIDE_M, SIDE_M), args.resolution, margin_m=0.2)
     truth = truth_map(grid)
-    traj = trajectory()
+    traj = trajectory(clearance_m=args.clearance, spacing_m=args.spacing)
     rng = np.random.default_rng(args.seed)
     rssi, k_true = rssi_for(traj, rng, args.noise_db)
     print(
@@ -149,14 +155,17 @@ def main() -> None:
     )
     base = MapperConfig()
     run(base, traj[:300], rssi[:300], k_true[:300], grid, truth)  # compile / warm caches
+    k0 = 20.0 - 40.2  # P_tx - PL(1 m): the calibration of the "+k0" rows
     configs = [
         ("strongest / distance_aware", base),
         ("all / distance_aware", replace(base, router_policy="all")),
+        ("strongest / distance_aware+k0", replace(base, k0_level_dbm=k0)),
+        ("all / distance_aware+k0", replace(base, k0_level_dbm=k0, router_policy="all")),
         ("strongest / kmeans", replace(base, k_estimator="kmeans")),
         ("all / kmeans", replace(base, k_estimator="kmeans", router_policy="all")),
     ]
     header = (
-        f"{'policy / estimator':28s} {'median':>7s} {'mean':>7s} {'p95':>7s}  {'k-acc':>6s} "
+        f"{'policy / estimator':31s} {'median':>7s} {'mean':>7s} {'p95':>7s}  {'k-acc':>6s} "
         f"{'IoU':>6s} {'freeIoU':>7s} {'wallP':>6s} {'wallR':>6s} {'cover':>6s}"
     )
     print(header + "   (µs per update)")
@@ -167,7 +176,7 @@ def main() -> None:
             all_times.append(times)
         t = np.concatenate(all_times)
         print(
-            f"{name:28s} {np.median(t):7.2f} {t.mean():7.2f} {np.percentile(t, 95):7.2f}  "
+            f"{name:31s} {np.median(t):7.2f} {t.mean():7.2f} {np.percentile(t, 95):7.2f}  "
             f"{m['k_accuracy']:6.3f} {m['paper_iou']:6.3f} {m['free_iou']:7.3f} "
             f"{m['wall_precision']:6.3f} {m['interior_wall_recall']:6.3f} {m['coverage']:6.3f}"
         )

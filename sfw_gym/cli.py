@@ -56,6 +56,40 @@ def _cmd_world(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_map(args: argparse.Namespace) -> int:
+    from sfw_gym.mapping import MapperConfig
+    from sfw_gym.offline import map_log, write_map
+
+    routers = parse_routers(args.routers)
+    if isinstance(routers, int):
+        raise ConfigError(
+            f"--routers: the map command needs router positions 'x1,y1;x2,y2' in the CSV's "
+            f"units, not a count ({routers})"
+        )
+    result = map_log(
+        args.log,
+        routers,
+        scale_m_per_unit=args.scale,
+        resolution_m=args.resolution,
+        margin_m=args.margin,
+        band=args.band,
+        config=MapperConfig(router_policy=args.policy),
+    )
+    paths = write_map(result, args.out, y_down=args.y_down)
+    log = result.log
+    rows, cols = result.grid.shape
+    print(
+        f"{log.path}: {log.n_samples} samples, {log.n_skipped} rows skipped (no position); "
+        f"routers <- columns {', '.join(result.columns)}"
+    )
+    print(
+        f"mapper: {result.median_us_per_sample:.1f} µs per sample (median; mean "
+        f"{result.us_per_sample:.1f}), {cols} x {rows} cells of {result.grid.resolution_m:g} m"
+    )
+    print(f"wrote {paths['png']}, {paths['npy']}, {paths['json']}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of every subcommand."""
     parser = argparse.ArgumentParser(
@@ -73,6 +107,30 @@ def build_parser() -> argparse.ArgumentParser:
     world.add_argument("--resolution", type=float, default=0.1, help="heat-map cell size, metres")
     world.add_argument("--out", default="world.png", help="output PNG (default world.png)")
     world.set_defaults(func=_cmd_world)
+
+    mp = sub.add_parser("map", help="map a recorded RSSI log (CSV) offline: PNG + .npy")
+    mp.add_argument("log", help="CSV: x, y, then RSSI columns (the SfW experiments' layout)")
+    mp.add_argument(
+        "--routers", required=True, help="router positions 'x1,y1;x2,y2' in the CSV's units"
+    )
+    mp.add_argument(
+        "--scale", type=float, default=1.0, help="metres per CSV unit (default 1; pixels e.g. 0.05)"
+    )
+    mp.add_argument("--resolution", type=float, default=0.05, help="map cell size, metres (default 0.05)")
+    mp.add_argument("--margin", type=float, default=1.0, help="border around the data, metres (default 1)")
+    mp.add_argument(
+        "--band", choices=["2.4", "5"], default=None,
+        help="with 2 RSSI columns per router: which band (default 2.4)",
+    )  # fmt: skip
+    mp.add_argument(
+        "--policy", choices=["strongest", "all"], default="strongest",
+        help="update along the strongest router's ray (the paper) or all heard routers",
+    )  # fmt: skip
+    mp.add_argument(
+        "--y-down", action="store_true", help="the CSV's y grows downward (image pixels)"
+    )
+    mp.add_argument("--out", default="map.png", help="output PNG; .npy and .json beside it")
+    mp.set_defaults(func=_cmd_map)
     return parser
 
 

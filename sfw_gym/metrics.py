@@ -159,6 +159,8 @@ def _shift(a: np.ndarray, dr: int, dc: int, fill: bool = False) -> np.ndarray:
     """``out[i, j] = a[i + dr, j + dc]`` (``fill`` beyond the edges)."""
     out = np.full(a.shape, fill, dtype=a.dtype)
     h, w = a.shape
+    if abs(dr) >= h or abs(dc) >= w:
+        return out
     src_r = slice(max(dr, 0), h + min(dr, 0))
     dst_r = slice(max(-dr, 0), h + min(-dr, 0))
     src_c = slice(max(dc, 0), w + min(dc, 0))

@@ -85,6 +85,9 @@ def _apply(changed, est_u8, est_cls, truth_cls, near_wall, interior, found_by, o
 class MapTracker:
     """Coverage, paper IoU, free IoU, wall precision and interior-wall recall of a belief map.
 
+    Each equals its `sfw_gym.metrics` function on the full maps, except that an undefined ratio
+    (empty denominator) reads 0.0 here rather than nan.
+
     Args:
         truth_u8: the ground-truth grid (0 wall, 255 free, 127 outside).
         tolerance_cells: wall tolerance of precision and recall (as in `sfw_gym.metrics`).
@@ -119,7 +122,9 @@ class MapTracker:
 
     @staticmethod
     def _ratio(num: int, den: int) -> float:
-        return num / den if den else float("nan")
+        # 0.0 while undefined (no wall estimated yet, …): info stays comparable and averageable;
+        # `sfw_gym.metrics` returns nan there instead.
+        return float(num / den) if den else 0.0
 
     @property
     def known_fraction(self) -> float:

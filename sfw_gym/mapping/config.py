@@ -32,7 +32,8 @@ class MapperConfig:
         max_k: Largest k-value the estimator can output (K; K + 1 k-means clusters).
         filter_window: Length of the sliding-window mean over each router's readings (1 = off).
         path_loss_exponent: n in the log-distance term of the distance-aware feature.
-        min_distance_m: Distances below this are raised to it in the log-distance term.
+        min_distance_m: Near field: distances below this are raised to it in the log-distance
+            term, and such readings are not used to fit thresholds (the model fails there).
         refit_min_samples: Samples per router before the first k-means fit (a prior before).
         refit_growth: Geometric refit schedule: the next fit after ``n * refit_growth`` samples.
         refit_max_interval: Refit at least every this many samples, whatever the growth.
@@ -76,7 +77,7 @@ class MapperConfig:
     max_k: int = 3
     filter_window: int = 3
     path_loss_exponent: float = 2.0
-    min_distance_m: float = 0.5
+    min_distance_m: float = 1.0
     refit_min_samples: int = 32
     refit_growth: float = 1.5
     refit_max_interval: int = 2000
@@ -103,7 +104,9 @@ class MapperConfig:
 
     def __post_init__(self) -> None:
         if self.k_estimator not in K_ESTIMATORS:
-            raise ConfigError(f"k_estimator must be one of {K_ESTIMATORS}, got {self.k_estimator!r}")
+            raise ConfigError(
+                f"k_estimator must be one of {K_ESTIMATORS}, got {self.k_estimator!r}"
+            )
         if self.router_policy not in ROUTER_POLICIES:
             raise ConfigError(
                 f"router_policy must be one of {ROUTER_POLICIES}, got {self.router_policy!r}"

@@ -1,15 +1,11 @@
 """Dense inverse k-visibility (Alg. 1 of Kim et al.): the oracle map from the true k of every cell.
 
 Along every ray from the router the k-value never decreases, and it steps up exactly where the
-ray crosses a wall. For each cell with a known k (``k >= 0``) the oracle walks from the cell
-towards the router to the first cell that also has a known k:
-
-- same k: no wall between them, the cell is free;
-- different k: a wall lies between them. If the walk passed cells without a known k
-  (``k < 0``, e.g. the wall's own cells), those are marked wall; if the two cells are
-  neighbours, the cell itself (the one farther from the router) is marked wall.
-
-Cells with unknown k that are never marked stay unknown (127).
+ray crosses a wall (never at a shadow line, which runs along the rays). Every cell with a known
+k (``k >= 0``) is free space; the oracle walks from it towards the router and, wherever two
+successive cells with a known k differ, marks the wall between them: the cells without a known
+k in between (``k < 0``, e.g. the wall's own cells) if any, else the farther of the two cells.
+Walls win over free; cells with unknown k that no ray marks stay unknown (127).
 """
 
 from __future__ import annotations
@@ -27,24 +23,24 @@ def _dense_kernel(k_grid, rgx, rgy, wall, free, rows, cols, t0, t1):
     n_rows, n_cols = k_grid.shape
     for i in range(n_rows):
         for j in range(n_cols):
-            k = k_grid[i, j]
-            if k < 0:
+            if k_grid[i, j] < 0:
                 continue
+            free[i, j] = True
             n = traverse_grid(j + 0.5, i + 0.5, rgx, rgy, n_rows, n_cols, rows, cols, t0, t1)
-            found = False
-            m_hit = n
+            last = 0  # index of the last cell with a known k, walking towards the router
+            k_last = k_grid[i, j]
             for m in range(1, n):
-                if k_grid[rows[m], cols[m]] >= 0:
-                    found = True
-                    m_hit = m
-                    break
-            if not found or k_grid[rows[m_hit], cols[m_hit]] == k:
-                free[i, j] = True
-            elif m_hit == 1:
-                wall[i, j] = True
-            else:
-                for m in range(1, m_hit):
-                    wall[rows[m], cols[m]] = True
+                k = k_grid[rows[m], cols[m]]
+                if k < 0:
+                    continue
+                if k != k_last:
+                    if m - last > 1:
+                        for q in range(last + 1, m):
+                            wall[rows[q], cols[q]] = True
+                    else:
+                        wall[rows[last], cols[last]] = True
+                last = m
+                k_last = k
 
 
 def dense_inverse_k_visibility(grid: GridSpec, router_xy, k_grid) -> np.ndarray:

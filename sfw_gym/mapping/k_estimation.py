@@ -20,14 +20,18 @@ initialisation) with ``K + 1`` clusters on the router's samples. With sorted cen
    ``G_{m-1}`` (levels not seen yet) are spaced ``prior_wall_loss_db`` apart, half a wall
    loss from the nearest level; at most ``K`` thresholds are kept.
 
-Before ``refit_min_samples`` samples a prior applies: ``t_j = top - (j - 0.5) * prior_wall_loss_db``
-with ``top`` the largest filtered feature so far (or ``k0_level_dbm``). Refits follow a
-geometric schedule (the next after ``n * refit_growth`` samples, at most ``refit_max_interval``
-apart) on a bounded, strided subsample, so their cost is amortised; a refit also comes early
-once ``refit_min_samples // 2`` samples have fallen more than half a wall loss outside the
-fitted centroids (a new level, e.g. the robot entered a room behind another wall).
+Before ``refit_min_samples`` samples a prior applies,
+``t_j = top - (j - 0.5) * prior_wall_loss_db``,
+with ``top`` the strongest level seen so far (the mean of the readings within half a wall loss
+of it, restarted at any reading more than half a wall loss above it), or ``k0_level_dbm`` when
+calibrated. Refits follow a geometric schedule (the next after ``n * refit_growth`` samples, at
+most ``refit_max_interval`` apart) on a bounded, strided subsample, so their cost is amortised;
+a refit also comes early once ``refit_min_samples // 2`` samples have fallen more than half a
+wall loss outside the fitted centroids (a new level: the robot entered a room behind a wall).
 
 A reading of -100 dBm or less means "not heard": that router gets k = -1 and nothing is stored.
+Readings closer than ``min_distance_m`` to their router (near field, where the log-distance
+model fails) are classified but neither fitted nor counted by the refit schedule.
 """
 
 from __future__ import annotations
@@ -36,14 +40,12 @@ import math
 
 import numpy as np
 from numba import njit
-from sklearn.cluster import KMeans
-from threadpoolctl import ThreadpoolController
 
 from sfw_gym.errors import ConfigError
 from sfw_gym.mapping.config import MapperConfig
 
 NOT_HEARD_DBM = -100.0
-_THREADPOOLS: ThreadpoolController | None = None
+_THREADPOOLS = None  # threadpoolctl.ThreadpoolController, created at the first fit
 
 
 @njit(cache=True)
@@ -74,11 +76,12 @@ def add_samples(
     fit_n,
     fit_stride,
     n_seen,
+    n_fit_seen,
     next_refit,
     thresholds,
     n_thr,
     fitted,
-    max_feature,
+    prior,
     fit_range,
     novel,
     novel_needed,
@@ -109,8 +112,26 @@ def add_samples(
             s += ring[r, j]
         f = s / ring_count[r]
         out_feature[r] = f
+        n_seen[r] += 1
+        if not fitted[r] and not calibrated:
+            # Prior: track the strongest level seen (leader clustering with a half-wall band).
+            top = prior[r, 0] / prior[r, 1] if prior[r, 1] > 0 else -np.inf
+            if f > top + 0.5 * prior_gap:
+                prior[r, 0] = f
+                prior[r, 1] = 1.0
+            elif f > top - 0.5 * prior_gap:
+                prior[r, 0] += f
+                prior[r, 1] += 1.0
+            top = prior[r, 0] / prior[r, 1]
+            for j in range(max_k):
+                thresholds[r, j] = top - (j + 0.5) * prior_gap
+            n_thr[r] = max_k
+        out_k[r] = k_from_thresholds(f, thresholds[r], n_thr[r])
+        if dist[r] < min_distance:
+            continue  # near field: classified, but not used to fit or to trigger refits
         # Strided reservoir for fitting: keep every fit_stride-th sample; halve when full.
-        if n_seen[r] % fit_stride[r] == 0:
+        n_fit_seen[r] += 1
+        if (n_fit_seen[r] - 1) % fit_stride[r] == 0:
             if fit_n[r] == cap:
                 half = 0
                 for j in range(0, cap, 2):
@@ -118,22 +139,15 @@ def add_samples(
                     half += 1
                 fit_n[r] = half
                 fit_stride[r] *= 2
-            if n_seen[r] % fit_stride[r] == 0:
+            if (n_fit_seen[r] - 1) % fit_stride[r] == 0:
                 fit_buf[r, fit_n[r]] = f
                 fit_n[r] += 1
-        n_seen[r] += 1
         if fitted[r]:
             if f > fit_range[r, 0] + 0.5 * prior_gap or f < fit_range[r, 1] - 0.5 * prior_gap:
                 novel[r] += 1
                 if novel[r] >= novel_needed:
-                    next_refit[r] = n_seen[r]
-        elif not calibrated and f > max_feature[r]:
-            max_feature[r] = f
-            for j in range(max_k):
-                thresholds[r, j] = f - (j + 0.5) * prior_gap
-            n_thr[r] = max_k
-        out_k[r] = k_from_thresholds(f, thresholds[r], n_thr[r])
-        if n_seen[r] >= next_refit[r]:
+                    next_refit[r] = n_fit_seen[r]
+        if n_fit_seen[r] >= next_refit[r]:
             due = True
     return due
 
@@ -200,6 +214,9 @@ def fit_levels(data: np.ndarray, max_k: int, min_gap_db: float, min_fraction: fl
         centroids, or None when the data has fewer than 2 distinct values.
     """
     global _THREADPOOLS
+    from sklearn.cluster import KMeans  # imported here: ~0.5 s that only fitting needs
+    from threadpoolctl import ThreadpoolController
+
     x = np.asarray(data, dtype=np.float64)
     uniq = np.unique(x)
     if uniq.size < 2:
@@ -240,12 +257,8 @@ class KEstimator:
         self.config = config if config is not None else MapperConfig()
         if not isinstance(self.config, MapperConfig):
             raise ConfigError(f"config must be a MapperConfig, got {type(self.config).__name__}")
-        self.n_routers = int(n_routers)
-        self.reset()
-
-    def reset(self) -> None:
-        """Forget every sample and fit (back to the prior)."""
-        cfg, n = self.config, self.n_routers
+        self.n_routers = n = int(n_routers)
+        cfg = self.config
         self._ring = np.zeros((n, cfg.filter_window))
         self._ring_pos = np.zeros(n, np.int64)
         self._ring_count = np.zeros(n, np.int64)
@@ -253,21 +266,38 @@ class KEstimator:
         self._fit_n = np.zeros(n, np.int64)
         self._fit_stride = np.ones(n, np.int64)
         self._n_seen = np.zeros(n, np.int64)
-        self._next_refit = np.full(n, cfg.refit_min_samples, np.int64)
-        self._thresholds = np.full((n, cfg.max_k), -np.inf)
+        self._n_fit_seen = np.zeros(n, np.int64)
+        self._next_refit = np.zeros(n, np.int64)
+        self._thresholds = np.zeros((n, cfg.max_k))
         self._n_thr = np.zeros(n, np.int64)
+        self._fitted = np.zeros(n, np.bool_)
+        self._prior = np.zeros((n, 2))
+        self._fit_range = np.zeros((n, 2))
+        self._novel = np.zeros(n, np.int64)
+        self._feature = np.full(n, np.nan)
+        self._k = np.full(n, -1, np.int64)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget every sample and fit, back to the prior (in place)."""
+        cfg = self.config
+        for a in (self._ring, self._ring_pos, self._ring_count, self._fit_buf, self._fit_n):
+            a.fill(0)
+        for a in (self._n_seen, self._n_fit_seen, self._n_thr, self._prior, self._fit_range):
+            a.fill(0)
+        self._novel.fill(0)
+        self._fit_stride.fill(1)
+        self._next_refit.fill(cfg.refit_min_samples)
+        self._thresholds.fill(-np.inf)
+        self._fitted.fill(False)
+        self._feature.fill(np.nan)
+        self._k.fill(-1)
         if cfg.k0_level_dbm is not None:
             prior = thresholds_from_levels(
                 np.array([cfg.k0_level_dbm]), cfg.max_k, cfg.prior_wall_loss_db
             )
             self._thresholds[:] = prior
             self._n_thr[:] = prior.size
-        self._fitted = np.zeros(n, np.bool_)
-        self._max_feature = np.full(n, -np.inf)
-        self._fit_range = np.zeros((n, 2))
-        self._novel = np.zeros(n, np.int64)
-        self._feature = np.full(n, np.nan)
-        self._k = np.full(n, -1, np.int64)
         self.n_refits = 0
 
     # -- state shared with the mapper's compiled kernel ------------------------------------
@@ -286,11 +316,12 @@ class KEstimator:
             self._fit_n,
             self._fit_stride,
             self._n_seen,
+            self._n_fit_seen,
             self._next_refit,
             self._thresholds,
             self._n_thr,
             self._fitted,
-            self._max_feature,
+            self._prior,
             self._fit_range,
             self._novel,
             max(2, cfg.refit_min_samples // 2),
@@ -345,7 +376,7 @@ class KEstimator:
 
     @property
     def n_samples(self) -> np.ndarray:
-        """Heard readings so far per router."""
+        """Heard readings so far per router (near-field ones included)."""
         return self._n_seen.copy()
 
     def thresholds(self, router: int) -> np.ndarray:
@@ -356,7 +387,7 @@ class KEstimator:
         """Refit every router whose schedule is due (every router with samples if forced)."""
         cfg = self.config
         for r in range(self.n_routers):
-            n_seen = int(self._n_seen[r])
+            n_seen = int(self._n_fit_seen[r])
             if n_seen == 0 or (not force and n_seen < self._next_refit[r]):
                 continue
             growth = math.ceil(n_seen * (cfg.refit_growth - 1.0))

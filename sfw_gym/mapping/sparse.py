@@ -22,13 +22,13 @@ router and, in one compiled kernel:
      ``P(s) = 0.5 + (p_peak - 0.5) * min(1, L_ref / L) * exp(-(s - L/2)^2 / (2 sigma^2))``,
      ``sigma = max(sigma_min, sigma_fraction * L)``: a peak at the midpoint that lowers and
      widens as the piece grows; cells where the excess is below 1e-3 are skipped. The interval
-     is also trimmed of the cells already classified free at either end (the wall cannot be
-     there), so the estimate sharpens as the map fills in;
+     is also narrowed to where the wall can be: the longest run of cells not yet classified
+     free (a wall is one contiguous stretch), so the estimate sharpens as the map fills in;
      One piece lifts a cell to at most ``wall_cap_factor * logit(P(s))``: successive readings
      along one ray are far from independent, and summing many flat, long-piece likelihoods
      would otherwise build confident walls out of weak evidence;
-   - Delta k = m > 1: the piece is cut into m equal sub-pieces, each updated as Delta k = 1
-     (m peaks at the sub-piece midpoints);
+   - Delta k = m > 1: the piece (trimmed of the cells classified free at its ends) is cut into
+     m equal sub-pieces, each updated as Delta k = 1 (m peaks at the sub-piece midpoints);
    - Delta k < 0, or Delta k > 0 on a piece with no room for a wall (robot centres closer than
      ``2 * robot_radius_m``, or every cell known free): inconsistent, skipped;
 
@@ -101,7 +101,7 @@ def _u8_class(v):
     return CLASS_UNKNOWN
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _apply(cell, delta, cap, lmin, maps, track):
     """Add ``delta`` to one cell's log-odds; returns the entropy decrease (bits).
 
@@ -109,8 +109,8 @@ def _apply(cell, delta, cap, lmin, maps, track):
     ``cap`` (nor lowers one already above it). Keeps the cell's entropy and uint8 value current
     and records the cell (with its class before this update) the first time it is touched.
     """
-    lo, ent, u8, cls, classified, inside, stamp = maps
-    touched, old_cls, changed, state = track
+    lo, ent, u8, cls, _, inside, stamp = maps
+    touched, old_cls, _, state = track
     if not inside[cell]:
         return 0.0
     old = lo[cell]
@@ -142,6 +142,7 @@ def _apply(cell, delta, cap, lmin, maps, track):
 def _wall_piece(s_a, s_b, dk, j0, j1, ray, l_tot, n_cols, params, maps, track):
     """Eq. 6 over ray cells ``j0..j1-1`` for an interval ``[s_a, s_b]`` holding ``dk`` walls."""
     rows, cols, t0, t1 = ray
+    lo = maps[0]
     res = params[_P_RES]
     sub = (s_b - s_a) / dk
     sigma = max(params[_P_SMIN] / res, params[_P_SFRAC] * sub)
@@ -161,8 +162,46 @@ def _wall_piece(s_a, s_b, dk, j0, j1, ray, l_tot, n_cols, params, maps, track):
         p = 0.5 + x
         delta = np.log(p / (1.0 - p))
         cap = min(lmax, cap_factor * delta)
-        gain += _apply(rows[j] * n_cols + cols[j], delta, cap, lmin, maps, track)
+        cell = rows[j] * n_cols + cols[j]
+        if lo[cell] < cap:
+            gain += _apply(cell, delta, cap, lmin, maps, track)
     return gain
+
+
+@njit(cache=True)
+def _wall_candidates(j0, j1, dk, s_mid, ray, l_tot, cls, n_cols):
+    """Ray cells ``[j_lo, j_hi)`` where the walls of a piece can be (not known free).
+
+    One wall (``dk == 1``): the longest run of cells not classified free (ties: the run nearest
+    the piece's middle), since a wall is one contiguous stretch. Several walls: everything
+    between the first and the last cell not classified free. Empty if all cells are free.
+    """
+    rows, cols, t0, t1 = ray
+    if dk > 1:
+        j_lo = j0
+        while j_lo < j1 and cls[rows[j_lo] * n_cols + cols[j_lo]] == CLASS_FREE:
+            j_lo += 1
+        j_hi = j1
+        while j_hi > j_lo and cls[rows[j_hi - 1] * n_cols + cols[j_hi - 1]] == CLASS_FREE:
+            j_hi -= 1
+        return j_lo, j_hi
+    best_lo = j0
+    best_hi = j0
+    best_off = np.inf
+    j = j0
+    while j < j1:
+        if cls[rows[j] * n_cols + cols[j]] == CLASS_FREE:
+            j += 1
+            continue
+        start = j
+        while j < j1 and cls[rows[j] * n_cols + cols[j]] != CLASS_FREE:
+            j += 1
+        off = abs(0.5 * (t0[start] + t1[j - 1]) * l_tot - s_mid)
+        if j - start > best_hi - best_lo or (j - start == best_hi - best_lo and off < best_off):
+            best_lo = start
+            best_hi = j
+            best_off = off
+    return best_lo, best_hi
 
 
 @njit(cache=True)
@@ -173,6 +212,7 @@ def _ray_update(
     """Segment the ray of router ``r`` at earlier trajectory points and update every piece."""
     rows, cols, t0, t1 = ray
     anc_j, anc_s, anc_k = anchors
+    lo = maps[0]
     cls = maps[3]
     n_rows = raster.shape[1]
     n_cols = raster.shape[2]
@@ -235,18 +275,15 @@ def _ray_update(
         dk = anc_k[a + 1] - anc_k[a]
         if dk == 0:
             for j in range(j0, j1):
-                gain += _apply(rows[j] * n_cols + cols[j], free, lmax, lmin, maps, track)
+                cell = rows[j] * n_cols + cols[j]
+                if lo[cell] > lmin:  # cheap skip of saturated cells (most of them)
+                    gain += _apply(cell, free, lmax, lmin, maps, track)
         elif dk > 0:
-            # A wall keeps a robot radius from every trajectory point (the router is none),
-            # and lies beyond the cells already known free at either end of the piece.
+            # A wall keeps a robot radius from every trajectory point (the router is none)
+            # and lies where the map does not already know free space.
             s_a = anc_s[a] + (rad if a > 0 else 0.0)
             s_b = anc_s[a + 1] - rad
-            j_lo = j0
-            while j_lo < j1 and cls[rows[j_lo] * n_cols + cols[j_lo]] == CLASS_FREE:
-                j_lo += 1
-            j_hi = j1
-            while j_hi > j_lo and cls[rows[j_hi - 1] * n_cols + cols[j_hi - 1]] == CLASS_FREE:
-                j_hi -= 1
+            j_lo, j_hi = _wall_candidates(j0, j1, dk, 0.5 * (s_a + s_b), ray, l_tot, cls, n_cols)
             if j_hi == j_lo:
                 continue
             s_a = max(s_a, t0[j_lo] * l_tot)
@@ -269,10 +306,10 @@ def _update_kernel(
             return np.nan, False
     (
         kest_da, kest_n, kest_dmin, kest_gap, kest_cal, ring, ring_pos, ring_count, fit_buf,
-        fit_n, fit_stride, n_seen, next_refit, thresholds, n_thr, fitted, max_feature,
+        fit_n, fit_stride, n_seen, n_fit_seen, next_refit, thresholds, n_thr, fitted, prior,
         fit_range, novel, novel_needed,
     ) = kest  # fmt: skip
-    lo, ent, u8, cls, classified, inside, stamp = maps
+    lo, _, u8, cls, classified, _, _ = maps
     touched, old_cls, changed, state = track
     rows, cols, t0, t1 = ray
     n_rows = raster.shape[1]
@@ -288,8 +325,8 @@ def _update_kernel(
         dist_buf[r] = res * np.sqrt((gx - routers_g[r, 0]) ** 2 + (gy - routers_g[r, 1]) ** 2)
     due = add_samples(
         rssi, dist_buf, kest_da, kest_n, kest_dmin, kest_gap, kest_cal, ring, ring_pos,
-        ring_count, fit_buf, fit_n, fit_stride, n_seen, next_refit, thresholds, n_thr, fitted,
-        max_feature, fit_range, novel, novel_needed, feature, k_out,
+        ring_count, fit_buf, fit_n, fit_stride, n_seen, n_fit_seen, next_refit, thresholds, n_thr,
+        fitted, prior, fit_range, novel, novel_needed, feature, k_out,
     )  # fmt: skip
     gain = 0.0
     # Rule 1: footprint free; a bump marks the contact cell ahead occupied.
@@ -305,7 +342,9 @@ def _update_kernel(
         for j in range(c_lo, c_hi + 1):
             ddx = j + 0.5 - gx
             ddy = i + 0.5 - gy
-            if ddx * ddx + ddy * ddy <= rad * rad or (i == rr and j == rc):
+            if (ddx * ddx + ddy * ddy <= rad * rad or (i == rr and j == rc)) and lo[
+                i * n_cols + j
+            ] > lmin:
                 gain += _apply(i * n_cols + j, foot, lmax, lmin, maps, track)
     if bumped and heading == heading:
         reach = rad + 0.5
@@ -418,6 +457,7 @@ class SparseInverseKVisibility:
         )
         self._policy_all = cfg.router_policy == "all"
         self._k_estimator = KEstimator(n_r, cfg)
+        self._kest = self._k_estimator._kernel_args()
         h, w = grid.shape
         n_cells = h * w
         inside = np.ones(n_cells, np.bool_)
@@ -472,13 +512,25 @@ class SparseInverseKVisibility:
         self._state.fill(0.0)
         self._state[_S_ENTROPY] = float(self._inside.sum())
         self._k_estimator.reset()
-        self._kest = self._k_estimator._kernel_args()
         self.n_updates = 0
 
     def _read_only(self, flat: np.ndarray) -> np.ndarray:
         view = flat.reshape(self.grid.shape).view()
         view.flags.writeable = False
         return view
+
+    def __getstate__(self) -> dict:
+        # Views would unpickle as copies, cut off from the arrays they show: rebuild them.
+        state = self.__dict__.copy()
+        for name in ("_lo_view", "_u8_view", "_classified_view"):
+            del state[name]
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._lo_view = self._read_only(self._lo)
+        self._u8_view = self._read_only(self._u8)
+        self._classified_view = self._read_only(self._classified)
 
     def update(
         self,

@@ -64,6 +64,7 @@ _DOOR_CLEAR = 20  # cm: doorway jamb to the wall line's junction (centre line)
 _MIN_DOOR = 80  # cm
 _PUSH = 3  # cm: edge midpoints pushed into the facing wall (less than half the thinnest wall)
 _MAX_ATTEMPTS = 200
+_MIN_ISLAND = 50  # cm: shortest free-standing wall (between two doorways) allowed
 _FREE_FRACTION = {"apartment": 0.955, "office": 0.965}  # free area / interior area (measured)
 # Interior wall materials: probability and thickness choices (cm, even so half is an integer).
 _INTERIOR = {
@@ -326,6 +327,7 @@ def _apartment_bsp(rng: np.random.Generator, gross: float) -> _Layout | None:
     w = _snap(gross / h)
     leaves: list[tuple[int, int, int, int]] = []
     stack = [(0, 0, w, h)]
+    lines: tuple[list[int], list[int]] = ([], [])  # x of vertical cuts, y of horizontal cuts
     while stack:
         x0, y0, x1, y1 = stack.pop()
         sx, sy = x1 - x0, y1 - y0
@@ -333,11 +335,18 @@ def _apartment_bsp(rng: np.random.Generator, gross: float) -> _Layout | None:
         if big < 2 * 250 or (sx * sy <= rng.uniform(9e4, 2.2e5) and big <= 600):
             leaves.append((x0, y0, x1, y1))
             continue
-        cut = _uniform_snap(rng, max(250, 0.3 * big), min(big - 250, 0.7 * big))
-        if sx >= sy:
-            stack += [(x0, y0, x0 + cut, y1), (x0 + cut, y0, x1, y1)]
+        along_x = sx >= sy
+        start = x0 if along_x else y0
+        lo, hi = start + max(250, 0.3 * big), start + min(big - 250, 0.7 * big)
+        cut = start + _uniform_snap(rng, lo - start, hi - start)
+        # Line up with a parallel wall nearby (offset walls 5–30 cm apart look like mistakes).
+        near = [v for v in lines[not along_x] if 0 < abs(v - cut) < 30 and lo <= v <= hi]
+        cut = near[0] if near else cut
+        lines[not along_x].append(cut)
+        if along_x:
+            stack += [(x0, y0, cut, y1), (cut, y0, x1, y1)]
         else:
-            stack += [(x0, y0, x1, y0 + cut), (x0, y0 + cut, x1, y1)]
+            stack += [(x0, y0, x1, cut), (x0, cut, x1, y1)]
     if len(leaves) < 3:
         return None
     order = sorted(range(len(leaves)), key=lambda i: _area(leaves[i]))
@@ -600,11 +609,9 @@ def _build(
     on_edge = _on_boundary(layout, px, py)
     ext[on_edge] = 0
 
-    # Doorway positions, redrawn until every wall piece is still anchored to the building's
-    # exterior through other walls (no free-standing pillars).
     # Doorways of the spanning tree, redrawn until every wall piece is still anchored to the
     # exterior through other walls (no free-standing pillar); then the extra doors, each of which
-    # closes a loop around an island of walls, kept if no island is shorter than 0.5 m.
+    # closes a loop around an island of walls, kept unless an island is shorter than _MIN_ISLAND.
     tree, extra_doors = doors
     seg_of = {k: m for m, k in enumerate(walls)}
     span = np.stack([s0 - ext[:, 0], s1 + ext[:, 1]], 1).tolist()
@@ -620,7 +627,7 @@ def _build(
         m = seg_of[k]
         for _ in range(2):
             trial = {**gaps, m: _door_gap(rng, int(s0[m]), int(s1[m]), door_cm)}
-            if min(_islands(px, py, on_edge, span, trial), default=math.inf) >= 50:
+            if min(_islands(px, py, on_edge, span, trial), default=math.inf) >= _MIN_ISLAND:
                 gaps = trial
                 break
 

@@ -6,6 +6,7 @@ import numpy as np
 import shapely
 from sklearn.cluster import KMeans
 
+from sfw_gym._threads import single_threaded_openmp
 from sfw_gym.errors import ConfigError
 from sfw_gym.world.floorplan import Floorplan
 
@@ -35,6 +36,7 @@ def place_routers(floorplan: Floorplan, n: int, rng: np.random.Generator) -> np.
     if len(candidates) < n:
         raise ConfigError(f"floorplan {floorplan.name!r} has no open spot for a router")
     seed = int(rng.integers(2**31))
-    centres = KMeans(n_clusters=n, n_init=3, random_state=seed).fit(candidates).cluster_centers_
+    with single_threaded_openmp():
+        centres = KMeans(n_clusters=n, n_init=3, random_state=seed).fit(candidates).cluster_centers_
     nearest = np.argmin(np.linalg.norm(candidates[:, None] - centres[None], axis=2), axis=0)
     return candidates[nearest]

@@ -1,0 +1,212 @@
+"""The agent interface and the robot's view, the only door from an agent to the environment.
+
+An agent is built with keyword parameters only (every one has a default), bound to an episode with
+:meth:`Agent.reset`, then asked for one action per step with :meth:`Agent.act`::
+
+    env = gym.make("SfW-Explore-v0")
+    agent = FrontierAgent()
+    obs, info = env.reset(seed=0)
+    agent.reset(env, seed=0)
+    while True:
+        obs, reward, terminated, truncated, info = env.step(agent.act(obs))
+        if terminated or truncated:
+            break
+
+:meth:`Agent.reset` keeps a :class:`RobotViewHandle` and nothing else of the environment: the
+handle can call ``env.unwrapped.robot_view()`` (the robot's belief map, odometry pose, router
+positions, RSSI history, bump flag) and nothing more. Ground truth (the floorplan, the true pose,
+the true k-values) stays out of reach.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from sfw_gym.errors import ConfigError
+from sfw_gym.mapping.grid import GridSpec
+
+#: Keys of the robot's view that agents may rely on.
+VIEW_KEYS = frozenset(
+    {
+        "belief_u8", "probability", "grid", "odometry_pose", "routers_xy", "rssi_history",
+        "bumped", "radius_m", "max_linear_speed_m_s", "max_angular_speed_rad_s",
+        "control_period_s", "action_type",
+    }
+)  # fmt: skip
+#: Why an exploring agent stopped looking for goals.
+STOP_REASONS = ("no_frontiers", "all_blacklisted", "max_steps")
+
+
+class RobotViewHandle:
+    """A callable that returns the robot's view and exposes nothing else of the environment.
+
+    It keeps only the bound ``robot_view`` method (no attribute names the env) and checks each
+    view against :data:`VIEW_KEYS`, so an agent sees exactly what the robot knows.
+
+    Args:
+        env: A Gymnasium env (wrapped or not) whose ``unwrapped`` has ``robot_view()``.
+
+    Raises:
+        ConfigError: If the env has no ``robot_view`` method.
+    """
+
+    __slots__ = ("_fn",)
+
+    def __init__(self, env: Any) -> None:
+        fn = getattr(getattr(env, "unwrapped", env), "robot_view", None)
+        if not callable(fn):
+            raise ConfigError(
+                f"env {type(env).__name__} has no robot_view(): agents need SfW-Explore envs"
+            )
+        self._fn: Callable[[], dict[str, Any]] = fn
+
+    def __call__(self) -> RobotView:
+        """The robot's view now (fresh arrays)."""
+        raw = self._fn()
+        return RobotView(**{k: raw[k] for k in VIEW_KEYS})
+
+    def __reduce__(self) -> Any:
+        raise TypeError("a RobotViewHandle is bound to a live env and cannot be pickled")
+
+
+@dataclass(frozen=True)
+class RobotView:
+    """What the robot knows at one step (see ``SfWExploreEnv.robot_view``)."""
+
+    belief_u8: np.ndarray
+    probability: np.ndarray
+    grid: GridSpec
+    odometry_pose: tuple[float, float, float]
+    routers_xy: np.ndarray
+    rssi_history: np.ndarray
+    bumped: bool
+    radius_m: float
+    max_linear_speed_m_s: float
+    max_angular_speed_rad_s: float
+    control_period_s: float
+    action_type: str
+
+    @property
+    def xy(self) -> np.ndarray:
+        """Odometry position ``(x, y)``."""
+        return np.array(self.odometry_pose[:2], np.float64)
+
+    @property
+    def cell(self) -> tuple[int, int]:
+        """Grid cell ``(row, col)`` of the odometry position (clipped into the grid)."""
+        r, c = self.grid.world_to_cell(self.xy)
+        h, w = self.grid.shape
+        return min(max(int(r), 0), h - 1), min(max(int(c), 0), w - 1)
+
+
+class Agent(ABC):
+    """Base class of the baseline agents.
+
+    Subclasses take keyword parameters with defaults (``Agent()`` must work), set ``name``, and
+    implement :meth:`_act`. Randomness comes from the agent's own generator, seeded in
+    :meth:`reset`.
+
+    Attributes:
+        name: Short name used on the command line and in tables (``"frontier"``).
+        stop_reason: ``None`` while the agent has something to do; else why it stopped looking
+            for goals (one of :data:`STOP_REASONS`). Baselines keep acting (they fall back to
+            sweeping) so that an episode never stalls, but the first reason is kept.
+        steps: Actions taken since :meth:`reset`.
+    """
+
+    name: ClassVar[str] = "agent"
+    action_types: ClassVar[tuple[str, ...]] = ("continuous", "discrete")
+
+    def __init__(self, max_steps: int | None = None) -> None:
+        if max_steps is not None and (not isinstance(max_steps, int) or max_steps < 1):
+            raise ConfigError(f"max_steps must be None or an int >= 1, got {max_steps!r}")
+        self.max_steps = max_steps
+        self.stop_reason: str | None = None
+        self.steps = 0
+        self._view: RobotViewHandle | None = None
+        self.rng = np.random.default_rng()
+        self.action_type = "continuous"
+        self.trajectory: list[tuple[float, float]] = []
+
+    def reset(self, env: Any, seed: int | None = None) -> None:
+        """Bind the agent to ``env``'s current episode (call after ``env.reset``).
+
+        Args:
+            env: The environment; only its ``unwrapped.robot_view()`` is kept and used.
+            seed: Seed of the agent's own random generator.
+        """
+        self._view = RobotViewHandle(env)
+        view = self._view()
+        if view.action_type not in self.action_types:
+            raise ConfigError(
+                f"{type(self).__name__} supports action types {self.action_types}, "
+                f"the env uses {view.action_type!r}"
+            )
+        self.action_type = view.action_type
+        self.rng = np.random.default_rng(seed)
+        self.stop_reason = None
+        self.steps = 0
+        self.trajectory = []
+        self._on_reset(view)
+
+    def act(self, obs: Any = None) -> Any:
+        """The next action: ``np.float32 (linear, angular)`` or a discrete action ``int``."""
+        if self._view is None:
+            raise RuntimeError(f"{type(self).__name__}.act() called before reset(env)")
+        view = self._view()
+        self.trajectory.append((float(view.odometry_pose[0]), float(view.odometry_pose[1])))
+        if self.max_steps is not None and self.steps >= self.max_steps:
+            self._stop("max_steps")
+            linear, angular = 0.0, 0.0
+        else:
+            linear, angular = self._act(view, obs)
+        self.steps += 1
+        return self._to_action(linear, angular)
+
+    def params(self) -> dict[str, Any]:
+        """The constructor parameters (for logs and result files)."""
+        return {k: v for k, v in vars(self).items() if k in self._param_names()}
+
+    @classmethod
+    def _param_names(cls) -> set[str]:
+        import inspect
+
+        names: set[str] = set()
+        for klass in cls.__mro__:
+            init = klass.__dict__.get("__init__")
+            if init is not None:
+                names |= set(inspect.signature(init).parameters) - {"self"}
+        return names
+
+    # -- for subclasses -----------------------------------------------------------------------
+    def _on_reset(self, view: RobotView) -> None:  # noqa: B027 (optional hook)
+        """Per-episode set-up from the first view."""
+
+    @abstractmethod
+    def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
+        """``(linear, angular)`` fractions in [-1, 1] for this step."""
+
+    def _stop(self, reason: str) -> None:
+        if self.stop_reason is None:
+            self.stop_reason = reason
+
+    def _to_action(self, linear: float, angular: float) -> Any:
+        if self.action_type == "discrete":
+            from sfw_gym.agents.planning import to_discrete
+
+            return to_discrete(linear, angular)
+        return np.array([linear, angular], np.float32)
+
+
+def check_fraction(name: str, value: Any, lo: float = 0.0, hi: float = math.inf) -> float:
+    """Validate a finite number in ``[lo, hi]`` (a ConfigError naming ``name`` otherwise)."""
+    ok = isinstance(value, int | float | np.number) and not isinstance(value, bool)
+    if not ok or not math.isfinite(value) or not lo <= value <= hi:
+        raise ConfigError(f"{name} must be a number in [{lo}, {hi}], got {value!r}")
+    return float(value)

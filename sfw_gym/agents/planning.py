@@ -1,0 +1,214 @@
+"""Grid path planning on the robot's belief map and a pure-pursuit path follower.
+
+Costs: a cell believed a wall is an obstacle, inflated by the robot's radius; unknown cells are
+traversable at ``unknown_cost`` (× a free cell); cells near a wall cost extra so that paths keep
+clear of walls. Shortest paths come from scikit-image's minimum-cost-path search
+(:class:`skimage.graph.MCP_Geometric`, Dijkstra on the 8-connected grid), run once per replan from
+the robot to every cell, so that one search ranks every candidate goal.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+from skimage.graph import MCP_Geometric
+
+from sfw_gym.mapping.grid import U8_FREE_MIN, U8_WALL_MAX, GridSpec
+
+
+def belief_classes(belief_u8: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Threshold a uint8 belief (0 wall, 255 free, 127 unknown) into ``(free, wall, unknown)``."""
+    b = np.asarray(belief_u8)
+    wall = b <= U8_WALL_MAX
+    free = b >= U8_FREE_MIN
+    return free, wall, ~(free | wall)
+
+
+def traversal_costs(
+    belief_u8: np.ndarray,
+    resolution_m: float,
+    radius_m: float,
+    *,
+    unknown_cost: float = 1.5,
+    clearance_m: float = 0.2,
+    clearance_cost: float = 4.0,
+    blocked: np.ndarray | None = None,
+) -> np.ndarray:
+    """Per-cell traversal cost of the belief map (``inf`` = obstacle).
+
+    Args:
+        belief_u8: The belief map, ``[row, col]``.
+        resolution_m: Cell size, metres.
+        radius_m: Robot radius: cells whose centre lies within it of a wall cell are obstacles.
+        unknown_cost: Cost of an unknown cell (a free cell costs 1).
+        clearance_m: Beyond the radius, cells within this extra distance of a wall cost more.
+        clearance_cost: Extra cost at the inflated obstacle's edge, falling linearly to 0 at
+            ``radius_m + clearance_m``.
+        blocked: Optional extra obstacle mask (e.g. cells the agent has found impassable).
+
+    Returns:
+        float64 array of the belief's shape.
+    """
+    free, wall, unknown = belief_classes(belief_u8)
+    if blocked is not None:
+        wall = wall | blocked
+    cost = np.where(unknown, float(unknown_cost), 1.0)
+    if wall.any():
+        dist = ndimage.distance_transform_edt(~wall) * resolution_m
+        near = (dist > radius_m) & (dist < radius_m + clearance_m)
+        cost[near] += clearance_cost * (radius_m + clearance_m - dist[near]) / clearance_m
+        cost[dist <= radius_m] = np.inf
+    return cost
+
+
+def free_start(cost: np.ndarray, start_rc: tuple[int, int], radius_cells: int = 1) -> np.ndarray:
+    """A copy of ``cost`` with the cells around the robot made passable.
+
+    The robot stands where it stands: an inflated obstacle (or a wall misplaced by the map) under
+    it must not trap the planner. Cells within ``radius_cells`` get a finite, high cost.
+    """
+    out = cost.copy()
+    r, c = start_rc
+    h, w = out.shape
+    sl = (slice(max(r - radius_cells, 0), r + radius_cells + 1),
+          slice(max(c - radius_cells, 0), c + radius_cells + 1))  # fmt: skip
+    patch = out[sl]
+    patch[~np.isfinite(patch)] = 20.0
+    if 0 <= r < h and 0 <= c < w and not np.isfinite(out[r, c]):
+        out[r, c] = 20.0
+    return out
+
+
+@dataclass
+class CostField:
+    """Cheapest paths from the robot's cell to every cell of the grid.
+
+    Attributes:
+        start_rc: The robot's cell.
+        cumulative: Path cost to each cell, in metres × cell cost (``inf`` = unreachable).
+        resolution_m: Cell size, metres.
+    """
+
+    start_rc: tuple[int, int]
+    cumulative: np.ndarray
+    resolution_m: float
+    _mcp: MCP_Geometric
+
+    def reachable(self) -> np.ndarray:
+        """Mask of cells with a finite path cost."""
+        return np.isfinite(self.cumulative)
+
+    def path(self, goal_rc: tuple[int, int]) -> np.ndarray:
+        """``(N, 2)`` cells ``(row, col)`` from the start to ``goal_rc`` (empty if unreachable)."""
+        if not np.isfinite(self.cumulative[goal_rc]):
+            return np.zeros((0, 2), np.int64)
+        return np.asarray(self._mcp.traceback(tuple(int(v) for v in goal_rc)), np.int64)
+
+
+def cost_field(cost: np.ndarray, start_rc: tuple[int, int], resolution_m: float) -> CostField:
+    """Dijkstra from ``start_rc`` over ``cost`` (8-connected; ``inf`` cells are obstacles)."""
+    h, w = cost.shape
+    r, c = int(start_rc[0]), int(start_rc[1])
+    r, c = min(max(r, 0), h - 1), min(max(c, 0), w - 1)
+    mcp = MCP_Geometric(cost, fully_connected=True)
+    cum, _ = mcp.find_costs([(r, c)])
+    cum = np.asarray(cum, np.float64) * resolution_m
+    return CostField((r, c), cum, resolution_m, mcp)
+
+
+def simplify_path(path_xy: np.ndarray, spacing_m: float) -> np.ndarray:
+    """Resample a polyline so that consecutive points lie ``spacing_m`` or more apart (ends kept)."""
+    if len(path_xy) <= 2:
+        return path_xy
+    keep = [0]
+    for i in range(1, len(path_xy) - 1):
+        if np.hypot(*(path_xy[i] - path_xy[keep[-1]])) >= spacing_m:
+            keep.append(i)
+    keep.append(len(path_xy) - 1)
+    return path_xy[keep]
+
+
+def cells_to_world(grid: GridSpec, cells_rc: np.ndarray) -> np.ndarray:
+    """World ``(x, y)`` of cell centres, ``(N, 2)``."""
+    return grid.cell_to_world(np.asarray(cells_rc).reshape(-1, 2))
+
+
+def wrap_angle(a: float) -> float:
+    """Angle wrapped to [-π, π)."""
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@dataclass
+class PurePursuit:
+    """Pure-pursuit follower of a polyline (Coulter 1992) for a differential-drive robot.
+
+    The carrot is the first path point at least ``lookahead_m`` from the robot beyond the nearest
+    point on the path; the turn rate follows the carrot's bearing. Large bearing errors turn the
+    robot in place first.
+
+    Attributes:
+        lookahead_m: Carrot distance.
+        turn_in_place_rad: Bearing error above which the robot turns without driving.
+        angular_gain: Turn rate (fraction of the limit) per radian of bearing error.
+        goal_tolerance_m: Distance at which the path's end counts as reached.
+    """
+
+    lookahead_m: float = 0.5
+    turn_in_place_rad: float = 0.9
+    angular_gain: float = 1.5
+    goal_tolerance_m: float = 0.2
+
+    def __post_init__(self) -> None:
+        self.path = np.zeros((0, 2))
+        self._progress = 0
+
+    def set_path(self, path_xy: np.ndarray) -> None:
+        """Follow a new ``(N, 2)`` world polyline."""
+        self.path = np.asarray(path_xy, np.float64).reshape(-1, 2)
+        self._progress = 0
+
+    @property
+    def has_path(self) -> bool:
+        """Whether a path is set and its end not yet reached."""
+        return len(self.path) > 0
+
+    def remaining_m(self, xy: np.ndarray) -> float:
+        """Distance from ``xy`` along the rest of the path to its end."""
+        if not self.has_path:
+            return 0.0
+        rest = self.path[self._progress :]
+        legs = np.linalg.norm(np.diff(rest, axis=0), axis=1).sum() if len(rest) > 1 else 0.0
+        return float(np.linalg.norm(rest[0] - xy) + legs)
+
+    def command(self, pose: tuple[float, float, float]) -> tuple[float, float]:
+        """``(linear, angular)`` fractions in [-1, 1] towards the carrot; (0, 0) at the end."""
+        if not self.has_path:
+            return 0.0, 0.0
+        xy = np.array(pose[:2])
+        if np.linalg.norm(self.path[-1] - xy) <= self.goal_tolerance_m:
+            self.path = np.zeros((0, 2))
+            return 0.0, 0.0
+        # Advance the progress index to the nearest path point (never backwards).
+        window = self.path[self._progress : self._progress + 40]
+        self._progress += int(np.argmin(np.linalg.norm(window - xy, axis=1)))
+        carrot = self.path[-1]
+        for p in self.path[self._progress :]:
+            if np.linalg.norm(p - xy) >= self.lookahead_m:
+                carrot = p
+                break
+        bearing = wrap_angle(math.atan2(carrot[1] - xy[1], carrot[0] - xy[0]) - pose[2])
+        angular = float(np.clip(self.angular_gain * bearing, -1.0, 1.0))
+        if abs(bearing) > self.turn_in_place_rad:
+            return 0.0, math.copysign(1.0, bearing)
+        linear = float(np.clip(math.cos(bearing), 0.2, 1.0))
+        return linear, angular
+
+
+def to_discrete(linear: float, angular: float, deadband: float = 0.35) -> int:
+    """Map a (linear, angular) command to the discrete actions 0 forward, 1 left, 2 right."""
+    if abs(angular) > deadband or linear <= 0.0:
+        return 1 if angular > 0 else 2
+    return 0

@@ -1,0 +1,209 @@
+"""One suite over every registered env id: API conformance, determinism, pickling, vectors, rendering."""
+
+from __future__ import annotations
+
+import pickle
+import warnings
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env as gym_check_env
+
+import sfw_gym
+from sfw_gym.errors import ConfigError
+
+ENV_IDS = sorted(sfw_gym.ENV_IDS)
+#: Warnings we accept from the checkers, with why.
+WARNING_WHITELIST = (
+    # SB3's checker notes that image observations should be channel-last or -first of size ≥ 36;
+    # ours are channel-first and ≥ 36: SB3 still prints a generic hint for non-square Box spaces.
+    "It seems that your observation",
+)
+
+
+def _rollout(env_id: str, seed: int, n: int) -> list:
+    env = gym.make(env_id)
+    env.action_space.seed(seed)
+    obs, _ = env.reset(seed=seed)
+    out = [obs]
+    for _ in range(n):
+        obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+        out.append((obs, reward, terminated, truncated, info["true_pose"], info["coverage"]))
+        if terminated or truncated:
+            obs, _ = env.reset()
+    env.close()
+    return out
+
+
+def _assert_same(a, b) -> None:
+    if isinstance(a, dict):
+        assert a.keys() == b.keys()
+        for k in a:
+            _assert_same(a[k], b[k])
+    elif isinstance(a, tuple | list):
+        assert len(a) == len(b)
+        for x, y in zip(a, b, strict=True):
+            _assert_same(x, y)
+    else:
+        np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+class TestEveryEnv:
+    def test_gymnasium_check_env(self, env_id):
+        env = gym.make(env_id)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            gym_check_env(env.unwrapped, skip_render_check=False)
+        bad = [str(w.message) for w in caught if not str(w.message).startswith(WARNING_WHITELIST)]
+        assert not bad, bad
+
+    def test_sb3_check_env(self, env_id):
+        from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+        env = gym.make(env_id)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            sb3_check_env(env.unwrapped, warn=True)
+        bad = [str(w.message) for w in caught if not str(w.message).startswith(WARNING_WHITELIST)]
+        assert not bad, bad
+
+    def test_same_seed_same_rollout(self, env_id):
+        _assert_same(_rollout(env_id, 3, 100), _rollout(env_id, 3, 100))
+
+    def test_different_seeds_differ(self, env_id):
+        a, b = _rollout(env_id, 1, 5), _rollout(env_id, 2, 5)
+        assert not np.array_equal(a[0]["map"], b[0]["map"]) or not np.array_equal(
+            a[-1][4], b[-1][4]
+        )
+
+    def test_pickle_round_trip_continues_identically(self, env_id):
+        env = gym.make(env_id)
+        env.reset(seed=5)
+        for _ in range(10):
+            env.step(env.action_space.sample())
+        clone = pickle.loads(pickle.dumps(env))
+        env.action_space.seed(9)
+        actions = [env.action_space.sample() for _ in range(20)]
+        for action in actions:
+            a = env.step(action)
+            b = clone.step(action)
+            _assert_same(a[:4], b[:4])
+            np.testing.assert_array_equal(a[4]["true_pose"], b[4]["true_pose"])
+
+    def test_observations_fit_multi_input_policy(self, env_id):
+        env = gym.make(env_id)
+        obs, _ = env.reset(seed=0)
+        assert env.observation_space.contains(obs)
+        for key in ("map", "local"):
+            img = obs[key]
+            assert img.dtype == np.uint8 and img.shape[0] <= 3 and min(img.shape[1:]) >= 36
+
+    @pytest.mark.parametrize("mode", ["rgb_array", "human"])
+    def test_render_modes_headless(self, env_id, mode, monkeypatch):
+        monkeypatch.setenv("MPLBACKEND", "Agg")
+        env = gym.make(env_id, render_mode=mode)
+        env.reset(seed=0)
+        for _ in range(3):
+            env.step(env.action_space.sample())
+        frame = env.render()
+        if mode == "rgb_array":
+            assert frame.dtype == np.uint8 and frame.ndim == 3 and frame.shape[2] == 3
+            assert frame.shape[0] >= 200 and len(np.unique(frame.reshape(-1, 3), axis=0)) > 4
+        else:
+            assert frame is None
+        env.close()
+
+
+def test_gymnasium_async_vector_env():
+    envs = gym.vector.AsyncVectorEnv([lambda: gym.make("SfW-ExploreSmall-v0")] * 2)
+    obs, info = envs.reset(seed=[1, 2])
+    assert obs["map"].shape[0] == 2
+    for _ in range(5):
+        obs, rewards, terminated, truncated, info = envs.step(envs.action_space.sample())
+    assert rewards.shape == (2,) and "coverage" in info
+    envs.close()
+
+
+def test_sb3_subproc_vec_env():
+    from stable_baselines3.common.env_util import make_vec_env
+    from stable_baselines3.common.vec_env import SubprocVecEnv
+
+    venv = make_vec_env("SfW-ExploreSmall-v0", n_envs=2, seed=0, vec_env_cls=SubprocVecEnv)
+    venv.reset()
+    for _ in range(5):
+        obs, rewards, dones, infos = venv.step(np.array([venv.action_space.sample()] * 2))
+    assert obs["state"].shape[0] == 2 and len(infos) == 2
+    venv.close()
+
+
+def test_registered_without_import():
+    env = gym.make("sfw_gym:SfW-Explore-v0")
+    assert env.unwrapped.spec.id == "SfW-Explore-v0"
+
+
+class TestBadInput:
+    @pytest.fixture
+    def env(self):
+        env = gym.make("SfW-ExploreSmall-v0")
+        env.reset(seed=0)
+        return env
+
+    @pytest.mark.parametrize(
+        "action, match",
+        [
+            ([np.nan, 0.0], "finite"),
+            ([np.inf, 0.0], "finite"),
+            ([0.0, 0.0, 0.0], "shape"),
+            (np.zeros((2, 1)), "shape"),
+        ],
+    )
+    def test_bad_continuous_actions_raise(self, env, action, match):
+        pose = env.unwrapped.scene.robot.pose
+        with pytest.raises(ValueError, match=match):
+            env.unwrapped.step(np.array(action, dtype=np.float64))
+        assert env.unwrapped.scene.robot.pose == pose  # nothing moved
+
+    def test_out_of_range_actions_are_clipped(self, env):
+        u = env.unwrapped
+        u.reset(seed=1)
+        a = u.step(np.array([5.0, -7.0]))
+        u.reset(seed=1)
+        b = u.step(np.array([1.0, -1.0]))
+        np.testing.assert_array_equal(a[4]["true_pose"], b[4]["true_pose"])
+        assert np.isfinite(a[4]["true_pose"]).all()
+
+    def test_bad_discrete_actions_raise(self):
+        env = gym.make("SfW-ExploreDiscrete-v0")
+        env.reset(seed=0)
+        for action in (3, -1, 1.5, np.nan):
+            with pytest.raises(ValueError, match="action"):
+                env.unwrapped.step(action)
+
+    def test_unknown_reset_option(self, env):
+        with pytest.raises(ConfigError, match="unknown reset option.*'colour'"):
+            env.reset(options={"colour": "red"})
+
+    def test_router_in_a_wall(self, env):
+        with pytest.raises(ConfigError, match="router 0 .* (inside a wall|outside the building)"):
+            env.reset(options={"routers": [[-50.0, -50.0]]})
+
+    def test_too_many_routers(self, env):
+        with pytest.raises(ConfigError, match="router"):
+            env.reset(options={"routers": 5})
+
+    def test_bad_kwargs(self):
+        with pytest.raises(ConfigError, match="action_type"):
+            gym.make("SfW-Explore-v0", action_type="teleport")
+        with pytest.raises(ConfigError, match="radio"):
+            gym.make("SfW-Explore-v0", radio={"walls_are_lava": True})
+        with pytest.raises(ConfigError, match="preset"):
+            gym.make("SfW-Explore-v0", radio_preset="swamp")
+        with pytest.raises(ConfigError, match="resolution_m"):
+            gym.make("SfW-Explore-v0", resolution_m=0.0)
+
+    def test_step_before_reset(self):
+        env = gym.make("SfW-ExploreSmall-v0").unwrapped
+        with pytest.raises(gym.error.ResetNeeded):
+            env.step(np.zeros(2))

@@ -1,0 +1,127 @@
+"""GridSpec geometry and the compiled ray traversal."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from sfw_gym.errors import ConfigError
+from sfw_gym.mapping import GridSpec, classify_u8, ray_cells
+
+UNIT = GridSpec((0.0, 0.0), 1.0, (5, 5))
+
+
+def cells(start, end, grid=UNIT):
+    return [tuple(c) for c in ray_cells(grid, start, end).tolist()]
+
+
+def test_covering_exact_and_with_margin():
+    g = GridSpec.covering((0.0, 0.0, 15.0, 15.0), 0.05)
+    assert g.shape == (300, 300)
+    assert g.origin_xy == (0.0, 0.0)
+    g = GridSpec.covering((0.0, 0.0, 15.0, 10.0), 0.05, margin_m=0.2)
+    assert g.origin_xy == pytest.approx((-0.2, -0.2))
+    assert g.shape == (208, 308)  # rows follow y, columns follow x
+    assert g.bounds[2] >= 15.2 - 1e-9 and g.bounds[3] >= 10.2 - 1e-9
+
+
+def test_rows_are_y_and_cols_are_x():
+    g = GridSpec((1.0, 2.0), 0.1, (10, 20))
+    assert g.world_to_cell((1.12, 2.31)).tolist() == [3, 1]
+    assert g.cell_to_world((3, 1)).tolist() == pytest.approx([1.15, 2.35])
+    assert g.n_rows == 10 and g.n_cols == 20
+
+
+def test_round_trip_over_all_cells():
+    g = GridSpec((-3.0, 4.5), 0.05, (40, 70))
+    rr, cc = np.meshgrid(np.arange(40), np.arange(70), indexing="ij")
+    rc = np.stack([rr, cc], axis=-1)
+    centres = g.cell_to_world(rc)
+    assert np.array_equal(g.world_to_cell(centres), rc)
+    assert g.contains(centres).all()
+    xs, ys = g.cell_centres()
+    assert np.allclose(xs, centres[..., 0]) and np.allclose(ys, centres[..., 1])
+
+
+def test_contains_edges():
+    g = GridSpec((0.0, 0.0), 0.5, (2, 4))
+    pts = np.array([[0.0, 0.0], [1.999, 0.999], [2.0, 0.5], [0.5, 1.0], [-1e-9, 0.5]])
+    assert g.contains(pts).tolist() == [True, True, False, False, False]
+    assert not g.contains(np.array([np.nan, 0.5]))
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"origin_xy": (0.0, 0.0), "resolution_m": 0.0, "shape": (2, 2)},
+        {"origin_xy": (0.0, 0.0), "resolution_m": -1.0, "shape": (2, 2)},
+        {"origin_xy": (np.nan, 0.0), "resolution_m": 0.1, "shape": (2, 2)},
+        {"origin_xy": (0.0, 0.0), "resolution_m": 0.1, "shape": (0, 2)},
+        {"origin_xy": (0.0, 0.0), "resolution_m": 0.1, "shape": (2.5, 2)},
+        {"origin_xy": (0.0,), "resolution_m": 0.1, "shape": (2, 2)},
+    ],
+)
+def test_bad_grid_raises(kwargs):
+    with pytest.raises(ConfigError):
+        GridSpec(**kwargs)
+
+
+def test_bad_covering_raises():
+    with pytest.raises(ConfigError, match="bounds"):
+        GridSpec.covering((0.0, 0.0, -1.0, 1.0), 0.1)
+    with pytest.raises(ConfigError, match="margin_m"):
+        GridSpec.covering((0.0, 0.0, 1.0, 1.0), 0.1, margin_m=-0.1)
+
+
+def test_classify_u8_thirds():
+    wall, free = classify_u8(np.array([0, 84, 85, 127, 170, 171, 255], np.uint8))
+    assert wall.tolist() == [True, True, False, False, False, False, False]
+    assert free.tolist() == [False, False, False, False, False, True, True]
+
+
+def test_ray_axis_aligned():
+    assert cells((0.5, 0.5), (3.5, 0.5)) == [(0, 0), (0, 1), (0, 2), (0, 3)]
+    assert cells((2.5, 4.5), (2.5, 1.5)) == [(4, 2), (3, 2), (2, 2), (1, 2)]
+    assert cells((1.2, 1.2), (1.7, 1.9)) == [(1, 1)]  # inside one cell
+    assert cells((1.5, 1.5), (1.5, 1.5)) == [(1, 1)]  # a point
+
+
+def test_ray_diagonal_through_corners_steps_diagonally():
+    assert cells((0.5, 0.5), (3.5, 3.5)) == [(0, 0), (1, 1), (2, 2), (3, 3)]
+    assert cells((3.5, 0.5), (0.5, 3.5)) == [(0, 3), (1, 2), (2, 1), (3, 0)]
+
+
+def test_ray_general_slope_and_reverse():
+    fwd = cells((0.5, 0.5), (2.5, 1.5))
+    assert fwd == [(0, 0), (0, 1), (1, 1), (1, 2)]
+    assert cells((2.5, 1.5), (0.5, 0.5)) == fwd[::-1]
+
+
+def test_ray_is_clipped_to_the_grid():
+    assert cells((-2.0, 0.5), (1.5, 0.5)) == [(0, 0), (0, 1)]
+    assert cells((4.5, 2.5), (9.0, 2.5)) == [(2, 4)]
+    assert cells((-1.0, -1.0), (-3.0, 7.0)) == []
+
+
+def test_ray_parameters_and_connectivity_random():
+    rng = np.random.default_rng(0)
+    g = GridSpec((-1.0, 2.0), 0.1, (37, 53))
+    for _ in range(300):
+        a = rng.uniform([-1.0, 2.0], [4.3, 5.7])
+        b = rng.uniform([-1.0, 2.0], [4.3, 5.7])
+        c, t = ray_cells(g, a, b, return_t=True)
+        assert tuple(c[0]) == tuple(g.world_to_cell(a))
+        assert tuple(c[-1]) == tuple(g.world_to_cell(b))
+        steps = np.abs(np.diff(c, axis=0))
+        assert (steps.max(axis=1) == 1).all()  # 4- or 8-neighbours, no gaps or repeats
+        assert t[0, 0] == 0.0 and t[-1, 1] == pytest.approx(1.0)
+        assert (np.diff(t, axis=1) >= 0).all() and np.allclose(t[1:, 0], t[:-1, 1])
+        mid = a + (b - a) * t.mean(axis=1)[:, None]  # each cell holds its stretch's midpoint
+        assert np.array_equal(g.world_to_cell(mid), c)
+
+
+def test_ray_bad_input():
+    with pytest.raises(ConfigError):
+        ray_cells(UNIT, (np.nan, 0.0), (1.0, 1.0))
+    with pytest.raises(ConfigError):
+        ray_cells(UNIT, (0.0, 0.0, 0.0), (1.0, 1.0))
