@@ -90,6 +90,12 @@ def _cmd_map(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_bench(args: argparse.Namespace) -> int:
+    from sfw_gym.bench import main_bench
+
+    return main_bench(args.env, args.steps, args.resets, args.memory_steps)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of every subcommand."""
     parser = argparse.ArgumentParser(
@@ -131,6 +137,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     mp.add_argument("--out", default="map.png", help="output PNG; .npy and .json beside it")
     mp.set_defaults(func=_cmd_map)
+    bench = sub.add_parser("bench", help="env steps/s and reset ms beside CartPole-v1")
+    bench.add_argument("--env", default="SfW-Explore-v0", help="env id (default SfW-Explore-v0)")
+    bench.add_argument("--steps", type=int, default=5000, help="random steps to time")
+    bench.add_argument("--resets", type=int, default=50, help="resets to time")
+    bench.add_argument("--memory-steps", type=int, default=0,
+                       help="also report RSS before/after this many steps (e.g. 100000)")
+    bench.set_defaults(func=_cmd_bench)
     return parser
 
 

@@ -166,17 +166,23 @@ class FrontierAgent(Agent):
 
     # -- episode ---------------------------------------------------------------------------------
     def _on_reset(self, view: RobotView) -> None:
-        self.blacklist: list[np.ndarray] = []
+        res = view.grid.resolution_m
+        self.blacklisted = np.zeros(view.grid.shape, bool)
+        self.bumps = np.zeros(view.grid.shape, bool)
+        self._blacklist_radius_cells = self.blacklist_radius_m / res
+        self._bump_radius_cells = max(1.0, 0.1 / res)
         self.goal: Goal | None = None
         self.follower = PurePursuit(lookahead_m=self.lookahead_m)
         self.visited = np.zeros(view.grid.shape, bool)
-        self._visit_radius_cells = (view.radius_m + self.visited_margin_m) / view.grid.resolution_m
+        self._visit_radius_cells = (view.radius_m + self.visited_margin_m) / res
         self._since_plan = 0
         self.n_blacklisted = 0
         self.n_goals = 0
 
     def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
         self._mark_visited(view)
+        if view.bumped:
+            self._mark_bump(view)
         pose = view.odometry_pose
         goal = self.goal
         replan = goal is None or view.bumped or self._since_plan >= self.replan_every_steps
@@ -206,30 +212,38 @@ class FrontierAgent(Agent):
 
     # -- goals -----------------------------------------------------------------------------------
     def _mark_visited(self, view: RobotView) -> None:
-        r, c = view.cell
-        rad = self._visit_radius_cells
-        k = int(np.ceil(rad)) + 1
-        h, w = self.visited.shape
-        r0, r1, c0, c1 = max(r - k, 0), min(r + k + 1, h), max(c - k, 0), min(c + k + 1, w)
-        rr, cc = np.ogrid[r0:r1, c0:c1]
-        self.visited[r0:r1, c0:c1] |= (rr - r) ** 2 + (cc - c) ** 2 <= rad * rad
+        self._mark_disk(self.visited, view.cell, self._visit_radius_cells)
 
     def _blacklist(self, goal: Goal) -> None:
-        self.blacklist.append(np.array(goal.cell, np.float64))
+        """Blacklist the cells within ``blacklist_radius_m`` of a goal."""
+        self._mark_disk(self.blacklisted, goal.cell, self._blacklist_radius_cells)
         self.n_blacklisted += 1
         self.goal = None
 
-    def _is_blacklisted(self, cells: np.ndarray, resolution_m: float) -> np.ndarray:
-        if not self.blacklist:
-            return np.zeros(len(cells), bool)
-        bl = np.array(self.blacklist)
-        d = np.linalg.norm(cells[:, None, :] - bl[None, :, :], axis=2).min(axis=1)
-        return d * resolution_m <= self.blacklist_radius_m
+    @staticmethod
+    def _mark_disk(mask: np.ndarray, cell: tuple[int, int], radius_cells: float) -> None:
+        r, c = cell
+        k = int(np.ceil(radius_cells))
+        h, w = mask.shape
+        r0, r1, c0, c1 = max(r - k, 0), min(r + k + 1, h), max(c - k, 0), min(c + k + 1, w)
+        if r0 >= r1 or c0 >= c1:
+            return
+        rr, cc = np.ogrid[r0:r1, c0:c1]
+        mask[r0:r1, c0:c1] |= (rr - r) ** 2 + (cc - c) ** 2 <= radius_cells * radius_cells
+
+    def _mark_bump(self, view: RobotView) -> None:
+        """Remember a wall where the bumper fired (the mapper marks one cell; walls are longer)."""
+        x, y, th = view.odometry_pose
+        reach = view.radius_m + view.grid.resolution_m
+        contact = np.array([x + reach * np.cos(th), y + reach * np.sin(th)])
+        cell = tuple(int(v) for v in view.grid.world_to_cell(contact))
+        self._mark_disk(self.bumps, cell, self._bump_radius_cells)
 
     def _costs(self, view: RobotView) -> np.ndarray:
         cost = traversal_costs(
-            view.belief_u8, view.grid.resolution_m, view.radius_m, unknown_cost=self.unknown_cost
-        )
+            view.belief_u8, view.grid.resolution_m, view.radius_m,
+            unknown_cost=self.unknown_cost, blocked=self.bumps,
+        )  # fmt: skip
         return free_start(cost, view.cell)
 
     def _plan(self, view: RobotView) -> None:
@@ -261,7 +275,7 @@ class FrontierAgent(Agent):
         frontiers = find_frontiers(
             view.belief_u8,
             max(1, int(round(self.min_frontier_size_m / res))),
-            exclude=self.visited,
+            exclude=self.visited | self.bumps,
         )
         if not frontiers:
             self._stop("no_frontiers")
@@ -270,11 +284,13 @@ class FrontierAgent(Agent):
         any_open = False
         for f in frontiers:
             dist = field.cumulative[f.cells[:, 0], f.cells[:, 1]]
-            ok = np.isfinite(dist) & ~self._is_blacklisted(f.cells, res)
+            reachable = np.isfinite(dist)
+            if not reachable.any():  # unreachable on the belief map: blacklist it
+                self.blacklisted[f.cells[:, 0], f.cells[:, 1]] = True
+                self.n_blacklisted += 1
+                continue
+            ok = reachable & ~self.blacklisted[f.cells[:, 0], f.cells[:, 1]]
             if not ok.any():
-                if not np.isfinite(dist).any():  # unreachable on the belief map: blacklist it
-                    self.blacklist.append(np.array(f.centroid_rc))
-                    self.n_blacklisted += 1
                 continue
             any_open = True
             i = int(np.flatnonzero(ok)[np.argmin(dist[ok])])

@@ -173,6 +173,7 @@ class SfWExploreEnv(gym.Env):
         )
         s = self.scene
         self.grid = GridSpec(s.grid_origin, self.resolution_m, s.truth_u8.shape)
+        self._grid_bounds = self.grid.bounds
         self.mapper = SparseInverseKVisibility(self.grid, s.radio.routers, self.mapper_config)
         self.tracker = MapTracker(s.truth_u8)
         self.obs_builder = ObservationBuilder(
@@ -240,7 +241,7 @@ class SfWExploreEnv(gym.Env):
                 raise ValueError(f"action must have shape (2,) = (linear, angular), got {a.shape}")
             if not np.isfinite(a).all():
                 raise ValueError(f"action must be finite, got {a.tolist()}")
-            lin, ang = np.clip(a, -1.0, 1.0)
+            lin, ang = min(max(a[0], -1.0), 1.0), min(max(a[1], -1.0), 1.0)
         return float(lin) * cfg.max_linear_speed_m_s, float(ang) * cfg.max_angular_speed_rad_s
 
     def _sense_and_map(self, *, bumped: bool) -> dict[str, np.ndarray]:
@@ -252,7 +253,8 @@ class SfWExploreEnv(gym.Env):
         self.rssi_history.append(rssi)
         self.trajectory.append((true_pose.x, true_pose.y))
         self.odometry_trajectory.append((odom.x, odom.y))
-        if self.grid.contains(np.array(odom[:2])):
+        (x0, y0, x1, y1) = self._grid_bounds
+        if x0 <= odom.x < x1 and y0 <= odom.y < y1:
             self.last_gain_bits = self.mapper.update(
                 odom[:2], rssi.astype(np.float64), bumped=bumped, heading_rad=odom.theta
             )

@@ -99,7 +99,8 @@ class ObservationBuilder:
         robot = self._trajectory.copy()
         r, c = self.pixel_of(x, y)
         robot[max(r - 1, 0) : r + 2, max(c - 1, 0) : c + 2] = ROBOT_U8
-        image = np.stack([belief, robot, self._routers])
+        image = np.empty((3, self.map_px, self.map_px), np.uint8)
+        image[0], image[1], image[2] = belief, robot, self._routers
 
         half = self.crop_px // 2
         rows, cols = self.grid.shape
@@ -118,8 +119,8 @@ class ObservationBuilder:
         (x0, y0), (w, h) = self.grid.origin_xy, self._extent()
         state[k : k + 6] = (
             float(bumped),
-            np.clip((x - x0) / w, 0.0, 1.0),
-            np.clip((y - y0) / h, 0.0, 1.0),
+            min(max((x - x0) / w, 0.0), 1.0),
+            min(max((y - y0) / h, 0.0), 1.0),
             math.sin(theta),
             math.cos(theta),
             known_fraction,

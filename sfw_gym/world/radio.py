@@ -13,16 +13,12 @@ from types import MappingProxyType
 from typing import Any
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 from shapely.geometry import Point
 
 from sfw_gym.errors import ConfigError
 from sfw_gym.world.floorplan import MATERIALS, Floorplan
-from sfw_gym.world.wall_crossing import (
-    DEFAULT_MIN_PIECE_M,
-    cross_walls_from_sources,
-    cross_walls_from_sources_parallel,
-)
+from sfw_gym.world.wall_crossing import DEFAULT_MIN_PIECE_M, _cross_one
 
 #: Above this many points, wall counting runs on all cores.
 _PARALLEL_MIN_POINTS = 256
@@ -168,12 +164,12 @@ class ShadowingField:
         spacing_m: float = 0.5,
     ) -> None:
         xmin, ymin, xmax, ymax = bounds
-        self._origin = np.array([xmin - spacing_m, ymin - spacing_m])
-        self._spacing_m = spacing_m
+        self.origin = np.array([xmin - spacing_m, ymin - spacing_m])
+        self.spacing_m = spacing_m
         nx = math.ceil((xmax - xmin) / spacing_m) + 3
         ny = math.ceil((ymax - ymin) / spacing_m) + 3
         gy, gx = np.meshgrid(np.arange(ny), np.arange(nx), indexing="ij")
-        nodes = self._origin + spacing_m * np.stack([gx.ravel(), gy.ravel()], axis=1)
+        nodes = self.origin + spacing_m * np.stack([gx.ravel(), gy.ravel()], axis=1)
         tables = []
         for _ in range(n_routers):
             omega = rng.standard_normal((n_features, 2)) / (
@@ -186,7 +182,7 @@ class ShadowingField:
 
     def __call__(self, points: np.ndarray) -> np.ndarray:
         """Shadowing in dB at points (M, 2) for every router: (M, R)."""
-        return _bilinear(self.table_db, self._origin, self._spacing_m, points)
+        return _bilinear(self.table_db, self.origin, self.spacing_m, points)
 
 
 @njit(cache=True)
@@ -208,6 +204,43 @@ def _bilinear(
             bottom = tables[r, j + 1, i] * (1 - tx) + tables[r, j + 1, i + 1] * tx
             out[m, r] = top * (1 - ty) + bottom * ty
     return out
+
+
+@njit(cache=True)
+def _rssi_range(edges, edge_loss, routers, pts, params, tables, origin, spacing, rssi, k, lo, hi):  # noqa: PLR0913
+    """Mean RSSI and wall counts for points lo..hi: the whole model in one compiled loop."""
+    tx, pl0, ten_n, d0, cap, min_piece = params
+    ts = np.empty(edges.shape[0] + 1)
+    ids = np.empty(edges.shape[0] + 1, np.int64)
+    shadow = _bilinear(tables, origin, spacing, pts[lo:hi])
+    for m in range(lo, hi):
+        for r in range(routers.shape[0]):
+            c, loss = _cross_one(
+                edges, edge_loss, routers[r, 0], routers[r, 1], pts[m, 0], pts[m, 1], min_piece, ts, ids
+            )
+            d = max(np.hypot(pts[m, 0] - routers[r, 0], pts[m, 1] - routers[r, 1]), d0)
+            k[m, r] = c
+            rssi[m, r] = tx - (pl0 + ten_n * np.log10(d / d0)) - min(loss, cap) + shadow[m - lo, r]
+
+
+@njit(cache=True)
+def _rssi(edges, edge_loss, routers, pts, params, tables, origin, spacing):  # noqa: PLR0913
+    rssi = np.empty((pts.shape[0], routers.shape[0]))
+    k = np.empty((pts.shape[0], routers.shape[0]), np.int32)
+    _rssi_range(edges, edge_loss, routers, pts, params, tables, origin, spacing, rssi, k, 0, len(pts))
+    return rssi, k
+
+
+@njit(cache=True, parallel=True)
+def _rssi_parallel(edges, edge_loss, routers, pts, params, tables, origin, spacing):  # noqa: PLR0913
+    m = pts.shape[0]
+    rssi = np.empty((m, routers.shape[0]))
+    k = np.empty((m, routers.shape[0]), np.int32)
+    n_chunks = (m + 511) // 512
+    for c in prange(n_chunks):
+        _rssi_range(edges, edge_loss, routers, pts, params, tables, origin, spacing, rssi, k,
+                    c * 512, min(m, (c + 1) * 512))  # fmt: skip
+    return rssi, k
 
 
 class RadioModel:
@@ -234,17 +267,16 @@ class RadioModel:
         self._d0_loss_db = self.config.d0_loss_db
         losses = self.config.wall_loss_db
         self._edge_loss_db = np.array([losses[m] for m in floorplan.edge_materials], np.float64)
-        self._shadowing = (
-            ShadowingField(
-                floorplan.bounds,
-                len(self.routers),
-                self.config.shadowing_sigma_db,
-                self.config.shadowing_correlation_m,
-                self.rng,
-            )
-            if self.config.shadowing_sigma_db > 0
-            else None
-        )
+        cfg = self.config
+        self._params = np.array([cfg.tx_power_dbm, self._d0_loss_db, 10.0 * cfg.path_loss_exponent,
+                                 cfg.reference_distance_m, cfg.max_total_wall_loss_db,
+                                 DEFAULT_MIN_PIECE_M])  # fmt: skip
+        if cfg.shadowing_sigma_db > 0:
+            field = ShadowingField(floorplan.bounds, len(self.routers), cfg.shadowing_sigma_db,
+                                   cfg.shadowing_correlation_m, self.rng)  # fmt: skip
+            self._shadow_args = (field.table_db, field.origin, field.spacing_m)
+        else:  # a flat zero table: no shadowing
+            self._shadow_args = (np.zeros((len(self.routers), 2, 2)), np.zeros(2), 1.0)
 
     @property
     def n_routers(self) -> int:
@@ -265,30 +297,19 @@ class RadioModel:
         ratio = np.log10(d / self.config.reference_distance_m)
         return self._d0_loss_db + 10.0 * self.config.path_loss_exponent * ratio
 
-    def _walls(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        kernel = (
-            cross_walls_from_sources_parallel
-            if len(pts) >= _PARALLEL_MIN_POINTS
-            else cross_walls_from_sources
-        )
-        return kernel(self.floorplan.edges, self._edge_loss_db, self.routers, pts, DEFAULT_MIN_PIECE_M)
+    def _model(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Mean RSSI (M, R) and true k (M, R) at points, in one compiled pass."""
+        kernel = _rssi_parallel if len(pts) >= _PARALLEL_MIN_POINTS else _rssi
+        return kernel(self.floorplan.edges, self._edge_loss_db, self.routers, pts, self._params,
+                      *self._shadow_args)  # fmt: skip
 
     def true_k(self, points: np.ndarray) -> np.ndarray:
         """Number of walls between each router and each point: (M, R) int."""
-        return self._walls(self._points(points))[0]
+        return self._model(self._points(points))[1]
 
     def mean_rssi(self, points: np.ndarray) -> np.ndarray:
         """RSSI without temporal noise (path loss, capped walls, shadowing): (M, R) float dBm."""
-        pts = self._points(points)
-        walls = self._walls(pts)[1]
-        rssi = (
-            self.config.tx_power_dbm
-            - self.path_loss_db(pts)
-            - np.minimum(walls, self.config.max_total_wall_loss_db)
-        )
-        if self._shadowing is not None:
-            rssi += self._shadowing(pts)
-        return rssi
+        return self._model(self._points(points))[0]
 
     def measure(self, point: np.ndarray) -> np.ndarray:
         """One reading at ``point`` (2,): (R,) integer dBm, ``NOT_HEARD_DBM`` below sensitivity."""
@@ -296,15 +317,8 @@ class RadioModel:
 
     def measure_with_k(self, point: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """One reading at ``point`` and the true k of each router there (one wall traversal)."""
-        pts = self._points(point)[:1]
-        k, walls = self._walls(pts)
-        rssi = (
-            self.config.tx_power_dbm
-            - self.path_loss_db(pts)[0]
-            - np.minimum(walls[0], self.config.max_total_wall_loss_db)
-        )
-        if self._shadowing is not None:
-            rssi += self._shadowing(pts)[0]
+        rssi, k = self._model(self._points(point)[:1])
+        rssi = rssi[0]
         if self.config.noise_sigma_db > 0:
             rssi += self.rng.normal(0.0, self.config.noise_sigma_db, rssi.shape)
         reading = np.rint(rssi).astype(np.int32)

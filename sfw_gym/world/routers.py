@@ -37,6 +37,6 @@ def place_routers(floorplan: Floorplan, n: int, rng: np.random.Generator) -> np.
         raise ConfigError(f"floorplan {floorplan.name!r} has no open spot for a router")
     seed = int(rng.integers(2**31))
     with single_threaded_openmp():
-        centres = KMeans(n_clusters=n, n_init=3, random_state=seed).fit(candidates).cluster_centers_
+        centres = KMeans(n_clusters=n, n_init=1, random_state=seed).fit(candidates).cluster_centers_
     nearest = np.argmin(np.linalg.norm(candidates[:, None] - centres[None], axis=2), axis=0)
     return candidates[nearest]

@@ -171,37 +171,3 @@ def cross_walls_parallel(edges, edge_loss, a, b, min_piece_m):
             min(m, (c + 1) * _CHUNK),
         )
     return counts, losses
-
-
-@njit(cache=True)
-def cross_walls_from_sources(edges, edge_loss, sources, points, min_piece_m):
-    """Walls and losses between every source (R, 2) and every point (M, 2): two (M, R) arrays."""
-    counts = np.zeros((points.shape[0], sources.shape[0]), dtype=np.int32)
-    losses = np.zeros((points.shape[0], sources.shape[0]), dtype=np.float64)
-    _sources_range(edges, edge_loss, sources, points, min_piece_m, counts, losses, 0, len(points))
-    return counts, losses
-
-
-@njit(cache=True, parallel=True)
-def cross_walls_from_sources_parallel(edges, edge_loss, sources, points, min_piece_m):
-    """`cross_walls_from_sources` over all cores, for many points (heat maps, benchmarks)."""
-    m = points.shape[0]
-    counts = np.zeros((m, sources.shape[0]), dtype=np.int32)
-    losses = np.zeros((m, sources.shape[0]), dtype=np.float64)
-    n_chunks = (m + _CHUNK - 1) // _CHUNK
-    for c in prange(n_chunks):
-        _sources_range(edges, edge_loss, sources, points, min_piece_m, counts, losses,
-                       c * _CHUNK, min(m, (c + 1) * _CHUNK))  # fmt: skip
-    return counts, losses
-
-
-@njit(cache=True)
-def _sources_range(edges, edge_loss, sources, points, min_piece_m, counts, losses, lo, hi):
-    ts = np.empty(edges.shape[0] + 1, dtype=np.float64)
-    ids = np.empty(edges.shape[0] + 1, dtype=np.int64)
-    for i in range(lo, hi):
-        for r in range(sources.shape[0]):
-            counts[i, r], losses[i, r] = _cross_one(
-                edges, edge_loss, sources[r, 0], sources[r, 1], points[i, 0], points[i, 1],
-                min_piece_m, ts, ids,
-            )
