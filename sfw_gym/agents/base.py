@@ -133,6 +133,7 @@ class Agent(ABC):
         self.rng = np.random.default_rng()
         self.action_type = "continuous"
         self.trajectory: list[tuple[float, float]] = []
+        self.last_command = (0.0, 0.0)
 
     def reset(self, env: Any, seed: int | None = None) -> None:
         """Bind the agent to ``env``'s current episode (call after ``env.reset``).
@@ -153,6 +154,7 @@ class Agent(ABC):
         self.stop_reason = None
         self.steps = 0
         self.trajectory = []
+        self.last_command = (0.0, 0.0)
         self._on_reset(view)
 
     def act(self, obs: Any = None) -> Any:
@@ -167,6 +169,7 @@ class Agent(ABC):
         else:
             linear, angular = self._act(view, obs)
         self.steps += 1
+        self.last_command = (float(linear), float(angular))
         return self._to_action(linear, angular)
 
     def params(self) -> dict[str, Any]:

@@ -129,6 +129,7 @@ class FrontierAgent(Agent):
         goal_depth_m: How far past the frontier cell into the unknown the robot aims.
         visited_margin_m: Frontier cells within radius + this of the robot's path are not goals.
         lookahead_m: Pure-pursuit carrot distance.
+        backoff_steps: Steps of reversing after a bump (continuous actions only).
         max_steps: Optional step limit of the agent (``stop_reason = "max_steps"``).
     """
 
@@ -146,6 +147,7 @@ class FrontierAgent(Agent):
         goal_depth_m: float = 1.0,
         visited_margin_m: float = 0.15,
         lookahead_m: float = 0.5,
+        backoff_steps: int = 1,
         max_steps: int | None = None,
     ) -> None:
         super().__init__(max_steps=max_steps)
@@ -157,10 +159,12 @@ class FrontierAgent(Agent):
         self.goal_depth_m = check_fraction("goal_depth_m", goal_depth_m)
         self.visited_margin_m = check_fraction("visited_margin_m", visited_margin_m)
         self.lookahead_m = check_fraction("lookahead_m", lookahead_m, 0.05)
-        for name, v in (("progress_timeout_steps", progress_timeout_steps),
-                        ("replan_every_steps", replan_every_steps)):  # fmt: skip
-            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-                raise ConfigError(f"{name} must be an int >= 1, got {v!r}")
+        for name, v, lo in (("progress_timeout_steps", progress_timeout_steps, 1),
+                            ("replan_every_steps", replan_every_steps, 1),
+                            ("backoff_steps", backoff_steps, 0)):  # fmt: skip
+            if isinstance(v, bool) or not isinstance(v, int) or v < lo:
+                raise ConfigError(f"{name} must be an int >= {lo}, got {v!r}")
+        self.backoff_steps = backoff_steps
         self.progress_timeout_steps = progress_timeout_steps
         self.replan_every_steps = replan_every_steps
 
@@ -176,16 +180,26 @@ class FrontierAgent(Agent):
         self.visited = np.zeros(view.grid.shape, bool)
         self._visit_radius_cells = (view.radius_m + self.visited_margin_m) / res
         self._since_plan = 0
+        self._backoff = 0
         self.n_blacklisted = 0
         self.n_goals = 0
 
     def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
         self._mark_visited(view)
-        if view.bumped:
-            self._mark_bump(view)
         pose = view.odometry_pose
+        # A bump while driving forward: remember the wall ahead, back off (continuous) and
+        # replan. Contact while turning or reversing says nothing about what lies ahead.
+        bumped_ahead = view.bumped and self.last_command[0] > 0
+        if bumped_ahead:
+            self._mark_bump(view)
+            if self.action_type == "continuous":
+                self._backoff = self.backoff_steps
+        if self._backoff > 0:
+            self._backoff -= 1
+            self.goal = None if self._backoff == 0 else self.goal
+            return -1.0, 0.0
         goal = self.goal
-        replan = goal is None or view.bumped or self._since_plan >= self.replan_every_steps
+        replan = goal is None or bumped_ahead or self._since_plan >= self.replan_every_steps
         if goal is not None and not replan:
             remaining = self.follower.remaining_m(view.xy)
             if not self.follower.has_path:

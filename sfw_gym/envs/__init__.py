@@ -20,7 +20,7 @@ ENV_IDS: dict[str, dict[str, Any]] = {
         "resolution_m": 0.2,
         "map_px": 36,
         "crop_px": 36,
-        "max_episode_steps": 300,
+        "max_steps": 300,
     },
 }
 

@@ -64,8 +64,10 @@ class SfWExploreEnv(gym.Env):
 
     ## Episode End
     Terminated when the ground-truth coverage (fraction of free cells the map has classified)
-    reaches ``coverage_target`` (0.95). Truncated after ``max_episode_steps`` (3,000 by default:
-    300 m of driving at full speed, room for a typical 100 m² plan; see BENCHMARKS.md).
+    reaches ``coverage_target`` (0.95). Truncated by the env itself after ``max_steps`` (3,000 by default:
+    300 m of driving at full speed, room for a typical 100 m² plan; see BENCHMARKS.md), so that
+    the final ``info["summary"]`` (episode metrics, steps to 50/90 % coverage) is always there.
+    ``gym.make(..., max_episode_steps=N)`` still works but truncates from outside, without it.
 
     ## Arguments
     ``gym.make("SfW-Explore-v0", **kwargs)`` with, all JSON-serialisable:
@@ -76,7 +78,7 @@ class SfWExploreEnv(gym.Env):
     ("2.4" | "5"), ``radio`` / ``robot`` / ``mapper`` (dicts of RadioConfig / RobotConfig /
     MapperConfig overrides), ``resolution_m`` (0.1), ``map_px`` (64), ``crop_px`` (48),
     ``coverage_target`` (0.95), ``collision_penalty`` (0.1), ``reward_scale`` (0.01),
-    ``max_episode_steps`` (3000), ``render_mode`` (None | "rgb_array" | "human").
+    ``max_steps`` (3000), ``render_mode`` (None | "rgb_array" | "human").
     ``reset(options=…)``: ``floorplan`` (a Floorplan, a path or a generator seed), ``routers``
     (positions (R, 2) or a count ≤ n_routers), ``start_pose`` ((x, y, θ)).
 
@@ -103,7 +105,7 @@ class SfWExploreEnv(gym.Env):
         coverage_target: float = 0.95,
         collision_penalty: float = 0.1,
         reward_scale: float = 0.01,
-        max_episode_steps: int = 3000,
+        max_steps: int = 3000,
         render_mode: str | None = None,
     ) -> None:
         if action_type not in ACTION_TYPES:
@@ -116,7 +118,7 @@ class SfWExploreEnv(gym.Env):
         _check_int("n_routers", n_routers, 1, 16)
         _check_int("map_px", map_px, 36, 512)
         _check_int("crop_px", crop_px, 36, 512)
-        _check_int("max_episode_steps", max_episode_steps, 1, 10**7)
+        _check_int("max_steps", max_steps, 1, 10**7)
         _check_number("resolution_m", resolution_m, 0.02, 1.0)
         _check_number("coverage_target", coverage_target, 0.0, 1.0)
         _check_number("collision_penalty", collision_penalty, 0.0, 1e6)
@@ -137,7 +139,7 @@ class SfWExploreEnv(gym.Env):
         self.coverage_target = float(coverage_target)
         self.collision_penalty = float(collision_penalty)
         self.reward_scale = float(reward_scale)
-        self.max_episode_steps = max_episode_steps
+        self.max_steps = max_steps
         self.render_mode = render_mode
         self._folder_plans = _folder_plans(floorplan)
 
@@ -211,7 +213,7 @@ class SfWExploreEnv(gym.Env):
             if self.steps_to[level] < 0 and coverage >= level:
                 self.steps_to[level] = self.steps
         terminated = coverage >= self.coverage_target
-        truncated = not terminated and self.steps >= self.max_episode_steps
+        truncated = not terminated and self.steps >= self.max_steps
         info = self._info(terminal=terminated or truncated)
         if self.render_mode == "human":
             self.render()
@@ -361,7 +363,7 @@ class SfWExploreEnv(gym.Env):
             "robot": asdict(self.robot_config),
             "mapper": self.mapper_config.to_dict(),
             "resolution_m": self.resolution_m,
-            "max_episode_steps": self.max_episode_steps,
+            "max_steps": self.max_steps,
         }
 
 
