@@ -130,6 +130,9 @@ class FrontierAgent(Agent):
         visited_margin_m: Frontier cells within radius + this of the robot's path are not goals.
         lookahead_m: Pure-pursuit carrot distance.
         backoff_steps: Steps of reversing after a bump (continuous actions only).
+        bump_exclusion_m: Frontier cells this close to a bump are not goals (walls).
+        min_unknown_depth_m: A frontier must open onto unknown space at least this deep
+            (thinner strips between known regions are unresolved walls).
         max_steps: Optional step limit of the agent (``stop_reason = "max_steps"``).
     """
 
@@ -148,6 +151,8 @@ class FrontierAgent(Agent):
         visited_margin_m: float = 0.15,
         lookahead_m: float = 0.5,
         backoff_steps: int = 1,
+        bump_exclusion_m: float = 0.4,
+        min_unknown_depth_m: float = 0.3,
         max_steps: int | None = None,
     ) -> None:
         super().__init__(max_steps=max_steps)
@@ -165,6 +170,8 @@ class FrontierAgent(Agent):
             if isinstance(v, bool) or not isinstance(v, int) or v < lo:
                 raise ConfigError(f"{name} must be an int >= {lo}, got {v!r}")
         self.backoff_steps = backoff_steps
+        self.bump_exclusion_m = check_fraction("bump_exclusion_m", bump_exclusion_m)
+        self.min_unknown_depth_m = check_fraction("min_unknown_depth_m", min_unknown_depth_m)
         self.progress_timeout_steps = progress_timeout_steps
         self.replan_every_steps = replan_every_steps
 
@@ -289,7 +296,7 @@ class FrontierAgent(Agent):
         frontiers = find_frontiers(
             view.belief_u8,
             max(1, int(round(self.min_frontier_size_m / res))),
-            exclude=self.visited | self.bumps,
+            exclude=self._frontier_exclusion(view),
         )
         if not frontiers:
             self._stop("no_frontiers")
@@ -316,6 +323,23 @@ class FrontierAgent(Agent):
             return None
         f, i = best
         return Goal(self._deepen(view, field, tuple(f.cells[i]), f), "frontier")
+
+    def _frontier_exclusion(self, view: RobotView) -> np.ndarray:
+        """Cells that are not frontier goals: near the path, near bumps, or thin unknown strips.
+
+        Unknown space only one or two cells deep between known regions is a wall the map has
+        not resolved, not a way into unexplored space.
+        """
+        res = view.grid.resolution_m
+        _, _, unknown = belief_classes(view.belief_u8)
+        exclude = self.visited | ndimage.binary_dilation(
+            self.bumps, iterations=max(1, int(round(self.bump_exclusion_m / res)))
+        )
+        if self.min_unknown_depth_m > 0:
+            depth = ndimage.distance_transform_edt(unknown) * res
+            window = 2 * int(round(self.min_unknown_depth_m / res)) + 3
+            exclude |= ndimage.maximum_filter(depth, size=window) < self.min_unknown_depth_m
+        return exclude
 
     def _utility(self, view: RobotView, f: Frontier, path_m: float) -> float:
         size_m = f.size * view.grid.resolution_m
