@@ -30,7 +30,7 @@ def free_points(plan, n: int, rng: np.random.Generator) -> np.ndarray:
 
 
 def shapely_pieces(plan, a, b, min_piece_m: float = 0.02) -> int:
-    """Independent count: pieces of the segment outside the free space (≥ 2 cm, 2 cm gaps merged)."""
+    """Shapely count: pieces of the segment outside free space (≥ 2 cm, 2 cm gaps merged)."""
     seg = LineString([a, b])
     out = seg.difference(plan.free_space)
     spans = sorted(
@@ -66,15 +66,18 @@ def main() -> None:
         ref = np.array([shapely_pieces(plan, a[i], b[i]) for i in range(1000)])
         agree += int((ref == k[:1000]).sum())
         total += 1000
-    print(f"count_walls (all cores): median {statistics.median(rates) / 1e6:.2f} M segments/s "
-          f"(min {min(rates) / 1e6:.2f}, max {max(rates) / 1e6:.2f}) over {len(plans)} plans")
+    print(
+        f"count_walls (all cores): median {statistics.median(rates) / 1e6:.2f} M segments/s "
+        f"(min {min(rates) / 1e6:.2f}, max {max(rates) / 1e6:.2f}) over {len(plans)} plans"
+    )
     print(f"count_walls vs shapely: {agree}/{total} = {100 * agree / total:.2f} % agree")
     plan = plans[0]
     a, b = free_points(plan, 2, rng)[None, 0], free_points(plan, 2, rng)[None, 1]
     start = time.perf_counter()
     for _ in range(20_000):
         plan.count_walls(a, b)
-    print(f"count_walls single segment (step path): {(time.perf_counter() - start) / 20_000 * 1e6:.1f} µs/call")
+    per_call_us = (time.perf_counter() - start) / 20_000 * 1e6
+    print(f"count_walls single segment (step path): {per_call_us:.1f} µs/call")
 
     # generate_floorplan
     generate_floorplan(0)
@@ -84,9 +87,11 @@ def main() -> None:
         g = generate_floorplan(seed)
         times.append((time.perf_counter() - start) * 1e3)
         areas.append(g.area_m2)
-    print(f"generate_floorplan: median {statistics.median(times):.1f} ms, "
-          f"p95 {np.percentile(times, 95):.1f} ms over {args.seeds} seeds; "
-          f"area {min(areas):.0f}–{max(areas):.0f} m²")
+    print(
+        f"generate_floorplan: median {statistics.median(times):.1f} ms, "
+        f"p95 {np.percentile(times, 95):.1f} ms over {args.seeds} seeds; "
+        f"area {min(areas):.0f}–{max(areas):.0f} m²"
+    )
 
     # mean_rssi: 1e5 points x 4 routers
     plan = max(plans, key=lambda p: p.area_m2)
@@ -96,12 +101,16 @@ def main() -> None:
     start = time.perf_counter()
     radio.mean_rssi(pts)
     took = time.perf_counter() - start
-    print(f"mean_rssi: 1e5 points × 4 routers in {took * 1e3:.0f} ms = {1e5 / took / 1e3:.0f} k points/s "
-          f"({plan.name}, {plan.area_m2:.0f} m², {len(plan.edges)} wall faces)")
+    print(
+        f"mean_rssi: 1e5 points × 4 routers in {took * 1e3:.0f} ms = "
+        f"{1e5 / took / 1e3:.0f} k points/s "
+        f"({plan.name}, {plan.area_m2:.0f} m², {len(plan.edges)} wall faces)"
+    )
     start = time.perf_counter()
     for _ in range(5000):
         radio.measure(pts[0])
-    print(f"measure (one reading, 4 routers): {(time.perf_counter() - start) / 5000 * 1e6:.1f} µs/call")
+    per_call_us = (time.perf_counter() - start) / 5000 * 1e6
+    print(f"measure (one reading, 4 routers): {per_call_us:.1f} µs/call")
 
 
 if __name__ == "__main__":

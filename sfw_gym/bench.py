@@ -1,4 +1,4 @@
-"""``sfw-gym bench``: env steps/s and reset time, beside CartPole-v1 (and MiniGrid) in the same run."""
+"""``sfw-gym bench``: env steps/s and reset time beside CartPole-v1 (and MiniGrid), same run."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Shared fixtures: hand-made plans whose answers can be computed by hand, and the HouseExpo files."""
+"""Shared fixtures: hand-made plans with answers computable by hand, and the HouseExpo files."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""One suite over every registered env id: API conformance, determinism, pickling, vectors, rendering."""
+"""One suite over every registered env id: API, determinism, pickling, vectors, rendering."""
 
 from __future__ import annotations
 
@@ -121,7 +121,7 @@ def test_gymnasium_async_vector_env():
     obs, info = envs.reset(seed=[1, 2])
     assert obs["map"].shape[0] == 2
     for _ in range(5):
-        obs, rewards, terminated, truncated, info = envs.step(envs.action_space.sample())
+        obs, rewards, _terminated, _truncated, info = envs.step(envs.action_space.sample())
     assert rewards.shape == (2,) and "coverage" in info
     envs.close()
 
@@ -133,7 +133,7 @@ def test_sb3_subproc_vec_env():
     venv = make_vec_env("SfW-ExploreSmall-v0", n_envs=2, seed=0, vec_env_cls=SubprocVecEnv)
     venv.reset()
     for _ in range(5):
-        obs, rewards, dones, infos = venv.step(np.array([venv.action_space.sample()] * 2))
+        obs, _rewards, _dones, infos = venv.step(np.array([venv.action_space.sample()] * 2))
     assert obs["state"].shape[0] == 2 and len(infos) == 2
     venv.close()
 
@@ -182,11 +182,11 @@ class TestBadInput:
                 env.unwrapped.step(action)
 
     def test_unknown_reset_option(self, env):
-        with pytest.raises(ConfigError, match="unknown reset option.*'colour'"):
+        with pytest.raises(ConfigError, match=r"unknown reset option.*'colour'"):
             env.reset(options={"colour": "red"})
 
     def test_router_in_a_wall(self, env):
-        with pytest.raises(ConfigError, match="router 0 .* (inside a wall|outside the building)"):
+        with pytest.raises(ConfigError, match=r"router 0 .* (inside a wall|outside the building)"):
             env.reset(options={"routers": [[-50.0, -50.0]]})
 
     def test_too_many_routers(self, env):

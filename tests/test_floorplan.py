@@ -180,12 +180,12 @@ BAD_INPUTS = {
 def test_bad_files_raise_floorplan_error_naming_the_file(tmp_path, problem):
     path = tmp_path / "bad.json"
     path.write_text(BAD_INPUTS[problem])
-    with pytest.raises(FloorplanError, match="bad.json"):
+    with pytest.raises(FloorplanError, match=r"bad\.json"):
         load_floorplan(path)
 
 
 def test_missing_file_raises_floorplan_error(tmp_path):
-    with pytest.raises(FloorplanError, match="nope.json"):
+    with pytest.raises(FloorplanError, match=r"nope\.json"):
         load_floorplan(tmp_path / "nope.json")
 
 

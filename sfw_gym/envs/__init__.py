@@ -29,8 +29,13 @@ def register_envs() -> None:
     """Register every id in ENV_IDS (idempotent)."""
     for env_id, kwargs in ENV_IDS.items():
         if env_id not in gym.registry:
-            gym.register(id=env_id, entry_point=ENTRY_POINT, kwargs=dict(kwargs),
-                         max_episode_steps=None, disable_env_checker=False)
+            gym.register(
+                id=env_id,
+                entry_point=ENTRY_POINT,
+                kwargs=dict(kwargs),
+                max_episode_steps=None,
+                disable_env_checker=False,
+            )
 
 
 def __getattr__(name: str) -> Any:

@@ -1,4 +1,4 @@
-"""One episode's world: the floorplan, its routers and radio, the robot and the ground-truth grid."""
+"""One episode's world: floorplan, routers and radio, robot, and the ground-truth grid."""
 
 from __future__ import annotations
 
@@ -93,9 +93,13 @@ def _start_pose(
     if start_pose is not None:
         pose = np.asarray(start_pose, dtype=np.float64)
         if pose.shape != (3,) or not np.isfinite(pose).all():
-            raise ConfigError(f"start_pose must be three finite numbers (x, y, θ), got {start_pose!r}")
+            raise ConfigError(
+                f"start_pose must be three finite numbers (x, y, θ), got {start_pose!r}"
+            )
         if not plan.is_free(pose[:2]):
-            raise ConfigError(f"start_pose {pose[:2].tolist()} is not in the free space of {plan.name!r}")
+            raise ConfigError(
+                f"start_pose {pose[:2].tolist()} is not in the free space of {plan.name!r}"
+            )
         return float(pose[0]), float(pose[1]), float(pose[2])
     clearance = ndimage.distance_transform_edt(truth == 255) * resolution_m
     rows, cols = np.nonzero(clearance >= radius_m + START_CLEARANCE_MARGIN_M + resolution_m)

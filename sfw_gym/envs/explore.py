@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import gymnasium as gym
 import numpy as np
@@ -16,7 +16,7 @@ from sfw_gym.envs.map_tracker import MapTracker
 from sfw_gym.envs.observation import ObservationBuilder, observation_space
 from sfw_gym.errors import ConfigError
 from sfw_gym.mapping import GridSpec, MapperConfig, SparseInverseKVisibility
-from sfw_gym.world import NOT_HEARD_DBM, Floorplan, RadioConfig, Robot, RobotConfig
+from sfw_gym.world import NOT_HEARD_DBM, Floorplan, RadioConfig, RobotConfig
 
 ACTION_TYPES = ("continuous", "discrete")
 #: Discrete actions: (linear, angular) as fractions of the robot's limits.
@@ -30,9 +30,9 @@ class SfWExploreEnv(gym.Env):
 
     ## Description
     A differential-drive disc robot (pymunk) drives through an indoor floorplan. It has no camera
-    and no LiDAR: each step it hears the RSSI of the WiFi routers (log-distance path loss, a loss per
-    wall crossed, correlated shadowing, noise) and feels whether it bumped into a wall. From these
-    and its odometry, a sparse inverse k-visibility mapper (Kim et al., arXiv:2408.07757) estimates
+    and no LiDAR: each step it hears the RSSI of the WiFi routers (log-distance path loss, a loss
+    per wall crossed, correlated shadowing, noise) and feels whether it bumped into a wall. From
+    these and its odometry, a sparse inverse k-visibility mapper (Kim et al., arXiv:2408.07757) estimates
     how many walls separate it from each router and updates an occupancy belief map along the
     router–robot rays. The task: make that map complete and right, fast.
 
@@ -64,9 +64,9 @@ class SfWExploreEnv(gym.Env):
 
     ## Episode End
     Terminated when the ground-truth coverage (fraction of free cells the map has classified)
-    reaches ``coverage_target`` (0.95). Truncated by the env itself after ``max_steps`` (3,000 by default:
-    300 m of driving at full speed, room for a typical 100 m² plan; see BENCHMARKS.md), so that
-    the final ``info["summary"]`` (episode metrics, steps to 50/90 % coverage) is always there.
+    reaches ``coverage_target`` (0.95). Truncated by the env itself after ``max_steps`` (3,000 by
+    default: 300 m of driving at full speed, room for a typical 100 m² plan; see BENCHMARKS.md), so
+    that the final ``info["summary"]`` (episode metrics, steps to 50/90 % coverage) is always there.
     ``gym.make(..., max_episode_steps=N)`` still works but truncates from outside, without it.
 
     ## Arguments
@@ -86,7 +86,7 @@ class SfWExploreEnv(gym.Env):
     - v0: initial release.
     """
 
-    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 10}
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": ["rgb_array", "human"], "render_fps": 10}
 
     def __init__(
         self,
@@ -155,7 +155,7 @@ class SfWExploreEnv(gym.Env):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
-        """Start an episode: a floorplan, routers, a start pose, an empty map (see the class doc)."""
+        """Start an episode: floorplan, routers, start pose, an empty map (see the class doc)."""
         super().reset(seed=seed)
         options = dict(options or {})
         unknown = sorted(set(options) - set(RESET_OPTIONS))
@@ -195,9 +195,7 @@ class SfWExploreEnv(gym.Env):
         obs = self._sense_and_map(bumped=False)
         return obs, self._info(terminal=False)
 
-    def step(
-        self, action: Any
-    ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+    def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         """Drive for one control period, hear the routers, update the map, reward the gain."""
         if self.scene is None:
             raise gym.error.ResetNeeded("call reset() before step()")

@@ -96,7 +96,9 @@ class MapTracker:
     def __init__(self, truth_u8: np.ndarray, tolerance_cells: float = 2) -> None:
         self.truth_u8 = truth_u8
         wall, free = classify_u8(truth_u8)
-        self._truth_cls = np.where(wall, WALL, np.where(free, FREE, UNKNOWN)).astype(np.int8).ravel()
+        self._truth_cls = (
+            np.where(wall, WALL, np.where(free, FREE, UNKNOWN)).astype(np.int8).ravel()
+        )
         dist = ndimage.distance_transform_edt(~wall) if wall.any() else np.full(wall.shape, np.inf)
         self._near_wall = (dist <= tolerance_cells).ravel()
         self._interior = metrics.interior_wall_cells(truth_u8).ravel()

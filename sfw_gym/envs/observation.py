@@ -75,8 +75,8 @@ class ObservationBuilder:
         """Map-image pixel (row, col) of a world point, clamped to the image."""
         ox, oy = self.grid.origin_xy
         res = self.grid.resolution_m
-        r = int(math.floor((y - oy) / res / self.cells_per_px + self._pad_r))
-        c = int(math.floor((x - ox) / res / self.cells_per_px + self._pad_c))
+        r = math.floor((y - oy) / res / self.cells_per_px + self._pad_r)
+        c = math.floor((x - ox) / res / self.cells_per_px + self._pad_c)
         return min(max(r, 0), self.map_px - 1), min(max(c, 0), self.map_px - 1)
 
     def mark_visited(self, x: float, y: float) -> None:
@@ -130,4 +130,3 @@ class ObservationBuilder:
     def _extent(self) -> tuple[float, float]:
         rows, cols = self.grid.shape
         return cols * self.grid.resolution_m, rows * self.grid.resolution_m
-

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -12,7 +13,13 @@ if TYPE_CHECKING:
 
 TARGET_HEIGHT_PX = 360
 GREY = {0: (30, 30, 30), 127: (150, 150, 150), 255: (255, 255, 255)}
-ROUTER, ROBOT, PATH, ODOM, RAY = (220, 40, 40), (30, 160, 60), (60, 90, 220), (240, 150, 30), (250, 210, 0)
+ROUTER, ROBOT, PATH, ODOM, RAY = (
+    (220, 40, 40),
+    (30, 160, 60),
+    (60, 90, 220),
+    (240, 150, 30),
+    (250, 210, 0),
+)
 
 
 def draw_frame(env: SfWExploreEnv) -> np.ndarray:
@@ -20,7 +27,7 @@ def draw_frame(env: SfWExploreEnv) -> np.ndarray:
     s = env.scene
     assert s is not None
     truth = s.truth_u8
-    scale = max(1, int(round(TARGET_HEIGHT_PX / truth.shape[0])))
+    scale = max(1, round(TARGET_HEIGHT_PX / truth.shape[0]))
     left = _grey_rgb(truth)
     right = _grey_rgb(env.mapper.occupancy_u8)
     grid = env.grid
@@ -31,14 +38,17 @@ def draw_frame(env: SfWExploreEnv) -> np.ndarray:
 
     left = np.kron(left, np.ones((scale, scale, 1), np.uint8))
     right = np.kron(right, np.ones((scale, scale, 1), np.uint8))
-    h, w = left.shape[:2]
+    h, _w = left.shape[:2]
     robot_rc = px(np.array(s.robot.pose[:2]))[0]
     odom_rc = px(np.array(s.robot.odometry_pose[:2]))[0]
     for rc in px(s.radio.routers):  # rays from every router to the robot, then the routers
         _line(left, rc, robot_rc, RAY)
-    for panel, path, colour in ((left, env.trajectory, PATH), (right, env.odometry_trajectory, ODOM)):
+    for panel, path, colour in (
+        (left, env.trajectory, PATH),
+        (right, env.odometry_trajectory, ODOM),
+    ):
         pts = px(np.array(path))
-        for a, b in zip(pts[:-1], pts[1:], strict=False):
+        for a, b in itertools.pairwise(pts):
             _line(panel, a, b, colour)
     for panel in (left, right):
         for rc in px(s.radio.routers):

@@ -82,7 +82,8 @@ class Floorplan:
         unknown = sorted(set(self.edge_materials) - set(MATERIALS))
         if unknown:
             raise FloorplanError(
-                f"floorplan {self.name!r}: unknown wall material(s) {unknown}; known: {list(MATERIALS)}"
+                f"floorplan {self.name!r}: unknown wall material(s) {unknown}; "
+                f"known: {list(MATERIALS)}"
             )
         index = np.array([MATERIALS.index(m) for m in self.edge_materials], dtype=np.int64)
         edges.setflags(write=False)
@@ -357,8 +358,8 @@ def _check_polygon(poly: Any, what: str, name: str) -> None:
     extent = max(xmax - xmin, ymax - ymin)
     if not MIN_EXTENT_M <= extent <= MAX_EXTENT_M or max(map(abs, poly.bounds)) > 10 * MAX_EXTENT_M:
         raise FloorplanError(
-            f"floorplan {name!r}: {what} spans {extent:.3g} m at {poly.bounds}; expected a building "
-            f"of {MIN_EXTENT_M:g}–{MAX_EXTENT_M:g} m in metres (wrong units?)"
+            f"floorplan {name!r}: {what} spans {extent:.3g} m at {poly.bounds}; expected a "
+            f"building of {MIN_EXTENT_M:g}–{MAX_EXTENT_M:g} m in metres (wrong units?)"
         )
     if poly.area < MIN_AREA_M2:
         raise FloorplanError(

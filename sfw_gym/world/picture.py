@@ -1,4 +1,4 @@
-"""The world at a glance: plan, routers, RSSI heat map and true k-regions per router (paper Fig. 1)."""
+"""The world at a glance: plan, routers, RSSI and true k-regions per router (paper Fig. 1)."""
 
 from __future__ import annotations
 

@@ -148,8 +148,8 @@ class ShadowingField:
     """Spatially correlated Gaussian shadowing, one independent field per router, fixed once drawn.
 
     Exponential covariance σ²·exp(−r/L) (Gudmundson), drawn by random Fourier features (the
-    spectral density of the 2-D exponential kernel is a bivariate Student-t with 1 degree of freedom,
-    scaled by 1/L) and tabulated on a grid that is interpolated bilinearly.
+    spectral density of the 2-D exponential kernel is a bivariate Student-t with 1 degree of
+    freedom, scaled by 1/L) and tabulated on a grid that is interpolated bilinearly.
     """
 
     def __init__(
@@ -207,7 +207,7 @@ def _bilinear(
 
 
 @njit(cache=True)
-def _rssi_range(edges, edge_loss, routers, pts, params, tables, origin, spacing, rssi, k, lo, hi):  # noqa: PLR0913
+def _rssi_range(edges, edge_loss, routers, pts, params, tables, origin, spacing, rssi, k, lo, hi):
     """Mean RSSI and wall counts for points lo..hi: the whole model in one compiled loop."""
     tx, pl0, ten_n, d0, cap, min_piece = params
     ts = np.empty(edges.shape[0] + 1)
@@ -216,7 +216,15 @@ def _rssi_range(edges, edge_loss, routers, pts, params, tables, origin, spacing,
     for m in range(lo, hi):
         for r in range(routers.shape[0]):
             c, loss = _cross_one(
-                edges, edge_loss, routers[r, 0], routers[r, 1], pts[m, 0], pts[m, 1], min_piece, ts, ids
+                edges,
+                edge_loss,
+                routers[r, 0],
+                routers[r, 1],
+                pts[m, 0],
+                pts[m, 1],
+                min_piece,
+                ts,
+                ids,
             )
             d = max(np.hypot(pts[m, 0] - routers[r, 0], pts[m, 1] - routers[r, 1]), d0)
             k[m, r] = c
@@ -224,15 +232,17 @@ def _rssi_range(edges, edge_loss, routers, pts, params, tables, origin, spacing,
 
 
 @njit(cache=True)
-def _rssi(edges, edge_loss, routers, pts, params, tables, origin, spacing):  # noqa: PLR0913
+def _rssi(edges, edge_loss, routers, pts, params, tables, origin, spacing):
     rssi = np.empty((pts.shape[0], routers.shape[0]))
     k = np.empty((pts.shape[0], routers.shape[0]), np.int32)
-    _rssi_range(edges, edge_loss, routers, pts, params, tables, origin, spacing, rssi, k, 0, len(pts))
+    _rssi_range(
+        edges, edge_loss, routers, pts, params, tables, origin, spacing, rssi, k, 0, len(pts)
+    )
     return rssi, k
 
 
 @njit(cache=True, parallel=True)
-def _rssi_parallel(edges, edge_loss, routers, pts, params, tables, origin, spacing):  # noqa: PLR0913
+def _rssi_parallel(edges, edge_loss, routers, pts, params, tables, origin, spacing):
     m = pts.shape[0]
     rssi = np.empty((m, routers.shape[0]))
     k = np.empty((m, routers.shape[0]), np.int32)

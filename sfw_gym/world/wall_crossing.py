@@ -7,8 +7,8 @@ tests, so vertices and collinear edges are handled as if the line were shifted i
 special cases, and parity stays consistent.
 
 Two tolerances make the count physical rather than combinatorial:
-- outside pieces shorter than ``min_piece_m`` are ignored (clipping a 1 cm bevel, grazing a staircase
-  tooth, touching a wall's end);
+- outside pieces shorter than ``min_piece_m`` are ignored (clipping a 1 cm bevel, grazing a
+  staircase tooth, touching a wall's end);
 - outside pieces separated by an inside gap shorter than ``min_piece_m`` are one wall (a staircase
   tooth inside a diagonal wall).
 The boundary itself is free space: a segment running along a wall face crosses nothing.
@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-#: Outside pieces (and inside gaps) shorter than this are not walls (bevels are 1 cm, walls ≥ 10 cm).
+#: Outside pieces (and inside gaps) shorter than this are no walls (bevels 1 cm, walls ≥ 10 cm).
 DEFAULT_MIN_PIECE_M = 0.02
 _CHUNK = 512  # segments per parallel work item
 
