@@ -32,9 +32,9 @@ class SfWExploreEnv(gym.Env):
     A differential-drive disc robot (pymunk) drives through an indoor floorplan. It has no camera
     and no LiDAR: each step it hears the RSSI of the WiFi routers (log-distance path loss, a loss
     per wall crossed, correlated shadowing, noise) and feels whether it bumped into a wall. From
-    these and its odometry, a sparse inverse k-visibility mapper (Kim et al., arXiv:2408.07757) estimates
-    how many walls separate it from each router and updates an occupancy belief map along the
-    router–robot rays. The task: make that map complete and right, fast.
+    these and its odometry, a sparse inverse k-visibility mapper (Kim et al., arXiv:2408.07757)
+    estimates how many walls separate it from each router and updates an occupancy belief map
+    along the router–robot rays. The task: make that map complete and right, fast.
 
     ## Action Space
     ``action_type="continuous"``: ``Box(-1, 1, (2,), float32)`` = (linear, angular) velocity as
