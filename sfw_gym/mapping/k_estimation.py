@@ -37,6 +37,7 @@ model fails) are classified but neither fitted nor counted by the refit schedule
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 from numba import njit
@@ -215,6 +216,7 @@ def fit_levels(data: np.ndarray, max_k: int, min_gap_db: float, min_fraction: fl
     """
     global _THREADPOOLS
     from sklearn.cluster import KMeans  # imported here: ~0.5 s that only fitting needs
+    from sklearn.exceptions import ConvergenceWarning
     from threadpoolctl import ThreadpoolController
 
     x = np.asarray(data, dtype=np.float64)
@@ -229,7 +231,9 @@ def fit_levels(data: np.ndarray, max_k: int, min_gap_db: float, min_fraction: fl
     if _THREADPOOLS is None:
         _THREADPOOLS = ThreadpoolController()
     # One thread: the fit is tiny, and OpenMP spin-waits on a shared machine cost milliseconds.
-    with _THREADPOOLS.limit(limits=1, user_api="openmp"):
+    with _THREADPOOLS.limit(limits=1, user_api="openmp"), warnings.catch_warnings():
+        # Fewer distinct clusters than asked (repeated values) is fine: empty ones are dropped.
+        warnings.simplefilter("ignore", ConvergenceWarning)
         labels = km.fit_predict(x[:, None])
     counts = np.bincount(labels, minlength=n_clusters)
     keep = counts > 0
