@@ -1,23 +1,32 @@
 """Frontier exploration (Yamauchi 1997) in explore_lite's form, adapted to an RSSI-built map.
 
 A frontier is an unknown cell next to a believed-free cell of the thresholded belief; frontier
-cells are grouped into 8-connected clusters (:func:`scipy.ndimage.label`). Each cluster reachable
-on the belief map gets the utility ``gain_scale · size_m − potential_scale · path_m`` (explore_lite),
-where ``path_m`` is the cost-weighted path distance from the robot to the cluster's nearest cell;
-the best cluster's nearest cell is the goal.
+cells are grouped into 8-connected clusters (:func:`scipy.ndimage.label`). Each reachable cluster
+gets explore_lite's utility ``gain_scale · size_m − potential_scale · path_m``, where ``path_m`` is
+the cost-weighted path distance (unknown cells cost more than free ones; believed walls, inflated
+by the robot's radius, are obstacles) from the robot to the cheapest place from which it can
+resolve one of the cluster's cells.
 
-What differs from a LiDAR map. The map fills where the rays router→robot sweep, not around the
-robot, so (1) unknown space is everywhere, also behind the robot, and the frontier is long and
-fragmented; (2) the robot's own footprint leaves a thin unknown fringe along its path that no ray
-may ever fill (the cells just beyond its radius, and walls it has touched): frontier cells within
-``visited_margin_m`` of the robot's own path are not goals (standing there did not resolve them,
-so they are walls or beyond reach); (3) reaching a frontier resolves little by itself, so a goal
-is pushed ``goal_depth_m`` into the unknown behind it, which lays new trajectory anchors for the
-mapper's rays to join. A goal that makes no progress for ``progress_timeout_steps`` steps, or that
-the planner cannot reach, is blacklisted; a bump replans. When no frontier is left (or all are
-blacklisted) the agent records why in ``stop_reason`` and keeps sweeping: it drives to the
-reachable cell farthest from its path so far, so that an episode never stalls while unknown space
-is left.
+What differs from a LiDAR map, and how the agent deals with it. The mapper updates cells along
+the ray from the strongest router to the robot, between trajectory points with equal k, and marks
+the robot's footprint free; it has no range sensor. So:
+
+- unknown space is everywhere, also behind the robot, and the frontier is long and fragmented;
+- the cells beside walls are never on a ray piece between two trajectory points in the same
+  room, so only the footprint resolves them: the robot must *come within its radius* of a
+  frontier cell, not merely see it. A goal is therefore the reachable cell nearest (by path)
+  whose footprint covers a frontier cell, and exploration crawls along walls the way a
+  wall-follower would, while the rays fill the rooms' interiors;
+- there is no range sensor to find walls: unknown space is traversable (at a cost) and walls are
+  found by bumping; a bump while driving forward marks the contact region as an obstacle, backs
+  off one step and replans;
+- frontier cells that the robot's path passed within ``radius + visited_margin_m`` of, or that lie
+  near a bump, stayed unknown although the robot was there: they are walls, not goals.
+
+A goal that makes no progress for ``progress_timeout_steps`` steps is blacklisted; a cluster the
+planner cannot reach is blacklisted at once. When no frontier is left, or every one is
+blacklisted, the agent records why in ``stop_reason`` and keeps sweeping (it drives to the
+reachable cell farthest from its path so far): an episode never stalls while it has time left.
 """
 
 from __future__ import annotations
@@ -103,15 +112,43 @@ def find_frontiers(
     return out
 
 
+def disk_offsets(radius_cells: float) -> np.ndarray:
+    """``(K, 2)`` integer offsets ``(dr, dc)`` with ``dr² + dc² ≤ radius_cells²``."""
+    k = int(np.floor(radius_cells))
+    dr, dc = np.mgrid[-k : k + 1, -k : k + 1]
+    keep = dr**2 + dc**2 <= radius_cells**2 + 1e-9
+    return np.stack([dr[keep], dc[keep]], axis=1)
+
+
+def mark_disk(mask: np.ndarray, cell: tuple[int, int], radius_cells: float) -> None:
+    """Set the cells of ``mask`` within ``radius_cells`` of ``cell`` (in place, clipped)."""
+    r, c = int(cell[0]), int(cell[1])
+    k = int(np.ceil(radius_cells))
+    h, w = mask.shape
+    r0, r1, c0, c1 = max(r - k, 0), min(r + k + 1, h), max(c - k, 0), min(c + k + 1, w)
+    if r0 >= r1 or c0 >= c1:
+        return
+    rr, cc = np.ogrid[r0:r1, c0:c1]
+    mask[r0:r1, c0:c1] |= (rr - r) ** 2 + (cc - c) ** 2 <= radius_cells * radius_cells
+
+
 @dataclass
 class Goal:
-    """The goal being pursued: its cell, what it is for, and its progress bookkeeping."""
+    """The goal being pursued.
+
+    Attributes:
+        cell: Where the robot drives, ``(row, col)``.
+        target: The cell it means to resolve (a frontier cell), or the goal cell itself.
+        kind: ``"frontier"``, ``"sweep"`` or a subclass's own kind.
+        final_xy: Optional world point to drive to in a straight line after ``cell``.
+    """
 
     cell: tuple[int, int]
-    kind: str  # "frontier" | "sweep" | a subclass's own kind
+    target: tuple[int, int]
+    kind: str
+    final_xy: np.ndarray | None = None
     best_remaining_m: float = np.inf
     steps_without_progress: int = 0
-    final_xy: np.ndarray | None = None  # where to drive after reaching the cell (a straight pass)
 
 
 class FrontierAgent(Agent):
@@ -123,17 +160,14 @@ class FrontierAgent(Agent):
         min_frontier_size_m: Clusters shorter than this (cells × resolution) are ignored.
         progress_timeout_steps: Steps without getting 5 cm closer to a goal before it is
             blacklisted.
-        blacklist_radius_m: A cluster whose goal lies this close to a blacklisted goal is skipped.
-        replan_every_steps: Re-pick the goal this often, as the map changes under the robot.
+        blacklist_radius_m: Frontier cells this close to a blacklisted goal are skipped.
+        replan_every_steps: Re-pick the goal at least this often, as the map changes.
         unknown_cost: Planner cost of an unknown cell (a free one costs 1).
-        goal_depth_m: How far past the frontier cell into the unknown the robot aims.
         visited_margin_m: Frontier cells within radius + this of the robot's path are not goals.
+        bump_exclusion_m: Frontier cells this close to a bump are not goals (walls).
         lookahead_m: Pure-pursuit carrot distance.
         backoff_steps: Steps of reversing after a bump (continuous actions only).
-        bump_exclusion_m: Frontier cells this close to a bump are not goals (walls).
-        min_unknown_depth_m: A frontier must open onto unknown space at least this deep
-            (thinner strips between known regions are unresolved walls).
-        max_steps: Optional step limit of the agent (``stop_reason = "max_steps"``).
+        max_steps: Optional step limit of the agent (then ``stop_reason = "max_steps"``).
     """
 
     name = "frontier"
@@ -142,17 +176,15 @@ class FrontierAgent(Agent):
         self,
         gain_scale: float = 1.0,
         potential_scale: float = 3.0,
-        min_frontier_size_m: float = 0.5,
-        progress_timeout_steps: int = 40,
-        blacklist_radius_m: float = 0.5,
-        replan_every_steps: int = 10,
+        min_frontier_size_m: float = 0.3,
+        progress_timeout_steps: int = 30,
+        blacklist_radius_m: float = 0.3,
+        replan_every_steps: int = 5,
         unknown_cost: float = 1.5,
-        goal_depth_m: float = 1.0,
-        visited_margin_m: float = 0.15,
-        lookahead_m: float = 0.5,
+        visited_margin_m: float = 0.12,
+        bump_exclusion_m: float = 0.3,
+        lookahead_m: float = 0.4,
         backoff_steps: int = 1,
-        bump_exclusion_m: float = 0.4,
-        min_unknown_depth_m: float = 0.3,
         max_steps: int | None = None,
     ) -> None:
         super().__init__(max_steps=max_steps)
@@ -161,105 +193,120 @@ class FrontierAgent(Agent):
         self.min_frontier_size_m = check_fraction("min_frontier_size_m", min_frontier_size_m)
         self.blacklist_radius_m = check_fraction("blacklist_radius_m", blacklist_radius_m)
         self.unknown_cost = check_fraction("unknown_cost", unknown_cost, 1.0)
-        self.goal_depth_m = check_fraction("goal_depth_m", goal_depth_m)
         self.visited_margin_m = check_fraction("visited_margin_m", visited_margin_m)
+        self.bump_exclusion_m = check_fraction("bump_exclusion_m", bump_exclusion_m)
         self.lookahead_m = check_fraction("lookahead_m", lookahead_m, 0.05)
         for name, v, lo in (("progress_timeout_steps", progress_timeout_steps, 1),
                             ("replan_every_steps", replan_every_steps, 1),
                             ("backoff_steps", backoff_steps, 0)):  # fmt: skip
             if isinstance(v, bool) or not isinstance(v, int) or v < lo:
                 raise ConfigError(f"{name} must be an int >= {lo}, got {v!r}")
-        self.backoff_steps = backoff_steps
-        self.bump_exclusion_m = check_fraction("bump_exclusion_m", bump_exclusion_m)
-        self.min_unknown_depth_m = check_fraction("min_unknown_depth_m", min_unknown_depth_m)
         self.progress_timeout_steps = progress_timeout_steps
         self.replan_every_steps = replan_every_steps
+        self.backoff_steps = backoff_steps
 
     # -- episode ---------------------------------------------------------------------------------
     def _on_reset(self, view: RobotView) -> None:
         res = view.grid.resolution_m
-        self.blacklisted = np.zeros(view.grid.shape, bool)
-        self.bumps = np.zeros(view.grid.shape, bool)
-        self._blacklist_radius_cells = self.blacklist_radius_m / res
-        self._bump_radius_cells = max(1.0, 0.1 / res)
-        self.goal: Goal | None = None
-        self.follower = PurePursuit(lookahead_m=self.lookahead_m)
-        self.visited = np.zeros(view.grid.shape, bool)
+        shape = view.grid.shape
+        self.visited = np.zeros(shape, bool)  # within radius + margin of the path
+        self.blacklisted = np.zeros(shape, bool)
+        self.bumps = np.zeros(shape, bool)  # contact regions
         self._visit_radius_cells = (view.radius_m + self.visited_margin_m) / res
+        # A goal cell resolves a target when the robot stops within the follower's tolerance of
+        # its centre and the target's centre is within the robot's radius of the robot's centre.
+        tolerance_m = 0.6 * res
+        self._reach_offsets = disk_offsets(max((view.radius_m - tolerance_m) / res, 0.5))
+        self.goal: Goal | None = None
+        self.follower = PurePursuit(lookahead_m=self.lookahead_m, goal_tolerance_m=tolerance_m)
         self._since_plan = 0
         self._backoff = 0
         self.n_blacklisted = 0
         self.n_goals = 0
+        self.n_bumps = 0
 
     def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
-        self._mark_visited(view)
-        pose = view.odometry_pose
+        mark_disk(self.visited, view.cell, self._visit_radius_cells)
         # A bump while driving forward: remember the wall ahead, back off (continuous) and
         # replan. Contact while turning or reversing says nothing about what lies ahead.
         bumped_ahead = view.bumped and self.last_command[0] > 0
         if bumped_ahead:
             self._mark_bump(view)
-            if self.action_type == "continuous":
+            if self.action_type == "continuous" and self.backoff_steps:
                 self._backoff = self.backoff_steps
         if self._backoff > 0:
             self._backoff -= 1
-            self.goal = None if self._backoff == 0 else self.goal
+            self.follower.set_path(np.zeros((0, 2)))
             return -1.0, 0.0
-        goal = self.goal
-        replan = goal is None or bumped_ahead or self._since_plan >= self.replan_every_steps
-        if goal is not None and not replan:
-            remaining = self.follower.remaining_m(view.xy)
-            if not self.follower.has_path:
-                if goal.final_xy is not None:  # a straight pass after the goal cell
-                    self.follower.set_path(np.stack([view.xy, goal.final_xy]))
-                    goal.final_xy = None
-                    goal.best_remaining_m = np.inf
-                else:
-                    replan = True
-            elif remaining < goal.best_remaining_m - 0.05:
-                goal.best_remaining_m = remaining
-                goal.steps_without_progress = 0
-            else:
-                goal.steps_without_progress += 1
-                if goal.steps_without_progress >= self.progress_timeout_steps:
-                    self._blacklist(goal)
-                    replan = True
-        if replan:
+        if self._needs_plan(view, bumped_ahead):
             self._plan(view)
         self._since_plan += 1
-        if not self.follower.has_path:  # nothing to drive to: turn in place, never stand still
-            return 0.0, 1.0
-        return self.follower.command(pose)
+        for _ in range(2):
+            if not self.follower.has_path:  # nothing to drive to: turn, never stand still
+                return 0.0, 1.0
+            linear, angular = self.follower.command(view.odometry_pose)
+            if self.follower.has_path:
+                return linear, angular
+            self._arrived(view)  # reached the goal cell this step: the next goal at once
+        return linear, angular
 
-    # -- goals -----------------------------------------------------------------------------------
-    def _mark_visited(self, view: RobotView) -> None:
-        self._mark_disk(self.visited, view.cell, self._visit_radius_cells)
+    def _arrived(self, view: RobotView) -> None:
+        """The goal cell is reached: go on (straight leg), or blacklist an unresolved target."""
+        goal = self.goal
+        if goal is not None and goal.final_xy is not None:
+            self.follower.set_path(np.stack([view.xy, goal.final_xy]))
+            goal.final_xy = None
+            goal.best_remaining_m = np.inf
+            return
+        if goal is not None and goal.kind == "frontier" and self._still_unknown(view, goal.target):
+            self._blacklist(goal)  # the footprint covered it and it stayed unknown: a wall
+        self._plan(view)
 
-    def _blacklist(self, goal: Goal) -> None:
-        """Blacklist the cells within ``blacklist_radius_m`` of a goal."""
-        self._mark_disk(self.blacklisted, goal.cell, self._blacklist_radius_cells)
-        self.n_blacklisted += 1
-        self.goal = None
+    def _needs_plan(self, view: RobotView, bumped: bool) -> bool:
+        goal = self.goal
+        if goal is None or bumped or self._since_plan >= self.replan_every_steps:
+            return True
+        if not self.follower.has_path:
+            return True
+        if goal.kind == "frontier" and not self._still_unknown(view, goal.target):
+            return True
+        remaining = self.follower.remaining_m(view.xy)
+        if remaining < goal.best_remaining_m - 0.05:
+            goal.best_remaining_m = remaining
+            goal.steps_without_progress = 0
+            return False
+        goal.steps_without_progress += 1
+        if goal.steps_without_progress >= self.progress_timeout_steps:
+            self._blacklist(goal)
+            return True
+        return False
 
     @staticmethod
-    def _mark_disk(mask: np.ndarray, cell: tuple[int, int], radius_cells: float) -> None:
-        r, c = cell
-        k = int(np.ceil(radius_cells))
-        h, w = mask.shape
-        r0, r1, c0, c1 = max(r - k, 0), min(r + k + 1, h), max(c - k, 0), min(c + k + 1, w)
-        if r0 >= r1 or c0 >= c1:
-            return
-        rr, cc = np.ogrid[r0:r1, c0:c1]
-        mask[r0:r1, c0:c1] |= (rr - r) ** 2 + (cc - c) ** 2 <= radius_cells * radius_cells
+    def _still_unknown(view: RobotView, cell: tuple[int, int]) -> bool:
+        _, _, unknown = belief_classes(view.belief_u8[cell[0], cell[1]])
+        return bool(unknown)
+
+    # -- bookkeeping -----------------------------------------------------------------------------
+    def _blacklist(self, goal: Goal) -> None:
+        """Blacklist the cells within ``blacklist_radius_m`` of the goal's target."""
+        res_cells = self.blacklist_radius_m / self._cell_m
+        mark_disk(self.blacklisted, goal.target, max(res_cells, 0.5))
+        self.n_blacklisted += 1
+        self.goal = None
 
     def _mark_bump(self, view: RobotView) -> None:
         """Remember a wall where the bumper fired (the mapper marks one cell; walls are longer)."""
         x, y, th = view.odometry_pose
-        reach = view.radius_m + view.grid.resolution_m
+        reach = view.radius_m + 0.5 * view.grid.resolution_m
         contact = np.array([x + reach * np.cos(th), y + reach * np.sin(th)])
-        cell = tuple(int(v) for v in view.grid.world_to_cell(contact))
-        self._mark_disk(self.bumps, cell, self._bump_radius_cells)
+        mark_disk(self.bumps, tuple(view.grid.world_to_cell(contact)), 0.75)
+        self.n_bumps += 1
 
+    @property
+    def _cell_m(self) -> float:
+        return self._res
+
+    # -- planning --------------------------------------------------------------------------------
     def _costs(self, view: RobotView) -> np.ndarray:
         cost = traversal_costs(
             view.belief_u8, view.grid.resolution_m, view.radius_m,
@@ -270,116 +317,94 @@ class FrontierAgent(Agent):
     def _plan(self, view: RobotView) -> None:
         """Pick a goal and a path to it (or fall back to sweeping)."""
         self._since_plan = 0
+        self._res = view.grid.resolution_m
         field = cost_field(self._costs(view), view.cell, view.grid.resolution_m)
-        candidate = self._choose_goal(view, field)
-        if candidate is None:
-            candidate = self._sweep_goal(view, field)
-        self._set_goal(view, field, candidate)
+        goal = self._choose_goal(view, field)
+        if goal is None:
+            goal = self._sweep_goal(view, field)
+        self._set_goal(view, field, goal)
 
     def _set_goal(self, view: RobotView, field: CostField, goal: Goal | None) -> None:
+        prev = self.goal
         if goal is None:
             self.goal = None
             self.follower.set_path(np.zeros((0, 2)))
             return
-        prev = self.goal
-        if prev is not None and prev.kind == goal.kind and prev.cell == goal.cell:
+        if prev is not None and prev.kind == goal.kind and prev.target == goal.target:
             goal.best_remaining_m = prev.best_remaining_m  # same goal: keep its progress clock
             goal.steps_without_progress = prev.steps_without_progress
+        else:
+            self.n_goals += 1
         self.goal = goal
-        self.n_goals += 1
         cells = field.path(goal.cell)
         xy = view.grid.cell_to_world(cells) if len(cells) else view.xy[None]
-        self.follower.set_path(simplify_path(xy, 0.25))
+        self.follower.set_path(simplify_path(xy, 0.2))
+
+    def _approach(self, field: CostField) -> np.ndarray:
+        """Per cell: the cheapest path cost to a cell whose footprint covers it."""
+        cum = field.cumulative
+        h, w = cum.shape
+        out = np.full_like(cum, np.inf)
+        for dr, dc in self._reach_offsets:
+            src = cum[max(dr, 0) : h + min(dr, 0), max(dc, 0) : w + min(dc, 0)]
+            dst = out[max(-dr, 0) : h + min(-dr, 0), max(-dc, 0) : w + min(-dc, 0)]
+            np.minimum(dst, src, out=dst)
+        return out
+
+    def _approach_cell(self, field: CostField, target: tuple[int, int]) -> tuple[int, int]:
+        """The cheapest reachable cell whose footprint covers ``target``."""
+        h, w = field.cumulative.shape
+        cells = np.asarray(target) + self._reach_offsets
+        ok = (cells[:, 0] >= 0) & (cells[:, 0] < h) & (cells[:, 1] >= 0) & (cells[:, 1] < w)
+        cells = cells[ok]
+        i = int(np.argmin(field.cumulative[cells[:, 0], cells[:, 1]]))
+        return int(cells[i, 0]), int(cells[i, 1])
+
+    def _frontier_exclusion(self, view: RobotView) -> np.ndarray:
+        """Cells that are not frontier goals: near the path, near a bump, or blacklisted."""
+        near_bump = ndimage.binary_dilation(
+            self.bumps, iterations=max(1, int(round(self.bump_exclusion_m / self._res)))
+        )
+        return (self.visited_ring if self.visited_margin_m > 0 else False) | near_bump | self.blacklisted
 
     def _choose_goal(self, view: RobotView, field: CostField) -> Goal | None:
         res = view.grid.resolution_m
-        frontiers = find_frontiers(
-            view.belief_u8,
-            max(1, int(round(self.min_frontier_size_m / res))),
-            exclude=self._frontier_exclusion(view),
-        )
-        if not frontiers:
+        min_cells = max(1, int(round(self.min_frontier_size_m / res)))
+        all_frontiers = find_frontiers(view.belief_u8, min_cells)
+        if not all_frontiers:
             self._stop("no_frontiers")
             return None
-        best, best_u = None, -np.inf
-        any_open = False
-        for f in frontiers:
-            dist = field.cumulative[f.cells[:, 0], f.cells[:, 1]]
-            reachable = np.isfinite(dist)
-            if not reachable.any():  # unreachable on the belief map: blacklist it
+        exclude = self._frontier_exclusion(view)
+        approach = self._approach(field)
+        best: tuple[float, Frontier, tuple[int, int]] | None = None
+        for f in find_frontiers(view.belief_u8, min_cells, exclude=exclude):
+            cost = approach[f.cells[:, 0], f.cells[:, 1]]
+            if not np.isfinite(cost).any():  # no way to reach it on the belief map
                 self.blacklisted[f.cells[:, 0], f.cells[:, 1]] = True
                 self.n_blacklisted += 1
                 continue
-            ok = reachable & ~self.blacklisted[f.cells[:, 0], f.cells[:, 1]]
-            if not ok.any():
-                continue
-            any_open = True
-            i = int(np.flatnonzero(ok)[np.argmin(dist[ok])])
-            u = self._utility(view, f, float(dist[i]))
-            if u > best_u:
-                best, best_u = (f, i), u
-        if not any_open or best is None:
+            i = int(np.argmin(cost))
+            u = self._utility(view, f, float(cost[i]))
+            if best is None or u > best[0]:
+                best = (u, f, (int(f.cells[i, 0]), int(f.cells[i, 1])))
+        if best is None:
             self._stop("all_blacklisted")
             return None
-        f, i = best
-        return Goal(self._deepen(view, field, tuple(f.cells[i]), f), "frontier")
-
-    def _frontier_exclusion(self, view: RobotView) -> np.ndarray:
-        """Cells that are not frontier goals: near the path, near bumps, or thin unknown strips.
-
-        Unknown space only one or two cells deep between known regions is a wall the map has
-        not resolved, not a way into unexplored space.
-        """
-        res = view.grid.resolution_m
-        _, _, unknown = belief_classes(view.belief_u8)
-        exclude = self.visited | ndimage.binary_dilation(
-            self.bumps, iterations=max(1, int(round(self.bump_exclusion_m / res)))
-        )
-        if self.min_unknown_depth_m > 0:
-            depth = ndimage.distance_transform_edt(unknown) * res
-            window = 2 * int(round(self.min_unknown_depth_m / res)) + 3
-            exclude |= ndimage.maximum_filter(depth, size=window) < self.min_unknown_depth_m
-        return exclude
+        _, f, target = best
+        return Goal(self._approach_cell(field, target), target, "frontier")
 
     def _utility(self, view: RobotView, f: Frontier, path_m: float) -> float:
         size_m = f.size * view.grid.resolution_m
         return self.gain_scale * size_m - self.potential_scale * path_m
 
-    def _deepen(
-        self, view: RobotView, field: CostField, cell: tuple[int, int], f: Frontier
-    ) -> tuple[int, int]:
-        """Push the goal ``goal_depth_m`` into unknown space, away from the robot."""
-        if self.goal_depth_m <= 0:
-            return cell
-        res = view.grid.resolution_m
-        here = np.array(view.cell, np.float64)
-        d = np.array(cell, np.float64) - here
-        n = np.linalg.norm(d)
-        if n < 1e-9:
-            return cell
-        _, _, unknown = belief_classes(view.belief_u8)
-        reach = field.reachable()
-        best = cell
-        h, w = unknown.shape
-        for step in np.arange(1, int(self.goal_depth_m / res) + 1):
-            rc = np.round(np.array(cell) + d / n * step).astype(int)
-            if not (0 <= rc[0] < h and 0 <= rc[1] < w) or not reach[rc[0], rc[1]]:
-                break
-            if not unknown[rc[0], rc[1]]:
-                break
-            best = (int(rc[0]), int(rc[1]))
-        return best
-
     def _sweep_goal(self, view: RobotView, field: CostField) -> Goal | None:
         """Fallback: the reachable cell farthest from the path so far (keeps the rays sweeping)."""
-        reach = field.reachable() & np.isfinite(field.cumulative)
         free, _, unknown = belief_classes(view.belief_u8)
-        target = reach & (free | unknown) & ~self.visited
+        target = field.reachable() & (free | unknown) & ~self.visited & ~self.blacklisted
         if not target.any():
             return None
         far = ndimage.distance_transform_edt(~self.visited)
-        score = np.where(target, far, -1.0)
-        if unknown[target].any():  # prefer unknown space
-            score = np.where(target & unknown, far + 1e3, score)
+        score = np.where(target, far + 1e3 * unknown, -1.0)
         r, c = np.unravel_index(int(np.argmax(score)), score.shape)
-        return Goal((int(r), int(c)), "sweep")
+        cell = (int(r), int(c))
+        return Goal(cell, cell, "sweep")
