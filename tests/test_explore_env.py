@@ -47,11 +47,11 @@ def test_reward_is_scaled_information_gain_minus_collision_penalty():
 
 
 def test_terminates_at_the_coverage_target_and_reports_a_summary():
-    env = gym.make("SfW-ExploreSmall-v0", coverage_target=0.05)
+    env = gym.make("SfW-ExploreSmall-v0", coverage_target=0.01)
     env.reset(seed=0)
     _, _, terminated, truncated, info = drive(env, 300)
     assert terminated and not truncated
-    assert info["coverage"] >= 0.05 and info["summary"]["steps"] >= 1
+    assert info["coverage"] >= 0.01 and info["summary"]["steps"] >= 1
     assert 0 <= info["summary"]["map_mse"] <= 1
 
 

@@ -167,6 +167,8 @@ class FrontierAgent(Agent):
         bump_exclusion_m: Frontier cells this close to a bump are not goals (walls).
         lookahead_m: Pure-pursuit carrot distance.
         backoff_steps: Steps of reversing after a bump (continuous actions only).
+        turn_cost_m_per_rad: Path metres charged per radian of turning towards a goal, so that
+            the robot sweeps on instead of turning back and forth.
         max_steps: Optional step limit of the agent (then ``stop_reason = "max_steps"``).
     """
 
@@ -185,6 +187,7 @@ class FrontierAgent(Agent):
         bump_exclusion_m: float = 0.3,
         lookahead_m: float = 0.4,
         backoff_steps: int = 1,
+        turn_cost_m_per_rad: float = 0.3,
         max_steps: int | None = None,
     ) -> None:
         super().__init__(max_steps=max_steps)
@@ -204,6 +207,7 @@ class FrontierAgent(Agent):
         self.progress_timeout_steps = progress_timeout_steps
         self.replan_every_steps = replan_every_steps
         self.backoff_steps = backoff_steps
+        self.turn_cost_m_per_rad = check_fraction("turn_cost_m_per_rad", turn_cost_m_per_rad)
 
     # -- episode ---------------------------------------------------------------------------------
     def _on_reset(self, view: RobotView) -> None:
@@ -375,7 +379,7 @@ class FrontierAgent(Agent):
             self._stop("no_frontiers")
             return None
         exclude = self._frontier_exclusion(view)
-        approach = self._approach(field)
+        approach = self._approach(field) + self._turn_penalty(view)
         best: tuple[float, Frontier, tuple[int, int]] | None = None
         for f in find_frontiers(view.belief_u8, min_cells, exclude=exclude):
             cost = approach[f.cells[:, 0], f.cells[:, 1]]
@@ -392,6 +396,16 @@ class FrontierAgent(Agent):
             return None
         _, f, target = best
         return Goal(self._approach_cell(field, target), target, "frontier")
+
+    def _turn_penalty(self, view: RobotView) -> np.ndarray:
+        """Metres charged per radian the robot must turn to face a cell (smooth sweeps)."""
+        if self.turn_cost_m_per_rad <= 0:
+            return np.zeros(view.grid.shape)
+        xs, ys = view.grid.cell_centres()
+        x, y, th = view.odometry_pose
+        bearing = np.arctan2(ys - y, xs - x) - th
+        bearing = np.abs((bearing + np.pi) % (2 * np.pi) - np.pi)
+        return self.turn_cost_m_per_rad * bearing
 
     def _utility(self, view: RobotView, f: Frontier, path_m: float) -> float:
         size_m = f.size * view.grid.resolution_m

@@ -131,8 +131,14 @@ class SfWExploreEnv(gym.Env):
             "radio", radio, lambda **kw: RadioConfig.preset(radio_preset, band=radio_band, **kw)
         )
         self.robot_config = _make_config("robot", robot, RobotConfig)
+        # The robot knows its routers: their RSSI at 1 m with no wall (P_tx − PL(1 m)) calibrates
+        # k = 0, so a router first heard through a wall is not read one wall short.
+        mapper_defaults = {
+            "robot_radius_m": self.robot_config.radius_m,
+            "k0_level_dbm": self.radio_config.tx_power_dbm - self.radio_config.d0_loss_db,
+        }
         self.mapper_config = _make_config(
-            "mapper", {"robot_radius_m": self.robot_config.radius_m, **(mapper or {})}, MapperConfig
+            "mapper", {**mapper_defaults, **(mapper or {})}, MapperConfig
         )
         self.resolution_m = float(resolution_m)
         self.map_px, self.crop_px = map_px, crop_px

@@ -147,8 +147,8 @@ class Floorplan:
         a2, b2 = np.broadcast_arrays(np.asarray(a, np.float64), np.asarray(b, np.float64))
         if a2.shape[-1] != 2:
             raise FloorplanError(f"segment endpoints must have shape (M, 2), got {a2.shape}")
-        a2 = np.ascontiguousarray(a2.reshape(-1, 2))
-        b2 = np.ascontiguousarray(b2.reshape(-1, 2))
+        a2 = np.array(a2.reshape(-1, 2), order="C")  # copies: broadcast views are read-only
+        b2 = np.array(b2.reshape(-1, 2), order="C")
         edge_loss = table[self.edge_material_index]
         kernel = cross_walls_parallel if len(a2) >= _PARALLEL_MIN_SEGMENTS else cross_walls
         return kernel(self.edges, edge_loss, a2, b2, float(min_piece_m))
