@@ -50,8 +50,10 @@ def _cmd_world(args: argparse.Namespace) -> int:
     radio = RadioModel(plan, routers, RadioConfig.preset(args.preset, band=args.band), rng)
     out = draw_world(plan, radio, args.out, resolution_m=args.resolution)
     took = time.perf_counter() - start
-    print(f"{plan.name}: {plan.area_m2:.1f} m², {len(plan.edges)} wall faces, routers at "
-          f"{np.round(radio.routers, 2).tolist()}")
+    print(
+        f"{plan.name}: {plan.area_m2:.1f} m², {len(plan.edges)} wall faces, routers at "
+        f"{np.round(radio.routers, 2).tolist()}"
+    )
     print(f"wrote {out} in {took:.1f} s")
     return 0
 
@@ -96,6 +98,29 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     return main_bench(args.env, args.steps, args.resets, args.memory_steps)
 
 
+def _cmd_train(args: argparse.Namespace) -> int:
+    from sfw_gym.training import train_ppo
+
+    summary = train_ppo(
+        args.env,
+        args.timesteps,
+        args.out or f"runs/ppo/{args.env}",
+        n_envs=args.n_envs,
+        seed=args.seed,
+        hyperparams_path=args.hyperparams,
+        checkpoint_every=args.checkpoint_every,
+        eval_every=args.eval_every,
+        eval_episodes=args.eval_episodes,
+        resume=args.resume,
+        progress_bar=not args.no_progress,
+    )
+    print(
+        f"trained {summary['env_id'] if 'env_id' in summary else args.env} to "
+        f"{summary['steps']:,} steps in {summary['wall_time_s']:.0f} s; model: {summary['model']}"
+    )
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of every subcommand."""
     parser = argparse.ArgumentParser(
@@ -108,7 +133,9 @@ def build_parser() -> argparse.ArgumentParser:
     source.add_argument("--seed", type=int, default=0, help="procedural floorplan seed (default 0)")
     source.add_argument("--floorplan", help="a HouseExpo or sfw_gym JSON floorplan file")
     world.add_argument("--routers", default="2", help="a count, or positions 'x1,y1;x2,y2'")
-    world.add_argument("--preset", default="default", help="radio preset: default, thick, residential")
+    world.add_argument(
+        "--preset", default="default", help="radio preset: default, thick, residential"
+    )
     world.add_argument("--band", default="2.4", help="2.4 or 5 (GHz)")
     world.add_argument("--resolution", type=float, default=0.1, help="heat-map cell size, metres")
     world.add_argument("--out", default="world.png", help="output PNG (default world.png)")
@@ -122,8 +149,12 @@ def build_parser() -> argparse.ArgumentParser:
     mp.add_argument(
         "--scale", type=float, default=1.0, help="metres per CSV unit (default 1; pixels e.g. 0.05)"
     )
-    mp.add_argument("--resolution", type=float, default=0.05, help="map cell size, metres (default 0.05)")
-    mp.add_argument("--margin", type=float, default=1.0, help="border around the data, metres (default 1)")
+    mp.add_argument(
+        "--resolution", type=float, default=0.05, help="map cell size, metres (default 0.05)"
+    )
+    mp.add_argument(
+        "--margin", type=float, default=1.0, help="border around the data, metres (default 1)"
+    )
     mp.add_argument(
         "--band", choices=["2.4", "5"], default=None,
         help="with 2 RSSI columns per router: which band (default 2.4)",
@@ -141,9 +172,30 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--env", default="SfW-Explore-v0", help="env id (default SfW-Explore-v0)")
     bench.add_argument("--steps", type=int, default=5000, help="random steps to time")
     bench.add_argument("--resets", type=int, default=50, help="resets to time")
-    bench.add_argument("--memory-steps", type=int, default=0,
-                       help="also report RSS before/after this many steps (e.g. 100000)")
+    bench.add_argument(
+        "--memory-steps",
+        type=int,
+        default=0,
+        help="also report RSS before/after this many steps (e.g. 100000)",
+    )
     bench.set_defaults(func=_cmd_bench)
+
+    from sfw_gym.training import DEFAULT_HYPERPARAMS
+
+    train = sub.add_parser("train", help="train an agent (PPO, stable-baselines3)")
+    train.add_argument("algo", choices=["ppo"], help="the algorithm (ppo)")
+    train.add_argument("--env", default="SfW-Explore-v0", help="env id (default SfW-Explore-v0)")
+    train.add_argument("--timesteps", type=int, default=1_000_000, help="total env steps")
+    train.add_argument("--n-envs", type=int, default=None, help="parallel envs (default: YAML)")
+    train.add_argument("--seed", type=int, default=0)
+    train.add_argument("--out", default=None, help="output folder (default runs/ppo/ENV)")
+    train.add_argument("--hyperparams", default=str(DEFAULT_HYPERPARAMS), help="rl-zoo YAML")
+    train.add_argument("--checkpoint-every", type=int, default=50_000, help="env steps")
+    train.add_argument("--eval-every", type=int, default=25_000, help="env steps")
+    train.add_argument("--eval-episodes", type=int, default=5, help="held-out episodes")
+    train.add_argument("--resume", action="store_true", help="continue from the last checkpoint")
+    train.add_argument("--no-progress", action="store_true", help="no progress bar")
+    train.set_defaults(func=_cmd_train)
     return parser
 
 

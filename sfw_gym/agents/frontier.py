@@ -31,7 +31,7 @@ reachable cell farthest from its path so far): an episode never stalls while it 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -98,16 +98,17 @@ def find_frontiers(
         return []
     rows, cols = np.nonzero(labels)
     lab = labels[rows, cols]
+    sizes = np.bincount(lab, minlength=n + 1)
+    keep = sizes[lab] >= min_size_cells
+    rows, cols, lab = rows[keep], cols[keep], lab[keep]
     order = np.argsort(lab, kind="stable")
     rows, cols, lab = rows[order], cols[order], lab[order]
-    bounds = np.searchsorted(lab, np.arange(1, n + 2))
+    starts = np.flatnonzero(np.r_[True, lab[1:] != lab[:-1]]) if len(lab) else []
+    ends = np.r_[starts[1:], len(lab)] if len(lab) else []
     out = []
-    for i in range(n):
-        a, b = bounds[i], bounds[i + 1]
-        if b - a < min_size_cells:
-            continue
+    for a, b in zip(starts, ends, strict=True):
         cells = np.stack([rows[a:b], cols[a:b]], axis=1)
-        out.append(Frontier(cells, (float(rows[a:b].mean()), float(cols[a:b].mean()))))
+        out.append(Frontier(cells, (float(rows[a:b].sum() / (b - a)), float(cols[a:b].sum() / (b - a)))))
     out.sort(key=lambda f: -f.size)
     return out
 
@@ -140,15 +141,17 @@ class Goal:
         cell: Where the robot drives, ``(row, col)``.
         target: The cell it means to resolve (a frontier cell), or the goal cell itself.
         kind: ``"frontier"``, ``"sweep"`` or a subclass's own kind.
-        final_xy: Optional world point to drive to in a straight line after ``cell``.
+        waypoints: Cells to drive to next, in order, once ``cell`` is reached (a committed
+            route: periodic replanning re-paths to the current cell instead of re-choosing).
     """
 
     cell: tuple[int, int]
     target: tuple[int, int]
     kind: str
-    final_xy: np.ndarray | None = None
+    waypoints: list[tuple[int, int]] = field(default_factory=list)
     best_remaining_m: float = np.inf
     steps_without_progress: int = 0
+    bumps: int = 0
 
 
 class FrontierAgent(Agent):
@@ -163,16 +166,18 @@ class FrontierAgent(Agent):
         blacklist_radius_m: Frontier cells this close to a blacklisted goal are skipped.
         replan_every_steps: Re-pick the goal at least this often, as the map changes.
         unknown_cost: Planner cost of an unknown cell (a free one costs 1).
-        visited_margin_m: Frontier cells within radius + this of the robot's path are not goals.
         bump_exclusion_m: Frontier cells this close to a bump are not goals (walls).
         lookahead_m: Pure-pursuit carrot distance.
         backoff_steps: Steps of reversing after a bump (continuous actions only).
         turn_cost_m_per_rad: Path metres charged per radian of turning towards a goal, so that
             the robot sweeps on instead of turning back and forth.
+        max_bumps_per_goal: A goal is blacklisted after this many bumps on the way to it.
         max_steps: Optional step limit of the agent (then ``stop_reason = "max_steps"``).
     """
 
     name = "frontier"
+    #: Goal kinds that periodic replanning re-paths to instead of re-choosing.
+    _committed_kinds: tuple[str, ...] = ()
 
     def __init__(
         self,
@@ -183,11 +188,11 @@ class FrontierAgent(Agent):
         blacklist_radius_m: float = 0.3,
         replan_every_steps: int = 5,
         unknown_cost: float = 1.5,
-        visited_margin_m: float = 0.12,
         bump_exclusion_m: float = 0.3,
         lookahead_m: float = 0.4,
         backoff_steps: int = 1,
         turn_cost_m_per_rad: float = 0.3,
+        max_bumps_per_goal: int = 2,
         max_steps: int | None = None,
     ) -> None:
         super().__init__(max_steps=max_steps)
@@ -196,27 +201,28 @@ class FrontierAgent(Agent):
         self.min_frontier_size_m = check_fraction("min_frontier_size_m", min_frontier_size_m)
         self.blacklist_radius_m = check_fraction("blacklist_radius_m", blacklist_radius_m)
         self.unknown_cost = check_fraction("unknown_cost", unknown_cost, 1.0)
-        self.visited_margin_m = check_fraction("visited_margin_m", visited_margin_m)
         self.bump_exclusion_m = check_fraction("bump_exclusion_m", bump_exclusion_m)
         self.lookahead_m = check_fraction("lookahead_m", lookahead_m, 0.05)
         for name, v, lo in (("progress_timeout_steps", progress_timeout_steps, 1),
                             ("replan_every_steps", replan_every_steps, 1),
-                            ("backoff_steps", backoff_steps, 0)):  # fmt: skip
+                            ("backoff_steps", backoff_steps, 0),
+                            ("max_bumps_per_goal", max_bumps_per_goal, 1)):  # fmt: skip
             if isinstance(v, bool) or not isinstance(v, int) or v < lo:
                 raise ConfigError(f"{name} must be an int >= {lo}, got {v!r}")
         self.progress_timeout_steps = progress_timeout_steps
         self.replan_every_steps = replan_every_steps
         self.backoff_steps = backoff_steps
+        self.max_bumps_per_goal = max_bumps_per_goal
         self.turn_cost_m_per_rad = check_fraction("turn_cost_m_per_rad", turn_cost_m_per_rad)
 
     # -- episode ---------------------------------------------------------------------------------
     def _on_reset(self, view: RobotView) -> None:
         res = view.grid.resolution_m
         shape = view.grid.shape
-        self.visited = np.zeros(shape, bool)  # within radius + margin of the path
+        self.visited = np.zeros(shape, bool)  # within the robot's radius of its path
         self.blacklisted = np.zeros(shape, bool)
         self.bumps = np.zeros(shape, bool)  # contact regions
-        self._visit_radius_cells = (view.radius_m + self.visited_margin_m) / res
+        self._visit_radius_cells = view.radius_m / res
         # A goal cell resolves a target when the robot stops within the follower's tolerance of
         # its centre and the target's centre is within the robot's radius of the robot's centre.
         tolerance_m = 0.6 * res
@@ -226,6 +232,7 @@ class FrontierAgent(Agent):
         self._since_plan = 0
         self._backoff = 0
         self.n_blacklisted = 0
+        self.n_unreachable = 0
         self.n_goals = 0
         self.n_bumps = 0
 
@@ -238,6 +245,7 @@ class FrontierAgent(Agent):
             self._mark_bump(view)
             if self.action_type == "continuous" and self.backoff_steps:
                 self._backoff = self.backoff_steps
+        self._track_progress(view, bumped_ahead)
         if self._backoff > 0:
             self._backoff -= 1
             self.follower.set_path(np.zeros((0, 2)))
@@ -255,16 +263,38 @@ class FrontierAgent(Agent):
         return linear, angular
 
     def _arrived(self, view: RobotView) -> None:
-        """The goal cell is reached: go on (straight leg), or blacklist an unresolved target."""
+        """The goal cell is reached: on to the next waypoint, or blacklist an unresolved target."""
         goal = self.goal
-        if goal is not None and goal.final_xy is not None:
-            self.follower.set_path(np.stack([view.xy, goal.final_xy]))
-            goal.final_xy = None
-            goal.best_remaining_m = np.inf
+        if goal is not None and goal.waypoints:
+            nxt = goal.waypoints.pop(0)
+            goal.cell = goal.target = nxt
+            goal.best_remaining_m, goal.steps_without_progress, goal.bumps = np.inf, 0, 0
+            self._plan(view)
             return
         if goal is not None and goal.kind == "frontier" and self._still_unknown(view, goal.target):
             self._blacklist(goal)  # the footprint covered it and it stayed unknown: a wall
+        self.goal = None
         self._plan(view)
+
+    def _track_progress(self, view: RobotView, bumped: bool) -> None:
+        """Blacklist the goal after ``progress_timeout_steps`` without progress or
+        ``max_bumps_per_goal`` bumps on the way."""
+        goal = self.goal
+        if goal is None:
+            return
+        goal.bumps += int(bumped)
+        remaining = float(np.linalg.norm(view.xy - view.grid.cell_to_world(goal.cell)))
+        if remaining < goal.best_remaining_m - 0.05:
+            goal.best_remaining_m = remaining
+            goal.steps_without_progress = 0
+        else:
+            goal.steps_without_progress += 1
+        if (
+            goal.steps_without_progress >= self.progress_timeout_steps
+            or goal.bumps >= self.max_bumps_per_goal
+        ):
+            self._blacklist(goal)
+            self.follower.set_path(np.zeros((0, 2)))
 
     def _needs_plan(self, view: RobotView, bumped: bool) -> bool:
         goal = self.goal
@@ -272,18 +302,7 @@ class FrontierAgent(Agent):
             return True
         if not self.follower.has_path:
             return True
-        if goal.kind == "frontier" and not self._still_unknown(view, goal.target):
-            return True
-        remaining = self.follower.remaining_m(view.xy)
-        if remaining < goal.best_remaining_m - 0.05:
-            goal.best_remaining_m = remaining
-            goal.steps_without_progress = 0
-            return False
-        goal.steps_without_progress += 1
-        if goal.steps_without_progress >= self.progress_timeout_steps:
-            self._blacklist(goal)
-            return True
-        return False
+        return goal.kind == "frontier" and not self._still_unknown(view, goal.target)
 
     @staticmethod
     def _still_unknown(view: RobotView, cell: tuple[int, int]) -> bool:
@@ -303,7 +322,7 @@ class FrontierAgent(Agent):
         x, y, th = view.odometry_pose
         reach = view.radius_m + 0.5 * view.grid.resolution_m
         contact = np.array([x + reach * np.cos(th), y + reach * np.sin(th)])
-        mark_disk(self.bumps, tuple(view.grid.world_to_cell(contact)), 0.75)
+        mark_disk(self.bumps, tuple(view.grid.world_to_cell(contact)), 1.0)
         self.n_bumps += 1
 
     @property
@@ -319,34 +338,43 @@ class FrontierAgent(Agent):
         return free_start(cost, view.cell)
 
     def _plan(self, view: RobotView) -> None:
-        """Pick a goal and a path to it (or fall back to sweeping)."""
+        """Pick a goal and a path to it (or fall back to sweeping); re-path a committed goal."""
         self._since_plan = 0
         self._res = view.grid.resolution_m
-        field = cost_field(self._costs(view), view.cell, view.grid.resolution_m)
-        goal = self._choose_goal(view, field)
+        paths = cost_field(self._costs(view), view.cell, view.grid.resolution_m)
+        goal = self.goal
+        if goal is not None and goal.kind in self._committed_kinds:
+            if np.isfinite(paths.cumulative[goal.cell]):
+                self._set_goal(view, paths, goal)
+                return
+            self._blacklist(goal)
+        goal = self._choose_goal(view, paths)
         if goal is None:
-            goal = self._sweep_goal(view, field)
-        self._set_goal(view, field, goal)
+            goal = self._sweep_goal(view, paths)
+        self._set_goal(view, paths, goal)
 
-    def _set_goal(self, view: RobotView, field: CostField, goal: Goal | None) -> None:
+    def _set_goal(self, view: RobotView, paths: CostField, goal: Goal | None) -> None:
         prev = self.goal
         if goal is None:
             self.goal = None
             self.follower.set_path(np.zeros((0, 2)))
             return
-        if prev is not None and prev.kind == goal.kind and prev.target == goal.target:
+        if prev is goal:
+            pass
+        elif prev is not None and prev.kind == goal.kind and prev.target == goal.target:
             goal.best_remaining_m = prev.best_remaining_m  # same goal: keep its progress clock
             goal.steps_without_progress = prev.steps_without_progress
+            goal.bumps = prev.bumps
         else:
             self.n_goals += 1
         self.goal = goal
-        cells = field.path(goal.cell)
+        cells = paths.path(goal.cell)
         xy = view.grid.cell_to_world(cells) if len(cells) else view.xy[None]
         self.follower.set_path(simplify_path(xy, 0.2))
 
-    def _approach(self, field: CostField) -> np.ndarray:
+    def _approach(self, paths: CostField) -> np.ndarray:
         """Per cell: the cheapest path cost to a cell whose footprint covers it."""
-        cum = field.cumulative
+        cum = paths.cumulative
         h, w = cum.shape
         out = np.full_like(cum, np.inf)
         for dr, dc in self._reach_offsets:
@@ -355,37 +383,35 @@ class FrontierAgent(Agent):
             np.minimum(dst, src, out=dst)
         return out
 
-    def _approach_cell(self, field: CostField, target: tuple[int, int]) -> tuple[int, int]:
+    def _approach_cell(self, paths: CostField, target: tuple[int, int]) -> tuple[int, int]:
         """The cheapest reachable cell whose footprint covers ``target``."""
-        h, w = field.cumulative.shape
+        h, w = paths.cumulative.shape
         cells = np.asarray(target) + self._reach_offsets
         ok = (cells[:, 0] >= 0) & (cells[:, 0] < h) & (cells[:, 1] >= 0) & (cells[:, 1] < w)
         cells = cells[ok]
-        i = int(np.argmin(field.cumulative[cells[:, 0], cells[:, 1]]))
+        i = int(np.argmin(paths.cumulative[cells[:, 0], cells[:, 1]]))
         return int(cells[i, 0]), int(cells[i, 1])
 
     def _frontier_exclusion(self, view: RobotView) -> np.ndarray:
-        """Cells that are not frontier goals: near the path, near a bump, or blacklisted."""
+        """Cells that are not frontier goals: near a bump (walls), or blacklisted."""
         near_bump = ndimage.binary_dilation(
             self.bumps, iterations=max(1, int(round(self.bump_exclusion_m / self._res)))
         )
-        return (self.visited_ring if self.visited_margin_m > 0 else False) | near_bump | self.blacklisted
+        return near_bump | self.blacklisted
 
-    def _choose_goal(self, view: RobotView, field: CostField) -> Goal | None:
+    def _choose_goal(self, view: RobotView, paths: CostField) -> Goal | None:
         res = view.grid.resolution_m
         min_cells = max(1, int(round(self.min_frontier_size_m / res)))
-        all_frontiers = find_frontiers(view.belief_u8, min_cells)
-        if not all_frontiers:
+        if not frontier_mask(view.belief_u8).any():
             self._stop("no_frontiers")
             return None
         exclude = self._frontier_exclusion(view)
-        approach = self._approach(field) + self._turn_penalty(view)
+        approach = self._approach(paths) + self._turn_penalty(view)
         best: tuple[float, Frontier, tuple[int, int]] | None = None
         for f in find_frontiers(view.belief_u8, min_cells, exclude=exclude):
             cost = approach[f.cells[:, 0], f.cells[:, 1]]
-            if not np.isfinite(cost).any():  # no way to reach it on the belief map
-                self.blacklisted[f.cells[:, 0], f.cells[:, 1]] = True
-                self.n_blacklisted += 1
+            if not np.isfinite(cost).any():  # walled off on the belief map: skipped this time
+                self.n_unreachable += 1
                 continue
             i = int(np.argmin(cost))
             u = self._utility(view, f, float(cost[i]))
@@ -395,7 +421,7 @@ class FrontierAgent(Agent):
             self._stop("all_blacklisted")
             return None
         _, f, target = best
-        return Goal(self._approach_cell(field, target), target, "frontier")
+        return Goal(self._approach_cell(paths, target), target, "frontier")
 
     def _turn_penalty(self, view: RobotView) -> np.ndarray:
         """Metres charged per radian the robot must turn to face a cell (smooth sweeps)."""
@@ -411,10 +437,10 @@ class FrontierAgent(Agent):
         size_m = f.size * view.grid.resolution_m
         return self.gain_scale * size_m - self.potential_scale * path_m
 
-    def _sweep_goal(self, view: RobotView, field: CostField) -> Goal | None:
+    def _sweep_goal(self, view: RobotView, paths: CostField) -> Goal | None:
         """Fallback: the reachable cell farthest from the path so far (keeps the rays sweeping)."""
         free, _, unknown = belief_classes(view.belief_u8)
-        target = field.reachable() & (free | unknown) & ~self.visited & ~self.blacklisted
+        target = paths.reachable() & (free | unknown) & ~self.visited & ~self.blacklisted
         if not target.any():
             return None
         far = ndimage.distance_transform_edt(~self.visited)

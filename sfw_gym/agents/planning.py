@@ -33,34 +33,44 @@ def traversal_costs(
     radius_m: float,
     *,
     unknown_cost: float = 1.5,
+    inflation_cost: float = 8.0,
     clearance_m: float = 0.2,
-    clearance_cost: float = 4.0,
+    lethal_radius_m: float | None = None,
     blocked: np.ndarray | None = None,
 ) -> np.ndarray:
     """Per-cell traversal cost of the belief map (``inf`` = obstacle).
 
+    A free cell costs 1 and an unknown one ``unknown_cost``. Believed walls (and ``blocked``
+    cells) are obstacles, inflated by ``lethal_radius_m``; cells within the robot's radius of a
+    wall cost ``inflation_cost`` more, falling linearly to 0 at ``radius_m + clearance_m``. The
+    map's walls are blurred estimates, so the default inflation is soft: a doorway narrower
+    than the estimate stays passable, at a price.
+
     Args:
         belief_u8: The belief map, ``[row, col]``.
         resolution_m: Cell size, metres.
-        radius_m: Robot radius: cells whose centre lies within it of a wall cell are obstacles.
-        unknown_cost: Cost of an unknown cell (a free cell costs 1).
-        clearance_m: Beyond the radius, cells within this extra distance of a wall cost more.
-        clearance_cost: Extra cost at the inflated obstacle's edge, falling linearly to 0 at
-            ``radius_m + clearance_m``.
-        blocked: Optional extra obstacle mask (e.g. cells the agent has found impassable).
+        radius_m: Robot radius, metres.
+        unknown_cost: Cost of an unknown cell.
+        inflation_cost: Extra cost of a cell within ``radius_m`` of a wall.
+        clearance_m: Width of the falling cost band beyond the radius.
+        lethal_radius_m: Cells within this of a wall are obstacles (default: half a cell, i.e.
+            only the wall cells themselves).
+        blocked: Optional extra obstacle mask (e.g. where the robot bumped).
 
     Returns:
         float64 array of the belief's shape.
     """
-    free, wall, unknown = belief_classes(belief_u8)
+    _, wall, unknown = belief_classes(belief_u8)
     if blocked is not None:
         wall = wall | blocked
     cost = np.where(unknown, float(unknown_cost), 1.0)
     if wall.any():
         dist = ndimage.distance_transform_edt(~wall) * resolution_m
-        near = (dist > radius_m) & (dist < radius_m + clearance_m)
-        cost[near] += clearance_cost * (radius_m + clearance_m - dist[near]) / clearance_m
-        cost[dist <= radius_m] = np.inf
+        outer = radius_m + clearance_m
+        band = dist < outer
+        cost[band] += inflation_cost * np.clip((outer - dist[band]) / clearance_m, 0.0, 1.0)
+        lethal = 0.5 * resolution_m if lethal_radius_m is None else lethal_radius_m
+        cost[dist <= lethal] = np.inf
     return cost
 
 

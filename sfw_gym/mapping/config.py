@@ -31,6 +31,10 @@ class MapperConfig:
             removed); ``"kmeans"`` clusters raw RSSI (the paper).
         max_k: Largest k-value the estimator can output (K; K + 1 k-means clusters).
         filter_window: Length of the sliding-window mean over each router's readings (1 = off).
+        filter_reset_db: Edge-preserving filter: a reading farther than this from every reading
+            in the window starts a new window (the robot crossed into another k; averaging
+            across the step would make features between two levels, misread and mis-fitted).
+            None: half of ``prior_wall_loss_db``; 0: a plain sliding mean.
         path_loss_exponent: n in the log-distance term of the distance-aware feature.
         min_distance_m: Near field: distances below this are raised to it in the log-distance
             term, and such readings are not used to fit thresholds (the model fails there).
@@ -76,6 +80,7 @@ class MapperConfig:
     k_estimator: str = "distance_aware"
     max_k: int = 3
     filter_window: int = 3
+    filter_reset_db: float | None = None
     path_loss_exponent: float = 2.0
     min_distance_m: float = 1.0
     refit_min_samples: int = 32
@@ -154,6 +159,12 @@ class MapperConfig:
         p = self.wall_peak_probability
         if not _is_number(p) or not 0.5 < p < 1.0:
             raise ConfigError(f"wall_peak_probability must be in (0.5, 1), got {p!r}")
+        if self.filter_reset_db is not None and (
+            not _is_number(self.filter_reset_db) or self.filter_reset_db < 0
+        ):
+            raise ConfigError(
+                f"filter_reset_db must be None or a finite number >= 0, got {self.filter_reset_db!r}"
+            )
         if self.k0_level_dbm is not None:
             if not _is_number(self.k0_level_dbm):
                 raise ConfigError(f"k0_level_dbm must be None or finite, got {self.k0_level_dbm!r}")

@@ -47,6 +47,8 @@ from sfw_gym.mapping.config import MapperConfig
 
 NOT_HEARD_DBM = -100.0
 _THREADPOOLS = None  # threadpoolctl.ThreadpoolController, created at the first fit
+import os
+EXTRA = int(os.environ.get("EXTRA", "0"))
 
 
 @njit(cache=True)
@@ -70,6 +72,7 @@ def add_samples(
     min_distance,
     prior_gap,
     calibrated,
+    reset_db,
     ring,
     ring_pos,
     ring_count,
@@ -104,6 +107,17 @@ def add_samples(
         if distance_aware:
             d = max(dist[r], min_distance)
             f += 10.0 * path_loss_exponent * np.log10(d)
+        if reset_db > 0.0 and ring_count[r] > 0:
+            # A new level (the robot crossed a shadow line): restart the window, so no sample
+            # averages two levels. "New" = farther than reset_db from every reading held.
+            near = False
+            for j in range(ring_count[r]):
+                if abs(ring[r, j] - f) <= reset_db:
+                    near = True
+                    break
+            if not near:
+                ring_count[r] = 0
+                ring_pos[r] = 0
         ring[r, ring_pos[r]] = f
         ring_pos[r] = (ring_pos[r] + 1) % window
         if ring_count[r] < window:
@@ -223,7 +237,7 @@ def fit_levels(data: np.ndarray, max_k: int, min_gap_db: float, min_fraction: fl
     uniq = np.unique(x)
     if uniq.size < 2:
         return None
-    n_clusters = min(max_k + 1, uniq.size)
+    n_clusters = min(max_k + 1 + EXTRA, uniq.size)
     init = np.quantile(x, (np.arange(n_clusters) + 0.5) / n_clusters)
     if np.unique(init).size < n_clusters:
         init = np.quantile(uniq, (np.arange(n_clusters) + 0.5) / n_clusters)
@@ -263,6 +277,10 @@ class KEstimator:
             raise ConfigError(f"config must be a MapperConfig, got {type(self.config).__name__}")
         self.n_routers = n = int(n_routers)
         cfg = self.config
+        #: Effective restart distance of the edge-preserving filter (0 = plain sliding mean).
+        self.filter_reset_db = (
+            0.5 * cfg.prior_wall_loss_db if cfg.filter_reset_db is None else cfg.filter_reset_db
+        )
         self._ring = np.zeros((n, cfg.filter_window))
         self._ring_pos = np.zeros(n, np.int64)
         self._ring_count = np.zeros(n, np.int64)
@@ -313,6 +331,7 @@ class KEstimator:
             float(cfg.min_distance_m),
             float(cfg.prior_wall_loss_db),
             cfg.k0_level_dbm is not None,
+            self.filter_reset_db,
             self._ring,
             self._ring_pos,
             self._ring_count,

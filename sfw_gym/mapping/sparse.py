@@ -305,7 +305,8 @@ def _update_kernel(
         if not np.isfinite(rssi[r]):
             return np.nan, False
     (
-        kest_da, kest_n, kest_dmin, kest_gap, kest_cal, ring, ring_pos, ring_count, fit_buf,
+        kest_da, kest_n, kest_dmin, kest_gap, kest_cal, kest_reset, ring, ring_pos, ring_count,
+        fit_buf,
         fit_n, fit_stride, n_seen, n_fit_seen, next_refit, thresholds, n_thr, fitted, prior,
         fit_range, novel, novel_needed,
     ) = kest  # fmt: skip
@@ -324,7 +325,7 @@ def _update_kernel(
     for r in range(n_r):
         dist_buf[r] = res * np.sqrt((gx - routers_g[r, 0]) ** 2 + (gy - routers_g[r, 1]) ** 2)
     due = add_samples(
-        rssi, dist_buf, kest_da, kest_n, kest_dmin, kest_gap, kest_cal, ring, ring_pos,
+        rssi, dist_buf, kest_da, kest_n, kest_dmin, kest_gap, kest_cal, kest_reset, ring, ring_pos,
         ring_count, fit_buf, fit_n, fit_stride, n_seen, n_fit_seen, next_refit, thresholds, n_thr,
         fitted, prior, fit_range, novel, novel_needed, feature, k_out,
     )  # fmt: skip

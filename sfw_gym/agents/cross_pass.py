@@ -1,0 +1,266 @@
+"""Frontier exploration plus the paper's cross-connecting passes between router dominance zones.
+
+The sparse mapper updates only along the strongest router's ray (Kim et al., arXiv:2408.07757).
+A cell owned by router A near the border of B's zone lies on A-rays only to points beyond it, in
+B's zone, where the robot uses B's rays instead; so a band of unknown cells stays along the
+borders between dominance zones whatever the route. The paper's remedy is to cross those borders
+on purpose. Here the robot estimates the zones itself — a log-distance model of every router
+(``rssi = c_r − 10 n log10 d``; the offset ``c_r`` fitted to its own RSSI history), corrected near
+its path by the residuals it measured (inverse-distance weighting) — finds the unknown cells
+within ``band_m`` of a zone border, and, when such a band lies near its route, inserts a short
+cross-connecting pass: a closed loop of two legs along the border, one on each side, joined by two
+crossings perpendicular to it. The leg on the far side lays trajectory points beyond the band on
+the near router's rays; the leg on the near side then updates the band between them (and the
+second crossing does the same for the other router's side).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from scipy import ndimage
+from scipy.spatial import cKDTree
+
+from sfw_gym.agents.base import RobotView, check_fraction
+from sfw_gym.agents.frontier import FrontierAgent, Goal
+from sfw_gym.agents.planning import CostField, belief_classes
+from sfw_gym.errors import ConfigError
+from sfw_gym.mapping.grid import GridSpec
+from sfw_gym.world import NOT_HEARD_DBM
+
+
+def router_scores(
+    grid: GridSpec,
+    routers_xy: np.ndarray,
+    samples_xy: np.ndarray | None = None,
+    samples_rssi: np.ndarray | None = None,
+    *,
+    path_loss_exponent: float = 2.0,
+    residual_radius_m: float = 2.0,
+) -> np.ndarray:
+    """Predicted RSSI (dBm, up to a common constant) of every router at every cell.
+
+    The log-distance model ``c_r − 10 n log10(max(d, 1 m))``; with samples, ``c_r`` is the
+    median offset of router r's heard readings, and the residuals at the samples are spread to
+    cells within ``residual_radius_m`` by inverse-distance weighting (walls the robot measured).
+
+    Args:
+        grid: The map geometry.
+        routers_xy: ``(R, 2)`` router positions.
+        samples_xy: ``(T, 2)`` positions of the readings (the robot's odometry).
+        samples_rssi: ``(T, R)`` readings, dBm (``NOT_HEARD_DBM`` when not heard).
+        path_loss_exponent: ``n``.
+        residual_radius_m: Reach of a reading's residual.
+
+    Returns:
+        ``(R, n_rows, n_cols)`` float64.
+    """
+    xs, ys = grid.cell_centres()
+    cells = np.stack([xs.ravel(), ys.ravel()], axis=1)
+    routers = np.asarray(routers_xy, np.float64).reshape(-1, 2)
+
+    def model(points: np.ndarray) -> np.ndarray:
+        d = np.linalg.norm(points[:, None, :] - routers[None, :, :], axis=2)
+        return -10.0 * path_loss_exponent * np.log10(np.maximum(d, 1.0))
+
+    scores = model(cells)
+    if samples_xy is not None and samples_rssi is not None and len(samples_xy):
+        pts = np.asarray(samples_xy, np.float64).reshape(-1, 2)
+        rssi = np.asarray(samples_rssi, np.float64).reshape(len(pts), -1)
+        resid = rssi - model(pts)
+        heard = rssi > NOT_HEARD_DBM
+        tree = cKDTree(pts)
+        k = min(8, len(pts))
+        dist, idx = tree.query(cells, k=k, distance_upper_bound=residual_radius_m)
+        dist, idx = dist.reshape(len(cells), k), idx.reshape(len(cells), k)
+        found = np.isfinite(dist)
+        idx = np.where(found, idx, 0)
+        for r in range(routers.shape[0]):
+            if not heard[:, r].any():
+                scores[:, r] = -np.inf
+                continue
+            offset = float(np.median(resid[heard[:, r], r]))
+            e = np.where(heard[:, r], resid[:, r] - offset, 0.0)
+            w = np.where(found & heard[idx, r], 1.0 / (dist + 0.3) ** 2, 0.0)
+            wsum = w.sum(axis=1)
+            local = np.where(wsum > 0, (w * e[idx]).sum(axis=1) / np.maximum(wsum, 1e-12), 0.0)
+            scores[:, r] += offset + local
+    return scores.T.reshape(routers.shape[0], *grid.shape)
+
+
+def dominance_bands(scores: np.ndarray, band_cells: float) -> tuple[np.ndarray, np.ndarray]:
+    """The strongest router per cell and the cells within ``band_cells`` of a zone border.
+
+    Args:
+        scores: ``(R, H, W)`` predicted RSSI per router.
+        band_cells: Half-width of the band, in cells.
+
+    Returns:
+        ``(zone, band)``: ``(H, W)`` int router index, ``(H, W)`` bool.
+    """
+    zone = np.argmax(scores, axis=0)
+    border = np.zeros(zone.shape, bool)
+    border[:-1, :] |= zone[:-1, :] != zone[1:, :]
+    border[1:, :] |= zone[1:, :] != zone[:-1, :]
+    border[:, :-1] |= zone[:, :-1] != zone[:, 1:]
+    border[:, 1:] |= zone[:, 1:] != zone[:, :-1]
+    if not border.any():
+        return zone, border
+    band = ndimage.distance_transform_edt(~border) <= band_cells
+    return zone, band
+
+
+class CrossPassAgent(FrontierAgent):
+    """:class:`FrontierAgent` with cross-connecting passes across router-zone borders.
+
+    Args:
+        band_m: Half-width of the band along a zone border whose unknown cells a pass targets.
+        min_band_area_m2: Unknown band clusters smaller than this get no pass.
+        pass_trigger_m: A pass is inserted only for bands within this path distance.
+        pass_length_m: Length of each leg along the border.
+        pass_offset_m: Distance of each leg from the border.
+        zones_every_steps: Re-estimate the zones this often.
+        **frontier_params: Parameters of :class:`FrontierAgent`.
+    """
+
+    name = "cross-pass"
+    _committed_kinds = ("pass",)
+
+    def __init__(
+        self,
+        band_m: float = 0.8,
+        min_band_area_m2: float = 0.3,
+        pass_trigger_m: float = 5.0,
+        pass_length_m: float = 2.0,
+        pass_offset_m: float = 0.7,
+        zones_every_steps: int = 25,
+        **frontier_params: Any,
+    ) -> None:
+        super().__init__(**frontier_params)
+        self.band_m = check_fraction("band_m", band_m, 0.05)
+        self.min_band_area_m2 = check_fraction("min_band_area_m2", min_band_area_m2)
+        self.pass_trigger_m = check_fraction("pass_trigger_m", pass_trigger_m)
+        self.pass_length_m = check_fraction("pass_length_m", pass_length_m, 0.1)
+        self.pass_offset_m = check_fraction("pass_offset_m", pass_offset_m, 0.05)
+        if isinstance(zones_every_steps, bool) or not isinstance(zones_every_steps, int) or (
+            zones_every_steps < 1
+        ):
+            raise ConfigError(f"zones_every_steps must be an int >= 1, got {zones_every_steps!r}")
+        self.zones_every_steps = zones_every_steps
+
+    def _on_reset(self, view: RobotView) -> None:
+        super()._on_reset(view)
+        self.passed = np.zeros(view.grid.shape, bool)  # band cells a pass has targeted
+        self.n_passes = 0
+        self._zones_at = -(10**9)
+        self.scores: np.ndarray | None = None
+        self.zone: np.ndarray | None = None
+        self.band: np.ndarray | None = None
+
+    def _update_zones(self, view: RobotView) -> None:
+        if self.steps - self._zones_at < self.zones_every_steps and self.scores is not None:
+            return
+        self._zones_at = self.steps
+        traj = np.asarray(self.trajectory, np.float64).reshape(-1, 2)
+        hist = view.rssi_history
+        n = min(len(traj), len(hist))
+        self.scores = router_scores(
+            view.grid, view.routers_xy, traj[len(traj) - n :], hist[len(hist) - n :]
+        )
+        self.zone, self.band = dominance_bands(self.scores, self.band_m / view.grid.resolution_m)
+
+    def _choose_goal(self, view: RobotView, paths: CostField) -> Goal | None:
+        if len(view.routers_xy) > 1:
+            self._update_zones(view)
+            goal = self._pass_goal(view, paths)
+            if goal is not None:
+                self.n_passes += 1
+                return goal
+        return super()._choose_goal(view, paths)
+
+    def unknown_band(self, view: RobotView) -> np.ndarray:
+        """Unknown cells in the estimated border bands not yet targeted by a pass."""
+        if self.band is None:
+            return np.zeros(view.grid.shape, bool)
+        _, _, unknown = belief_classes(view.belief_u8)
+        return self.band & unknown & ~self.passed & ~self._frontier_exclusion(view)
+
+    def _pass_goal(self, view: RobotView, paths: CostField) -> Goal | None:
+        res = view.grid.resolution_m
+        targets = self.unknown_band(view) & paths.reachable()
+        if not targets.any():
+            return None
+        labels, n = ndimage.label(targets, structure=np.ones((3, 3), bool))
+        sizes = np.bincount(labels.ravel(), minlength=n + 1)
+        sizes[0] = 0
+        cost = np.where(labels > 0, paths.cumulative, np.inf)
+        min_cells = self.min_band_area_m2 / res**2
+        best_cost = ndimage.minimum(cost, labels, index=np.arange(1, n + 1))
+        order = np.argsort(best_cost)
+        for i in order:
+            lab = i + 1
+            if best_cost[i] > self.pass_trigger_m:
+                break
+            if sizes[lab] < min_cells:
+                continue
+            rows, cols = np.nonzero(labels == lab)
+            self.passed[rows, cols] = True
+            waypoints = self._pass_waypoints(view, paths, rows, cols)
+            if len(waypoints) >= 2:
+                return Goal(waypoints[0], waypoints[0], "pass", waypoints=waypoints[1:])
+        return None
+
+    def _pass_waypoints(
+        self, view: RobotView, paths: CostField, rows: np.ndarray, cols: np.ndarray
+    ) -> list[tuple[int, int]]:
+        """A closed loop across the border at a band cluster: far leg, crossing, near leg, back."""
+        assert self.scores is not None and self.zone is not None
+        grid = view.grid
+        c_rc = (int(np.median(rows)), int(np.median(cols)))
+        a = int(self.zone[c_rc])
+        others = [r for r in range(len(self.scores)) if r != a]
+        b = max(others, key=lambda r: self.scores[r][c_rc])
+        diff = self.scores[a] - self.scores[b]
+        gy, gx = np.gradient(diff)
+        normal = np.array([gx[c_rc], gy[c_rc]])
+        if not np.isfinite(normal).all() or np.linalg.norm(normal) < 1e-9:
+            normal = view.routers_xy[a] - view.routers_xy[b]
+        normal = normal / max(np.linalg.norm(normal), 1e-9)  # towards router a's side
+        tangent = np.array([-normal[1], normal[0]])
+        centre = grid.cell_to_world(np.array(c_rc))
+        # Move the centre onto the border: along the normal by diff / |gradient| (dB / dB-per-m).
+        slope = float(np.hypot(gx[c_rc], gy[c_rc])) / grid.resolution_m
+        if np.isfinite(slope) and slope > 1e-6:
+            centre = centre - normal * np.clip(diff[c_rc] / slope, -self.band_m, self.band_m)
+        half, off = 0.5 * self.pass_length_m, self.pass_offset_m
+        corners = [
+            centre - normal * off - tangent * half,  # far side (router b's zone)
+            centre - normal * off + tangent * half,
+            centre + normal * off + tangent * half,  # near side (router a's zone)
+            centre + normal * off - tangent * half,
+        ]
+        # Start at the corner nearest the robot, keep the loop's order, close it.
+        start = int(np.argmin([np.linalg.norm(p - view.xy) for p in corners[:2]]))
+        if start == 1:
+            corners = [corners[1], corners[0], corners[3], corners[2]]
+        corners.append(corners[0])
+        out: list[tuple[int, int]] = []
+        for p in corners:
+            cell = self._snap(paths, grid, p, centre)
+            if cell is not None and (not out or cell != out[-1]):
+                out.append(cell)
+        return out
+
+    @staticmethod
+    def _snap(
+        paths: CostField, grid: GridSpec, p: np.ndarray, towards: np.ndarray
+    ) -> tuple[int, int] | None:
+        """The first reachable cell from ``p`` towards ``towards`` (None if none)."""
+        h, w = grid.shape
+        for t in np.linspace(0.0, 1.0, 8):
+            q = p + (towards - p) * t
+            r, c = (int(v) for v in grid.world_to_cell(q))
+            if 0 <= r < h and 0 <= c < w and np.isfinite(paths.cumulative[r, c]):
+                return r, c
+        return None

@@ -1,0 +1,267 @@
+"""PPO training (stable-baselines3) with checkpoints, resume, held-out evaluation and a curve.
+
+Layout of an output folder::
+
+    OUT/checkpoints/ppo_<steps>_steps.zip   every ``checkpoint_every`` env steps
+    OUT/tb/                                 TensorBoard logs
+    OUT/train_<start>.monitor.csv           episode returns (one file per run segment)
+    OUT/eval/evaluations.npz                held-out evaluation (EvalCallback)
+    OUT/model.zip                           the final model (written atomically)
+    OUT/config.yml                          hyperparameters, env, seeds, command, wall time
+    OUT/training_curve.png                  episode return and held-out return vs env steps
+"""
+
+from __future__ import annotations
+
+import ast
+import os
+import re
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from sfw_gym.errors import ConfigError
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+DEFAULT_HYPERPARAMS = REPO_ROOT / "agents" / "hyperparams" / "ppo.yml"
+#: Evaluation episodes draw their floorplans from seeds this far from the training seeds.
+HELD_OUT_SEED_OFFSET = 1_000_000
+_PPO_KEYS = {
+    "n_steps", "batch_size", "n_epochs", "gamma", "gae_lambda", "learning_rate", "clip_range",
+    "ent_coef", "vf_coef", "max_grad_norm", "policy_kwargs",
+}  # fmt: skip
+
+
+def load_hyperparams(env_id: str, path: str | Path = DEFAULT_HYPERPARAMS) -> dict[str, Any]:
+    """The rl-zoo YAML block for ``env_id`` (``policy_kwargs`` parsed safely)."""
+    path = Path(path)
+    try:
+        table = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, yaml.YAMLError) as exc:
+        raise ConfigError(f"{path}: cannot read hyperparameters: {exc}") from exc
+    if not isinstance(table, dict) or env_id not in table:
+        known = sorted(table) if isinstance(table, dict) else []
+        raise ConfigError(f"{path}: no hyperparameters for {env_id!r}; blocks: {known}")
+    params = dict(table[env_id])
+    if isinstance(params.get("policy_kwargs"), str):
+        params["policy_kwargs"] = parse_policy_kwargs(params["policy_kwargs"])
+    unknown = set(params) - _PPO_KEYS - {"policy", "n_timesteps", "n_envs", "normalize"}
+    if unknown:
+        raise ConfigError(f"{path}: unknown keys for {env_id!r}: {sorted(unknown)}")
+    return params
+
+
+def parse_policy_kwargs(text: str) -> dict[str, Any]:
+    """Evaluate rl-zoo's ``policy_kwargs`` string allowing only dict(...) calls and literals."""
+
+    def value(node: ast.AST) -> Any:
+        if (
+            isinstance(node, ast.Call)
+            and isinstance(node.func, ast.Name)
+            and node.func.id == "dict"
+        ):
+            if node.args:
+                raise ConfigError(f"policy_kwargs: dict() takes keywords only: {text!r}")
+            return {kw.arg: value(kw.value) for kw in node.keywords}
+        if isinstance(node, ast.List | ast.Tuple):
+            return [value(e) for e in node.elts]
+        if isinstance(node, ast.Dict):
+            return {value(k): value(v) for k, v in zip(node.keys, node.values, strict=True)}
+        if isinstance(node, ast.Constant):
+            return node.value
+        raise ConfigError(f"policy_kwargs: only dict(...) and literals are allowed: {text!r}")
+
+    try:
+        tree = ast.parse(text, mode="eval")
+    except SyntaxError as exc:
+        raise ConfigError(f"policy_kwargs: not a Python expression: {text!r}") from exc
+    out = value(tree.body)
+    if not isinstance(out, dict):
+        raise ConfigError(f"policy_kwargs must be a dict, got {text!r}")
+    return out
+
+
+def latest_checkpoint(out_dir: Path) -> tuple[Path, int] | None:
+    """The checkpoint with the most env steps in ``OUT/checkpoints``, if any."""
+    found = []
+    for path in (out_dir / "checkpoints").glob("ppo_*_steps.zip"):
+        match = re.fullmatch(r"ppo_(\d+)_steps\.zip", path.name)
+        if match:
+            found.append((int(match.group(1)), path))
+    if not found:
+        return None
+    steps, path = max(found)
+    return path, steps
+
+
+def _make_env_fn(env_id: str, env_kwargs: dict[str, Any]):
+    def make() -> Any:
+        import gymnasium as gym
+
+        return gym.make(env_id, **env_kwargs)
+
+    return make
+
+
+def _make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], monitor: Path):
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecMonitor
+
+    # Workers start by forkserver and have not imported sfw_gym: name the module in the id.
+    qualified = env_id if ":" in env_id else f"sfw_gym:{env_id}"
+    fns = [_make_env_fn(qualified, env_kwargs) for _ in range(n_envs)]
+    venv = SubprocVecEnv(fns) if n_envs > 1 else DummyVecEnv(fns)
+    venv.seed(seed)
+    return VecMonitor(venv, filename=str(monitor))
+
+
+def train_ppo(
+    env_id: str,
+    timesteps: int,
+    out_dir: str | Path,
+    *,
+    n_envs: int | None = None,
+    seed: int = 0,
+    hyperparams_path: str | Path = DEFAULT_HYPERPARAMS,
+    env_kwargs: dict[str, Any] | None = None,
+    checkpoint_every: int = 50_000,
+    eval_every: int = 25_000,
+    eval_episodes: int = 5,
+    resume: bool = False,
+    progress_bar: bool = True,
+    device: str = "auto",
+) -> dict[str, Any]:
+    """Train (or resume training) PPO on ``env_id`` up to ``timesteps`` env steps in total.
+
+    With ``resume=True`` the latest checkpoint in ``OUT/checkpoints`` is loaded and training
+    continues from its step count (the step counter, optimiser and rollout schedule carry on);
+    without a checkpoint it starts afresh. Returns a summary (steps, wall time, paths).
+    """
+    import sfw_gym  # noqa: F401  (registration in this process)
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback, EvalCallback
+
+    if timesteps < 1:
+        raise ConfigError(f"timesteps must be ≥ 1, got {timesteps}")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    params = load_hyperparams(env_id, hyperparams_path)
+    n_envs = int(n_envs or params.get("n_envs", 1))
+    policy = params.get("policy", "MultiInputPolicy")
+    ppo_kwargs = {k: v for k, v in params.items() if k in _PPO_KEYS}
+    env_kwargs = dict(env_kwargs or {})
+
+    previous = latest_checkpoint(out) if resume else None
+    start_steps = previous[1] if previous else 0
+    if start_steps >= timesteps:
+        return {"steps": start_steps, "resumed_from": str(previous[0]), "wall_time_s": 0.0,
+                "model": str(out / "model.zip")}  # fmt: skip
+    venv = _make_venv(env_id, n_envs, seed + start_steps, env_kwargs,
+                      out / f"train_{start_steps}.monitor.csv")  # fmt: skip
+    eval_env = _make_venv(env_id, 1, seed + HELD_OUT_SEED_OFFSET, env_kwargs,
+                          out / f"eval_{start_steps}.monitor.csv")  # fmt: skip
+    try:
+        if previous:
+            model = PPO.load(previous[0], env=venv, device=device,
+                             tensorboard_log=str(out / "tb"))  # fmt: skip
+        else:
+            model = PPO(policy, venv, seed=seed, device=device, verbose=0,
+                        tensorboard_log=str(out / "tb"), **ppo_kwargs)  # fmt: skip
+        callbacks = CallbackList([
+            CheckpointCallback(max(checkpoint_every // n_envs, 1), str(out / "checkpoints"),
+                               name_prefix="ppo"),
+            EvalCallback(eval_env, n_eval_episodes=eval_episodes,
+                         eval_freq=max(eval_every // n_envs, 1), log_path=str(out / "eval"),
+                         best_model_save_path=None, deterministic=True, verbose=0),
+        ])  # fmt: skip
+        start = time.perf_counter()
+        model.learn(total_timesteps=timesteps - start_steps, callback=callbacks,
+                    reset_num_timesteps=previous is None, progress_bar=progress_bar,
+                    tb_log_name="ppo")  # fmt: skip
+        wall = time.perf_counter() - start
+        _save_atomic(model, out / "model.zip")
+        # A final checkpoint, so that a later resume starts from the end of this run.
+        _save_atomic(model, out / "checkpoints" / f"ppo_{model.num_timesteps}_steps.zip")
+    finally:
+        venv.close()
+        eval_env.close()
+    summary = {
+        "env_id": env_id,
+        "steps": int(model.num_timesteps),
+        "resumed_from": str(previous[0]) if previous else None,
+        "wall_time_s": round(wall, 1),
+        "n_envs": n_envs,
+        "seed": seed,
+        "hyperparameters": params,
+        "env_kwargs": env_kwargs,
+        "command": " ".join(sys.argv),
+        "model": str(out / "model.zip"),
+    }
+    _write_yaml_atomic(out / "config.yml", summary)
+    plot_training_curve(out)
+    return summary
+
+
+def _save_atomic(model: Any, path: Path) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.stem}.tmp.zip")
+    model.save(tmp)
+    os.replace(tmp, path)
+
+
+def _write_yaml_atomic(path: Path, data: dict[str, Any]) -> None:
+    from sfw_gym.world.floorplan import write_text_atomic
+
+    write_text_atomic(path, yaml.safe_dump(data, sort_keys=False))
+
+
+def plot_training_curve(out_dir: str | Path) -> Path | None:
+    """Episode return (training, smoothed) and held-out evaluation return vs env steps → PNG."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = Path(out_dir)
+    steps, returns = [], []
+
+    def start_of(path: Path) -> int:
+        return int(path.name.split("_")[1].split(".")[0])
+
+    for csv in sorted(out.glob("train_*.monitor.csv"), key=start_of):
+        offset_steps = start_of(csv)
+        lines = csv.read_text().splitlines()[2:]  # a JSON header line, then the column names
+        if not lines:
+            continue
+        data = np.loadtxt(lines, delimiter=",", ndmin=2)
+        # columns r, l, t: cumulative episode lengths give the env step at each episode's end
+        steps.extend(offset_steps + np.cumsum(data[:, 1]) * 1.0)
+        returns.extend(data[:, 0])
+    evals = out / "eval" / "evaluations.npz"
+    if not steps and not evals.exists():
+        return None
+    fig, ax = plt.subplots(figsize=(7, 4))
+    if steps:
+        order = np.argsort(steps)
+        s, r = np.asarray(steps)[order], np.asarray(returns)[order]
+        ax.plot(s, r, ".", alpha=0.25, label="training episodes")
+        k = max(1, len(r) // 20)
+        ax.plot(s, np.convolve(r, np.ones(k) / k, mode="same"), label=f"training (mean of {k})")
+    if evals.exists():
+        ev = np.load(evals)
+        ax.errorbar(ev["timesteps"], ev["results"].mean(1), yerr=ev["results"].std(1), fmt="o-",
+                    label="held-out seeds")  # fmt: skip
+    ax.set_xlabel("env steps")
+    ax.set_ylabel("episode return (≈ m² mapped)")
+    ax.legend()
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    path = out / "training_curve.png"
+    tmp = out / ".training_curve.tmp.png"
+    fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    os.replace(tmp, path)
+    return path

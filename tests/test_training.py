@@ -1,0 +1,67 @@
+"""PPO training: hyperparameters, and a run killed mid-way resumes from its checkpoint."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import pytest
+
+from sfw_gym.errors import ConfigError
+from sfw_gym.training import (
+    DEFAULT_HYPERPARAMS,
+    latest_checkpoint,
+    load_hyperparams,
+    parse_policy_kwargs,
+    train_ppo,
+)
+
+TINY = {"max_steps": 40}
+
+
+def test_hyperparams_load_for_every_block():
+    params = load_hyperparams("SfW-Explore-v0")
+    assert params["policy"] == "MultiInputPolicy"
+    assert params["policy_kwargs"]["net_arch"] == {"pi": [128], "vf": [128]}
+    with pytest.raises(ConfigError, match="no hyperparameters"):
+        load_hyperparams("CartPole-v1", DEFAULT_HYPERPARAMS)
+
+
+def test_policy_kwargs_are_parsed_safely():
+    assert parse_policy_kwargs("dict(a=[1, 2], b=dict(c=True))") == {"a": [1, 2], "b": {"c": True}}
+    with pytest.raises(ConfigError, match="only dict"):
+        parse_policy_kwargs("dict(activation_fn=__import__('os').system('true'))")
+
+
+def test_killed_run_resumes_from_its_last_checkpoint(tmp_path):
+    out = tmp_path / "run"
+    script = textwrap.dedent(f"""
+        from sfw_gym.training import train_ppo
+        train_ppo("SfW-ExploreSmall-v0", 100_000, {str(out)!r}, n_envs=1, env_kwargs={TINY!r},
+                  checkpoint_every=64, eval_every=10**9, progress_bar=False)
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", script])
+    try:
+        deadline = time.monotonic() + 240
+        while time.monotonic() < deadline:
+            found = latest_checkpoint(out)
+            if found and found[1] >= 128:
+                break
+            assert proc.poll() is None, "training ended before it was killed"
+            time.sleep(0.5)
+        else:
+            pytest.fail("no checkpoint within 240 s")
+    finally:
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()
+    path, steps = latest_checkpoint(out)
+    target = steps + 128
+    summary = train_ppo("SfW-ExploreSmall-v0", target, out, n_envs=1, env_kwargs=TINY,
+                        checkpoint_every=64, eval_every=10**9, resume=True, progress_bar=False)  # fmt: skip
+    assert summary["resumed_from"] == str(path)
+    assert target <= summary["steps"] < target + 128  # continued, not restarted from 0
+    assert latest_checkpoint(out)[1] == summary["steps"]
+    assert (out / "model.zip").exists() and (out / "config.yml").exists()
