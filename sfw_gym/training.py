@@ -140,9 +140,10 @@ def train_ppo(
     continues from its step count (the step counter, optimiser and rollout schedule carry on);
     without a checkpoint it starts afresh. Returns a summary (steps, wall time, paths).
     """
-    import sfw_gym  # noqa: F401  (registration in this process)
     from stable_baselines3 import PPO
     from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback, EvalCallback
+
+    import sfw_gym  # noqa: F401  (registration in this process)
 
     if timesteps < 1:
         raise ConfigError(f"timesteps must be ≥ 1, got {timesteps}")
