@@ -121,6 +121,39 @@ def _cmd_train(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_evaluate(args: argparse.Namespace) -> int:
+    import json
+    from pathlib import Path
+
+    from sfw_gym.evaluate import evaluate
+
+    def _json(option: str, text: str | None) -> dict:
+        try:
+            value = json.loads(text) if text else {}
+        except json.JSONDecodeError as exc:
+            raise ConfigError(f"{option}: not valid JSON ({exc})") from None
+        if not isinstance(value, dict):
+            raise ConfigError(f"{option}: expected a JSON object, got {text!r}")
+        return value
+
+    result = evaluate(
+        [a.strip() for a in args.agents.split(",") if a.strip()],
+        args.episodes,
+        args.seed,
+        out=args.out,
+        env_id=args.env,
+        floorplans=args.floorplans,
+        env_kwargs=_json("--env-kwargs", args.env_kwargs),
+        agent_params=_json("--agent-params", args.agent_params),
+        workers=args.workers,
+        gif_episodes=args.gif_episodes if args.gif else 0,
+        progress=not args.no_progress,
+    )
+    print((Path(args.out) / "results.md").read_text(encoding="utf-8"), end="")
+    print(f"wrote {len(result['files'])} files under {args.out}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of every subcommand."""
     parser = argparse.ArgumentParser(
@@ -196,6 +229,30 @@ def build_parser() -> argparse.ArgumentParser:
     train.add_argument("--resume", action="store_true", help="continue from the last checkpoint")
     train.add_argument("--no-progress", action="store_true", help="no progress bar")
     train.set_defaults(func=_cmd_train)
+    ev = sub.add_parser(
+        "evaluate", help="compare agents on the same floorplans and seeds (table, curves, paths)"
+    )
+    ev.add_argument(
+        "--agents", default="frontier,cross-pass,random",
+        help="comma-separated: frontier, cross-pass, greedy, random (default: all but greedy)",
+    )  # fmt: skip
+    ev.add_argument("--episodes", type=int, default=10, help="episodes per agent (default 10)")
+    ev.add_argument("--seed", type=int, default=0, help="episode i uses reset(seed=SEED + i)")
+    ev.add_argument(
+        "--floorplans", default=None, help="folder of plan files (cycled) or one file; "
+        "default: the env's procedural plans",
+    )  # fmt: skip
+    ev.add_argument("--env", default="SfW-Explore-v0", help="env id (default SfW-Explore-v0)")
+    ev.add_argument("--env-kwargs", default=None, help="extra gym.make kwargs as JSON")
+    ev.add_argument(
+        "--agent-params", default=None, help='per-agent parameters as JSON: {"frontier": {...}}'
+    )
+    ev.add_argument("--out", default="evaluation", help="output folder (resumes from it)")
+    ev.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    ev.add_argument("--gif", action="store_true", help="also write GIFs of the first episodes")
+    ev.add_argument("--gif-episodes", type=int, default=1, help="episodes per agent with a GIF")
+    ev.add_argument("--no-progress", action="store_true", help="no progress bar")
+    ev.set_defaults(func=_cmd_evaluate)
     return parser
 
 

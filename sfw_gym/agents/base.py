@@ -114,9 +114,10 @@ class Agent(ABC):
 
     Attributes:
         name: Short name used on the command line and in tables (``"frontier"``).
-        stop_reason: ``None`` while the agent has something to do; else why it stopped looking
-            for goals (one of :data:`STOP_REASONS`). Baselines keep acting (they fall back to
-            sweeping) so that an episode never stalls, but the first reason is kept.
+        stop_reason: ``None`` while the agent pursues goals; else why its goal search came up
+            empty at its latest attempt (one of :data:`STOP_REASONS`). The baselines keep acting
+            meanwhile (they fall back to sweeping), so an episode never stalls; the reason is
+            cleared when a goal turns up again (``max_steps`` is final).
         steps: Actions taken since :meth:`reset`.
     """
 
@@ -196,8 +197,14 @@ class Agent(ABC):
         """``(linear, angular)`` fractions in [-1, 1] for this step."""
 
     def _stop(self, reason: str) -> None:
-        if self.stop_reason is None:
+        """Record why the agent has no goal now (``max_steps`` is final)."""
+        if self.stop_reason != "max_steps":
             self.stop_reason = reason
+
+    def _resume(self) -> None:
+        """The agent has a goal again: clear a ``no_frontiers`` / ``all_blacklisted`` reason."""
+        if self.stop_reason != "max_steps":
+            self.stop_reason = None
 
     def _to_action(self, linear: float, angular: float) -> Any:
         if self.action_type == "discrete":

@@ -5,8 +5,8 @@ A cell owned by router A near the border of B's zone lies on A-rays only to poin
 B's zone, where the robot uses B's rays instead; so a band of unknown cells stays along the
 borders between dominance zones whatever the route. The paper's remedy is to cross those borders
 on purpose. Here the robot estimates the zones itself — a log-distance model of every router
-(``rssi = c_r − 10 n log10 d``; the offset ``c_r`` fitted to its own RSSI history), corrected near
-its path by the residuals it measured (inverse-distance weighting) — finds the unknown cells
+(``rssi = c − 10 n log10 d``, one tx power for all), corrected near its path by the residuals of
+its own RSSI history (inverse-distance weighting) — finds the unknown cells
 within ``band_m`` of a zone border, and, when such a band lies near its route, inserts a short
 cross-connecting pass: a closed loop of two legs along the border, one on each side, joined by two
 crossings perpendicular to it. The leg on the far side lays trajectory points beyond the band on
@@ -41,9 +41,10 @@ def router_scores(
 ) -> np.ndarray:
     """Predicted RSSI (dBm, up to a common constant) of every router at every cell.
 
-    The log-distance model ``c_r − 10 n log10(max(d, 1 m))``; with samples, ``c_r`` is the
-    median offset of router r's heard readings, and the residuals at the samples are spread to
-    cells within ``residual_radius_m`` by inverse-distance weighting (walls the robot measured).
+    The log-distance model ``c − 10 n log10(max(d, 1 m))`` with one tx power for all routers;
+    with samples, each router's residuals at the samples (readings minus the model, minus their
+    common median) are spread to cells within ``residual_radius_m`` by inverse-distance weighting
+    (the walls the robot has measured).
 
     Args:
         grid: The map geometry.
@@ -70,6 +71,8 @@ def router_scores(
         rssi = np.asarray(samples_rssi, np.float64).reshape(len(pts), -1)
         resid = rssi - model(pts)
         heard = rssi > NOT_HEARD_DBM
+        if heard.any():
+            resid = resid - float(np.median(resid[heard]))  # routers share one tx power
         tree = cKDTree(pts)
         k = min(8, len(pts))
         dist, idx = tree.query(cells, k=k, distance_upper_bound=residual_radius_m)
@@ -80,12 +83,10 @@ def router_scores(
             if not heard[:, r].any():
                 scores[:, r] = -np.inf
                 continue
-            offset = float(np.median(resid[heard[:, r], r]))
-            e = np.where(heard[:, r], resid[:, r] - offset, 0.0)
+            e = np.where(heard[:, r], resid[:, r], 0.0)
             w = np.where(found & heard[idx, r], 1.0 / (dist + 0.3) ** 2, 0.0)
             wsum = w.sum(axis=1)
-            local = np.where(wsum > 0, (w * e[idx]).sum(axis=1) / np.maximum(wsum, 1e-12), 0.0)
-            scores[:, r] += offset + local
+            scores[:, r] += np.where(wsum > 0, (w * e[idx]).sum(axis=1) / np.maximum(wsum, 1e-12), 0.0)
     return scores.T.reshape(routers.shape[0], *grid.shape)
 
 

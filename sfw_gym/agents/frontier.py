@@ -172,6 +172,10 @@ class FrontierAgent(Agent):
         turn_cost_m_per_rad: Path metres charged per radian of turning towards a goal, so that
             the robot sweeps on instead of turning back and forth.
         max_bumps_per_goal: A goal is blacklisted after this many bumps on the way to it.
+        unreachable_ttl_steps: A cluster the planner cannot reach is blacklisted this long (the
+            map may open a way later).
+        min_unknown_region_m2: Frontier cells of unknown pockets smaller than this (enclosed by
+            known cells) are not goals: they lead nowhere and fill in as the robot passes by.
         max_steps: Optional step limit of the agent (then ``stop_reason = "max_steps"``).
     """
 
@@ -193,6 +197,8 @@ class FrontierAgent(Agent):
         backoff_steps: int = 1,
         turn_cost_m_per_rad: float = 0.3,
         max_bumps_per_goal: int = 2,
+        unreachable_ttl_steps: int = 200,
+        min_unknown_region_m2: float = 0.5,
         max_steps: int | None = None,
     ) -> None:
         super().__init__(max_steps=max_steps)
@@ -206,13 +212,16 @@ class FrontierAgent(Agent):
         for name, v, lo in (("progress_timeout_steps", progress_timeout_steps, 1),
                             ("replan_every_steps", replan_every_steps, 1),
                             ("backoff_steps", backoff_steps, 0),
-                            ("max_bumps_per_goal", max_bumps_per_goal, 1)):  # fmt: skip
+                            ("max_bumps_per_goal", max_bumps_per_goal, 1),
+                            ("unreachable_ttl_steps", unreachable_ttl_steps, 1)):  # fmt: skip
             if isinstance(v, bool) or not isinstance(v, int) or v < lo:
                 raise ConfigError(f"{name} must be an int >= {lo}, got {v!r}")
         self.progress_timeout_steps = progress_timeout_steps
         self.replan_every_steps = replan_every_steps
         self.backoff_steps = backoff_steps
         self.max_bumps_per_goal = max_bumps_per_goal
+        self.unreachable_ttl_steps = unreachable_ttl_steps
+        self.min_unknown_region_m2 = check_fraction("min_unknown_region_m2", min_unknown_region_m2)
         self.turn_cost_m_per_rad = check_fraction("turn_cost_m_per_rad", turn_cost_m_per_rad)
 
     # -- episode ---------------------------------------------------------------------------------
@@ -220,7 +229,8 @@ class FrontierAgent(Agent):
         res = view.grid.resolution_m
         shape = view.grid.shape
         self.visited = np.zeros(shape, bool)  # within the robot's radius of its path
-        self.blacklisted = np.zeros(shape, bool)
+        self.blacklisted = np.zeros(shape, bool)  # goals that failed (for good)
+        self.unreachable_until = np.zeros(shape, np.int64)  # walled-off frontiers (for a while)
         self.bumps = np.zeros(shape, bool)  # contact regions
         self._visit_radius_cells = view.radius_m / res
         # A goal cell resolves a target when the robot stops within the follower's tolerance of
@@ -232,7 +242,6 @@ class FrontierAgent(Agent):
         self._since_plan = 0
         self._backoff = 0
         self.n_blacklisted = 0
-        self.n_unreachable = 0
         self.n_goals = 0
         self.n_bumps = 0
 
@@ -393,11 +402,21 @@ class FrontierAgent(Agent):
         return int(cells[i, 0]), int(cells[i, 1])
 
     def _frontier_exclusion(self, view: RobotView) -> np.ndarray:
-        """Cells that are not frontier goals: near a bump (walls), or blacklisted."""
+        """Cells that are not frontier goals: near a bump (walls), blacklisted, or in a small
+        unknown pocket inside known space (it will be resolved in passing)."""
+        res = view.grid.resolution_m
         near_bump = ndimage.binary_dilation(
-            self.bumps, iterations=max(1, int(round(self.bump_exclusion_m / self._res)))
+            self.bumps, iterations=max(1, round(self.bump_exclusion_m / res))
         )
-        return near_bump | self.blacklisted
+        exclude = near_bump | self.blacklisted | (self.unreachable_until > self.steps)
+        if self.min_unknown_region_m2 > 0:
+            _, _, unknown = belief_classes(view.belief_u8)
+            labels, n = ndimage.label(unknown, structure=_EIGHT)
+            if n:
+                area = np.bincount(labels.ravel(), minlength=n + 1) * res * res
+                area[0] = np.inf
+                exclude |= area[labels] < self.min_unknown_region_m2
+        return exclude
 
     def _choose_goal(self, view: RobotView, paths: CostField) -> Goal | None:
         res = view.grid.resolution_m
@@ -410,8 +429,11 @@ class FrontierAgent(Agent):
         best: tuple[float, Frontier, tuple[int, int]] | None = None
         for f in find_frontiers(view.belief_u8, min_cells, exclude=exclude):
             cost = approach[f.cells[:, 0], f.cells[:, 1]]
-            if not np.isfinite(cost).any():  # walled off on the belief map: skipped this time
-                self.n_unreachable += 1
+            if not np.isfinite(cost).any():  # walled off on the belief map: blacklisted a while
+                self.unreachable_until[f.cells[:, 0], f.cells[:, 1]] = (
+                    self.steps + self.unreachable_ttl_steps
+                )
+                self.n_blacklisted += 1
                 continue
             i = int(np.argmin(cost))
             u = self._utility(view, f, float(cost[i]))
@@ -421,6 +443,7 @@ class FrontierAgent(Agent):
             self._stop("all_blacklisted")
             return None
         _, f, target = best
+        self._resume()
         return Goal(self._approach_cell(paths, target), target, "frontier")
 
     def _turn_penalty(self, view: RobotView) -> np.ndarray:

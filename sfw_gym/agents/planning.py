@@ -141,6 +141,18 @@ def simplify_path(path_xy: np.ndarray, spacing_m: float) -> np.ndarray:
     return path_xy[keep]
 
 
+def densify_path(path_xy: np.ndarray, spacing_m: float) -> np.ndarray:
+    """Insert points along a polyline so that consecutive points lie at most ``spacing_m`` apart."""
+    if len(path_xy) < 2:
+        return path_xy
+    out = [path_xy[:1]]
+    for a, b in zip(path_xy[:-1], path_xy[1:], strict=True):
+        n = max(1, int(np.ceil(np.linalg.norm(b - a) / spacing_m)))
+        t = np.arange(1, n + 1)[:, None] / n
+        out.append(a + (b - a) * t)
+    return np.concatenate(out)
+
+
 def cells_to_world(grid: GridSpec, cells_rc: np.ndarray) -> np.ndarray:
     """World ``(x, y)`` of cell centres, ``(N, 2)``."""
     return grid.cell_to_world(np.asarray(cells_rc).reshape(-1, 2))
@@ -176,8 +188,8 @@ class PurePursuit:
         self._progress = 0
 
     def set_path(self, path_xy: np.ndarray) -> None:
-        """Follow a new ``(N, 2)`` world polyline."""
-        self.path = np.asarray(path_xy, np.float64).reshape(-1, 2)
+        """Follow a new ``(N, 2)`` world polyline (resampled every 5 cm)."""
+        self.path = densify_path(np.asarray(path_xy, np.float64).reshape(-1, 2), 0.05)
         self._progress = 0
 
     @property
@@ -202,7 +214,7 @@ class PurePursuit:
             self.path = np.zeros((0, 2))
             return 0.0, 0.0
         # Advance the progress index to the nearest path point (never backwards).
-        window = self.path[self._progress : self._progress + 40]
+        window = self.path[self._progress : self._progress + 20]
         self._progress += int(np.argmin(np.linalg.norm(window - xy, axis=1)))
         carrot = self.path[-1]
         for p in self.path[self._progress :]:

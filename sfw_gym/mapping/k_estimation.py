@@ -47,8 +47,6 @@ from sfw_gym.mapping.config import MapperConfig
 
 NOT_HEARD_DBM = -100.0
 _THREADPOOLS = None  # threadpoolctl.ThreadpoolController, created at the first fit
-import os
-EXTRA = int(os.environ.get("EXTRA", "0"))
 
 
 @njit(cache=True)
@@ -237,18 +235,28 @@ def fit_levels(data: np.ndarray, max_k: int, min_gap_db: float, min_fraction: fl
     uniq = np.unique(x)
     if uniq.size < 2:
         return None
-    n_clusters = min(max_k + 1 + EXTRA, uniq.size)
-    init = np.quantile(x, (np.arange(n_clusters) + 0.5) / n_clusters)
-    if np.unique(init).size < n_clusters:
-        init = np.quantile(uniq, (np.arange(n_clusters) + 0.5) / n_clusters)
-    km = KMeans(n_clusters=n_clusters, init=init[:, None], n_init=1, max_iter=100)
+    n_clusters = min(max_k + 1, uniq.size)
+    # Two deterministic starts, the better (lower inertia) kept: sample quantiles, which suit
+    # balanced levels, and evenly spaced over the range, which keeps a dominant level (most
+    # samples seen from one room) from taking several clusters and leaving two sparse levels
+    # to share one.
+    q = np.quantile(x, (np.arange(n_clusters) + 0.5) / n_clusters)
+    if np.unique(q).size < n_clusters:
+        q = np.quantile(uniq, (np.arange(n_clusters) + 0.5) / n_clusters)
+    spread = np.linspace(uniq[0], uniq[-1], n_clusters)
     if _THREADPOOLS is None:
         _THREADPOOLS = ThreadpoolController()
+    best = None
     # One thread: the fit is tiny, and OpenMP spin-waits on a shared machine cost milliseconds.
     with _THREADPOOLS.limit(limits=1, user_api="openmp"), warnings.catch_warnings():
         # Fewer distinct clusters than asked (repeated values) is fine: empty ones are dropped.
         warnings.simplefilter("ignore", ConvergenceWarning)
-        labels = km.fit_predict(x[:, None])
+        for init in (q, spread):
+            km = KMeans(n_clusters=n_clusters, init=init[:, None], n_init=1, max_iter=100)
+            labels = km.fit_predict(x[:, None])
+            if best is None or km.inertia_ < best[0].inertia_:
+                best = (km, labels)
+    km, labels = best
     counts = np.bincount(labels, minlength=n_clusters)
     keep = counts > 0
     cents = km.cluster_centers_[keep, 0]

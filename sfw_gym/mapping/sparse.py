@@ -54,6 +54,8 @@ from sfw_gym.mapping.k_estimation import KEstimator, add_samples, k_from_thresho
 from sfw_gym.mapping.raycast import ray_buffer_size, traverse_grid
 
 _LN2 = math.log(2.0)
+import os
+CENSOR = int(os.environ.get('CENSOR', '0'))
 # Indices into the float64 `state` array of the kernel.
 _S_ENTROPY, _S_UID, _S_PREV_X, _S_PREV_Y, _S_HAS_PREV, _S_N_TOUCHED, _S_N_CHANGED = range(7)
 # Indices into the float64 `params` array of the kernel.
@@ -266,6 +268,7 @@ def _ray_update(
     lmin = params[_P_LMIN]
     lmax = params[_P_LMAX]
     free = params[_P_FREE]
+    k_sat = thresholds.shape[1]
     gain = 0.0
     for a in range(n_anc - 1):
         j0 = anc_j[a] + 1
@@ -273,6 +276,10 @@ def _ray_update(
         if j1 <= j0:
             continue
         dk = anc_k[a + 1] - anc_k[a]
+        if CENSOR >= 1 and anc_k[a] >= k_sat and anc_k[a + 1] >= k_sat:
+            continue
+        if CENSOR >= 2 and anc_k[a + 1] >= k_sat and dk > 0:
+            continue
         if dk == 0:
             for j in range(j0, j1):
                 cell = rows[j] * n_cols + cols[j]

@@ -1,0 +1,115 @@
+"""Greedy information gain per metre: the reference 'next-best-view' agent for the RSSI mapper."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from sfw_gym.agents.base import check_fraction
+from sfw_gym.agents.cross_pass import router_scores
+from sfw_gym.agents.frontier import FrontierAgent, Goal, frontier_mask
+from sfw_gym.agents.planning import CostField, belief_classes
+from sfw_gym.agents.base import RobotView
+from sfw_gym.errors import ConfigError
+
+
+class GreedyInfoGainAgent(FrontierAgent):
+    """Drive to the candidate goal with the most expected information gain per metre of path.
+
+    Candidates are frontier cells (subsampled). A candidate's expected gain counts the unknown
+    cells the mapper would update from there: those on the ray from the router predicted to be
+    the strongest at the candidate (log-distance model with the robot's own RSSI residuals) to
+    the candidate, plus the unknown cells in the robot's footprint there. The score is that count
+    divided by the path distance plus ``distance_offset_m``. Motion, bumps, blacklisting and the
+    fallback sweep are :class:`FrontierAgent`'s.
+
+    Args:
+        max_candidates: Candidates scored per replan (an even subsample of frontier cells).
+        distance_offset_m: Added to the path distance (keeps near goals from dominating).
+        zones_every_steps: Re-fit the router model this often.
+        **frontier_params: Parameters of :class:`FrontierAgent`.
+    """
+
+    name = "greedy"
+
+    def __init__(
+        self,
+        max_candidates: int = 300,
+        distance_offset_m: float = 1.0,
+        zones_every_steps: int = 25,
+        **frontier_params: Any,
+    ) -> None:
+        super().__init__(**frontier_params)
+        for name, v in (("max_candidates", max_candidates),
+                        ("zones_every_steps", zones_every_steps)):  # fmt: skip
+            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+                raise ConfigError(f"{name} must be an int >= 1, got {v!r}")
+        self.max_candidates = max_candidates
+        self.distance_offset_m = check_fraction("distance_offset_m", distance_offset_m, 0.01)
+        self.zones_every_steps = zones_every_steps
+
+    def _on_reset(self, view: RobotView) -> None:
+        super()._on_reset(view)
+        self._zone: np.ndarray | None = None
+        self._zones_at = -(10**9)
+
+    def _strongest(self, view: RobotView) -> np.ndarray:
+        if self._zone is None or self.steps - self._zones_at >= self.zones_every_steps:
+            traj = np.asarray(self.trajectory, np.float64).reshape(-1, 2)
+            hist = view.rssi_history
+            n = min(len(traj), len(hist))
+            scores = router_scores(
+                view.grid, view.routers_xy, traj[len(traj) - n :], hist[len(hist) - n :]
+            )
+            self._zone = np.argmax(scores, axis=0)
+            self._zones_at = self.steps
+        return self._zone
+
+    def expected_gain(self, view: RobotView, cells: np.ndarray) -> np.ndarray:
+        """Unknown cells the mapper would update with the robot at each of ``cells`` (N, 2)."""
+        grid = view.grid
+        _, _, unknown = belief_classes(view.belief_u8)
+        zone = self._strongest(view)
+        routers = np.asarray(view.routers_xy, np.float64)
+        ends = grid.cell_to_world(cells)
+        starts = routers[zone[cells[:, 0], cells[:, 1]]]
+        length = np.linalg.norm(ends - starts, axis=1)
+        n = max(2, int(np.ceil(length.max() / (0.5 * grid.resolution_m))) + 1)
+        t = np.linspace(0.0, 1.0, n)
+        pts = starts[:, None, :] + (ends - starts)[:, None, :] * t[None, :, None]
+        rc = grid.world_to_cell(pts)
+        h, w = grid.shape
+        r = np.clip(rc[..., 0], 0, h - 1)
+        c = np.clip(rc[..., 1], 0, w - 1)
+        flat = r * w + c
+        # Count each cell once per ray: sort the flat indices per row, count the changes.
+        flat.sort(axis=1)
+        first = np.ones_like(flat, bool)
+        first[:, 1:] = flat[:, 1:] != flat[:, :-1]
+        gain = (unknown.ravel()[flat] & first).sum(axis=1).astype(np.float64)
+        foot = np.asarray(self._reach_offsets)
+        fr = np.clip(cells[:, None, 0] + foot[None, :, 0], 0, h - 1)
+        fc = np.clip(cells[:, None, 1] + foot[None, :, 1], 0, w - 1)
+        return gain + unknown[fr, fc].sum(axis=1)
+
+    def _choose_goal(self, view: RobotView, paths: CostField) -> Goal | None:
+        mask = frontier_mask(view.belief_u8)
+        if not mask.any():
+            self._stop("no_frontiers")
+            return None
+        mask &= ~self._frontier_exclusion(view)
+        approach = self._approach(paths)
+        mask &= np.isfinite(approach)
+        cells = np.argwhere(mask)
+        if len(cells) == 0:
+            self._stop("all_blacklisted")
+            return None
+        if len(cells) > self.max_candidates:
+            cells = cells[np.linspace(0, len(cells) - 1, self.max_candidates).astype(int)]
+        dist = approach[cells[:, 0], cells[:, 1]]
+        score = self.expected_gain(view, cells) / (dist + self.distance_offset_m)
+        i = int(np.argmax(score))
+        target = (int(cells[i, 0]), int(cells[i, 1]))
+        self._resume()
+        return Goal(self._approach_cell(paths, target), target, "frontier")

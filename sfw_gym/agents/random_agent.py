@@ -1,0 +1,47 @@
+"""A random-walk reference agent."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from sfw_gym.agents.base import Agent, RobotView
+from sfw_gym.errors import ConfigError
+
+#: (linear, angular) of the discrete actions 0 forward, 1 turn left, 2 turn right.
+_DISCRETE = ((1.0, 0.0), (0.0, 1.0), (0.0, -1.0))
+
+
+class RandomAgent(Agent):
+    """Uniformly random actions, each held for ``hold_steps`` steps (a new one after a bump).
+
+    Continuous actions are drawn from ``U([-1, 1]²)``, discrete ones uniformly from the three
+    actions. With ``hold_steps=1`` this is the usual i.i.d. random policy; holding makes a
+    correlated random walk that gets somewhere, a fairer reference.
+
+    Args:
+        hold_steps: Steps each drawn action is repeated.
+        max_steps: Optional step limit of the agent.
+    """
+
+    name = "random"
+
+    def __init__(self, hold_steps: int = 5, max_steps: int | None = None) -> None:
+        super().__init__(max_steps=max_steps)
+        if isinstance(hold_steps, bool) or not isinstance(hold_steps, int) or hold_steps < 1:
+            raise ConfigError(f"hold_steps must be an int >= 1, got {hold_steps!r}")
+        self.hold_steps = hold_steps
+
+    def _on_reset(self, view: RobotView) -> None:
+        self._held = 0
+        self._command = (0.0, 0.0)
+
+    def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
+        if self._held <= 0 or view.bumped:
+            if self.action_type == "discrete":
+                self._command = _DISCRETE[int(self.rng.integers(len(_DISCRETE)))]
+            else:
+                lin, ang = self.rng.uniform(-1.0, 1.0, 2)
+                self._command = (float(lin), float(ang))
+            self._held = self.hold_steps
+        self._held -= 1
+        return self._command

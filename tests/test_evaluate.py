@@ -1,0 +1,156 @@
+"""The evaluate runner: same seeds for every agent, resumable checkpoint, atomic outputs, stats."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import sfw_gym  # noqa: F401
+from sfw_gym import evaluate as ev
+from sfw_gym.cli import main
+from sfw_gym.errors import ConfigError
+
+SMALL = "SfW-ExploreSmall-v0"
+#: Short episodes keep the suite fast.
+TINY = {"env_id": SMALL, "env_kwargs": {"max_steps": 40}, "workers": 1, "progress": False}
+
+
+def test_tiny_run_writes_table_curves_and_trajectories(tmp_path):
+    result = ev.evaluate(["frontier", "random"], 2, seed=5, out=tmp_path, **TINY)
+    recs = result["records"]
+    assert len(recs) == 4
+    # Same floorplan and seed for every agent in an episode.
+    for i in range(2):
+        pair = [r for r in recs if r["episode"] == i]
+        assert {r["seed"] for r in pair} == {5 + i}
+        assert len({r["floorplan"] for r in pair}) == 1
+    for name in ("results.csv", "results.md", "coverage_vs_steps.png", "iou_vs_path.png",
+                 "episodes.jsonl", "config.json"):  # fmt: skip
+        assert (tmp_path / name).stat().st_size > 0, name
+    assert len(list((tmp_path / "trajectories").glob("*.png"))) == 2
+    assert len(list((tmp_path / "episodes").glob("*.npz"))) == 4
+    assert not list(tmp_path.rglob("*.tmp")), "temp files left behind"
+    rows = list(csv.DictReader((tmp_path / "results.csv").open()))
+    assert [r["agent"] for r in rows] == ["frontier", "random"]
+    assert float(rows[0]["coverage_mean"]) > 0
+    md = (tmp_path / "results.md").read_text()
+    assert "| frontier | 2 |" in md and "±" in md
+    rec = recs[0]
+    for key in ("coverage", "map_iou", "k_accuracy", "path_length_m", "collisions",
+                "steps_to_coverage_50", "steps_to_coverage_90", "zone_band_unknown",
+                "stop_reason", "curve"):  # fmt: skip
+        assert key in rec, key
+    assert rec["steps"] == 40 and rec["stop_reason"] in ("max_steps", "no_frontiers",
+                                                         "all_blacklisted")  # fmt: skip
+
+
+def test_interrupted_run_resumes_without_redoing_episodes(tmp_path, monkeypatch):
+    real = ev.run_episode
+    calls: list[str] = []
+
+    def flaky(spec):
+        if len(calls) == 2:
+            raise KeyboardInterrupt  # the user hits Ctrl-C during the third episode
+        calls.append(spec.key)
+        return real(spec)
+
+    monkeypatch.setattr(ev, "run_episode", flaky)
+    with pytest.raises(KeyboardInterrupt):
+        ev.evaluate(["frontier", "random"], 2, seed=0, out=tmp_path, **TINY)
+    done = ev.load_checkpoint(tmp_path / ev.CHECKPOINT)
+    assert [r["key"] for r in done] == calls
+    # A torn last line (a crash mid-write of an older, non-atomic writer) is ignored.
+    with (tmp_path / ev.CHECKPOINT).open("a") as fh:
+        fh.write('{"key": "trunc')
+    rerun: list[str] = []
+
+    def counting(spec):
+        rerun.append(spec.key)
+        return real(spec)
+
+    monkeypatch.setattr(ev, "run_episode", counting)
+    result = ev.evaluate(["frontier", "random"], 2, seed=0, out=tmp_path, **TINY)
+    assert len(rerun) == 2 and not set(rerun) & set(calls)
+    assert len(result["records"]) == 4
+    # Asking for more episodes later runs only the new ones.
+    rerun.clear()
+    ev.evaluate(["frontier", "random"], 3, seed=0, out=tmp_path, **TINY)
+    assert len(rerun) == 2 and all("|2|" in k for k in rerun)
+
+
+def test_parallel_workers_match_the_serial_run(tmp_path):
+    serial = ev.evaluate(["random"], 2, seed=1, out=tmp_path / "a", **TINY)
+    parallel = ev.evaluate(["random"], 2, seed=1, out=tmp_path / "b", **{**TINY, "workers": 2})
+    key = lambda r: r["episode"]  # noqa: E731
+    for a, b in zip(sorted(serial["records"], key=key), sorted(parallel["records"], key=key),
+                    strict=True):  # fmt: skip
+        assert a["coverage"] == b["coverage"] and a["curve"] == b["curve"]
+
+
+def test_floorplan_folder_cycles_and_gif(tmp_path):
+    from sfw_gym.world.generator import generate_floorplan
+
+    plans = tmp_path / "plans"
+    for s in (1, 2):
+        generate_floorplan(s, area_m2=45.0).save(plans / f"plan{s}.json")
+    result = ev.evaluate(["random"], 3, seed=0, out=tmp_path / "out", floorplans=plans,
+                         gif_episodes=1, **TINY)  # fmt: skip
+    files = [r["floorplan_file"] for r in sorted(result["records"], key=lambda r: r["episode"])]
+    assert [f.rsplit("/", 1)[-1] for f in files] == ["plan1.json", "plan2.json", "plan1.json"]
+    gif = tmp_path / "out" / "gifs" / "random_0000.gif"
+    assert gif.stat().st_size > 0
+    import imageio.v3 as iio
+
+    assert iio.imread(gif).ndim == 4  # several frames
+
+
+def test_bad_arguments_are_clear_errors(tmp_path):
+    with pytest.raises(ConfigError, match="unknown agent"):
+        ev.evaluate(["frontier", "nope"], 1, out=tmp_path, **TINY)
+    with pytest.raises(ConfigError, match="episodes"):
+        ev.evaluate(["frontier"], 0, out=tmp_path, **TINY)
+    with pytest.raises(ConfigError, match="no .json"):
+        ev.evaluate(["frontier"], 1, out=tmp_path, floorplans=tmp_path, **TINY)
+    with pytest.raises(ConfigError, match="potential_scale"):
+        ev.evaluate(["frontier"], 1, out=tmp_path,
+                    agent_params={"frontier": {"potential_scale": -1}}, **TINY)  # fmt: skip
+
+
+def test_cli_evaluate(tmp_path, capsys):
+    args = ["evaluate", "--agents", "random", "--episodes", "1", "--env", SMALL, "--workers", "1",
+            "--out", str(tmp_path), "--no-progress", "--env-kwargs", '{"max_steps": 20}']  # fmt: skip
+    assert main(args) == 0
+    assert "| random | 1 |" in capsys.readouterr().out
+    assert main(["evaluate", "--agents", "bogus", "--out", str(tmp_path)]) == 2
+    assert "unknown agent" in capsys.readouterr().err
+    assert main(["evaluate", "--agents", "random", "--env-kwargs", "[1]", "--out",
+                 str(tmp_path)]) == 2  # fmt: skip
+
+
+def test_mean_ci95_and_summary():
+    mean, half, n = ev.mean_ci95([1.0, 2.0, 3.0, 4.0])
+    assert (mean, n) == (2.5, 4)
+    assert half == pytest.approx(3.182446 * np.std([1, 2, 3, 4], ddof=1) / 2, rel=1e-5)
+    assert math.isnan(ev.mean_ci95([7.0])[1]) and ev.mean_ci95([])[2] == 0
+    recs = [
+        {"agent": "a", "coverage": 0.95, "steps_to_coverage_90": 100, "stop_reason": "x"},
+        {"agent": "a", "coverage": 0.5, "steps_to_coverage_90": -1, "stop_reason": "y"},
+    ]
+    row = ev.summarize(recs, ["a"])[0]
+    assert row["steps_to_coverage_90_mean"] == 100 and row["steps_to_coverage_90_n"] == 1
+    assert row["episodes_coverage_ge_90"] == 1 and row["stop_reasons"] == "x:1;y:1"
+    assert "(1/2)" in ev.results_markdown([row])
+
+
+def test_zone_band_metric_counts_unknown_cells_near_the_true_zone_border():
+    env = gym.make(SMALL)
+    env.reset(seed=0, options={"routers": 2})
+    m = ev.zone_band_unknown(env)
+    assert m["zone_band_cells"] > 0
+    assert 0.9 * m["zone_band_cells"] < m["zone_band_unknown"] <= m["zone_band_cells"]  # 1 update
+    assert json.dumps(m)
