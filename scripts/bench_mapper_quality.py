@@ -1,31 +1,56 @@
 """Map quality of sparse inverse k-visibility on real and generated floorplans (issue 3).
 
 For every plan (the HouseExpo files in ``../shared/floorplans/houseexpo/`` and generated plans):
-two routers placed by `place_routers`, a dense lawnmower survey of the free space (passes
-``--spacing`` apart, a sample every 5 cm, keeping the robot's clearance), RSSI from `RadioModel`
-(noise off, or the default noise), and the mapper fed sample by sample. Prints per plan and in
-aggregate: the paper's IoU, free-space IoU, wall precision and interior-wall recall (2-cell
-tolerance), k-value accuracy, coverage.
+two routers placed by `place_routers`, a dense survey of the free space, RSSI from `RadioModel`
+(noise off, or the default shadowing and noise), and the mapper fed sample by sample. Prints per
+plan and in aggregate: the paper's IoU, free-space IoU, wall precision and interior-wall recall
+(2-cell tolerance), k-value accuracy, coverage.
+
+The survey is one continuous, physically valid path (a sample every 5 cm) inside the free space
+shrunk by the robot's clearance (its 0.17 m radius + 2 cm): first a wall-following pass around
+every boundary of that region, then a lawnmower (boustrophedon) of passes ``--spacing`` apart,
+each pass continuing into an overlapping one of the next row where it can, with collision-free
+transits (straight where possible, else a shortest path on a 5 cm grid) in between. The robot
+never jumps, so the mapper never joins two samples through a wall. ``--survey lawnmower``
+drops the wall-following pass.
+
+The mapper is configured as the environment configures it: ``k0_level_dbm = P_tx - PL(1 m)``
+(the robot knows its routers' transmit power; the free-space loss at 1 m is standard); rows
+labelled ``distance_aware`` without ``+k0`` drop that calibration.
+
+k-accuracy is the paper's Eq. 8 with true k counted up to ``max_k``: the estimator's top value
+K means "K or more walls" (the paper's rule), so a reading of K where the truth is K or more is
+right (``k_value_accuracy(..., max_k=K)``). ``k_exact`` compares with the uncapped truth.
 
 Usage:
-    python scripts/bench_mapper_quality.py --noise off            # every plan, noise off
-    python scripts/bench_mapper_quality.py --noise default --table  # estimators × policies
+    python scripts/bench_mapper_quality.py --noise off                # every plan, noise off
+    python scripts/bench_mapper_quality.py --noise default --table    # estimators x policies
+    python scripts/bench_mapper_quality.py --noise off --oracle       # + dense-oracle bounds
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import math
 import statistics
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 import shapely
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import breadth_first_order
+from shapely.geometry import LineString
 
-from sfw_gym.mapping import GridSpec, MapperConfig, SparseInverseKVisibility
-from sfw_gym.metrics import evaluate_map
+from sfw_gym.mapping import (
+    GridSpec,
+    MapperConfig,
+    SparseInverseKVisibility,
+    dense_inverse_k_visibility,
+)
+from sfw_gym.metrics import evaluate_map, k_value_accuracy
 from sfw_gym.world import (
     Floorplan,
     RadioConfig,
@@ -37,34 +62,155 @@ from sfw_gym.world import (
 
 HOUSEEXPO = Path(__file__).resolve().parents[2] / "shared" / "floorplans" / "houseexpo"
 ROBOT_RADIUS_M = 0.17
+CLEARANCE_M = ROBOT_RADIUS_M + 0.02
+STEP_M = 0.05
+PLAN_RES_M = 0.05  # grid of the transit planner
 METRICS = ("paper_iou", "free_iou", "wall_precision", "interior_wall_recall", "k_accuracy",
-           "coverage")  # fmt: skip
+           "k_exact", "coverage")  # fmt: skip
+ORACLE_METRICS = ("oracle_free_iou", "oracle_wall_recall")
 TARGETS = {"paper_iou": 0.95, "free_iou": 0.85, "wall_precision": 0.8, "interior_wall_recall": 0.7}
 
 
+# -- the survey -----------------------------------------------------------------------------------
+class TransitPlanner:
+    """Collision-free transits inside a region: straight if possible, else a path found by
+    breadth-first search on a grid (8-neighbours) and shortened by string pulling."""
+
+    def __init__(self, region) -> None:
+        self.region = region
+        xmin, ymin, xmax, ymax = region.bounds
+        self.origin = np.array([xmin - PLAN_RES_M, ymin - PLAN_RES_M])
+        nx = math.ceil((xmax - xmin) / PLAN_RES_M) + 3
+        ny = math.ceil((ymax - ymin) / PLAN_RES_M) + 3
+        gx, gy = np.meshgrid(self.origin[0] + (np.arange(nx) + 0.5) * PLAN_RES_M,
+                             self.origin[1] + (np.arange(ny) + 0.5) * PLAN_RES_M)  # fmt: skip
+        self.centres = np.stack([gx.ravel(), gy.ravel()], axis=1)
+        ok = shapely.contains_xy(region, gx, gy)
+        self.ok = ok
+        node = np.full(ok.size, -1, np.int64)
+        node[ok.ravel()] = np.arange(ok.sum())
+        self.node = node.reshape(ok.shape)
+        self.cell_of = np.flatnonzero(ok.ravel())
+        src, dst, w = [], [], []
+        for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
+            a = ok[: ny - dr, max(0, -dc) : nx - max(0, dc)]
+            b = ok[dr:, max(0, dc) : nx - max(0, -dc)]
+            both = a & b
+            src.append(self.node[: ny - dr, max(0, -dc) : nx - max(0, dc)][both])
+            dst.append(self.node[dr:, max(0, dc) : nx - max(0, -dc)][both])
+            w.append(np.full(int(both.sum()), math.hypot(dr, dc)))
+        s, d, ww = np.concatenate(src), np.concatenate(dst), np.concatenate(w)
+        n = int(ok.sum())
+        self.graph = coo_matrix((np.r_[ww, ww], (np.r_[s, d], np.r_[d, s])), shape=(n, n)).tocsr()
+
+    def _nearest_node(self, p) -> int:
+        i = int((p[1] - self.origin[1]) / PLAN_RES_M)
+        j = int((p[0] - self.origin[0]) / PLAN_RES_M)
+        best, best_d = -1, math.inf
+        for a in range(max(i - 3, 0), min(i + 4, self.ok.shape[0])):
+            for b in range(max(j - 3, 0), min(j + 4, self.ok.shape[1])):
+                if self.ok[a, b]:
+                    d = math.dist(self.centres[a * self.ok.shape[1] + b], p)
+                    if d < best_d:
+                        best, best_d = int(self.node[a, b]), d
+        return best
+
+    def path(self, a, b) -> list:
+        """Waypoints strictly between ``a`` and ``b``."""
+        if self.region.contains(LineString([a, b])):
+            return []
+        s, t = self._nearest_node(a), self._nearest_node(b)
+        _, pred = breadth_first_order(self.graph, s, directed=False)
+        chain = [t]
+        while chain[-1] != s and chain[-1] >= 0:
+            chain.append(int(pred[chain[-1]]))
+        pts = [np.asarray(a)] + [self.centres[self.cell_of[v]] for v in chain[::-1]]
+        pts.append(np.asarray(b))
+        out, i = [], 0  # string pulling: keep only the corners the region forces
+        while i < len(pts) - 1:
+            j = len(pts) - 1
+            while j > i + 1 and not self.region.contains(LineString([pts[i], pts[j]])):
+                j -= 1
+            out.append(tuple(pts[j]))
+            i = j
+        return out[:-1]
+
+
+def resample(waypoints: list, step_m: float) -> np.ndarray:
+    """Points every ``step_m`` along a polyline (its vertices kept)."""
+    out = []
+    for a, b in itertools.pairwise(waypoints):
+        a, b = np.asarray(a, float), np.asarray(b, float)
+        n = max(1, math.ceil(math.dist(a, b) / step_m))
+        out.append(a + (np.arange(n)[:, None] / n) * (b - a))
+    out.append(np.asarray(waypoints[-1], float)[None])
+    return np.concatenate(out)
+
+
+def survey(plan: Floorplan, spacing_m: float, wall_follow: bool = True) -> np.ndarray:
+    """The continuous survey path (N, 2) described in the module docstring."""
+    region = plan.free_space.buffer(-CLEARANCE_M)
+    planner = TransitPlanner(region)
+    route: list = []
+
+    def go(seq: list) -> None:
+        if route:
+            route.extend(planner.path(route[-1], seq[0]))
+        route.extend(seq)
+
+    if wall_follow:
+        for poly in getattr(region, "geoms", [region]):
+            for ring in (poly.exterior, *poly.interiors):
+                loop = list(ring.coords)[:-1]
+                if route:  # enter the loop at its point nearest the robot
+                    i = int(np.argmin(np.linalg.norm(np.asarray(loop) - route[-1], axis=1)))
+                    loop = loop[i:] + loop[:i]
+                go([*loop, loop[0]])
+    xmin, ymin, xmax, ymax = region.bounds
+    segs, rows = [], []
+    for row, y in enumerate(np.arange(ymin + spacing_m / 2, ymax, spacing_m)):
+        cut = region.intersection(LineString([(xmin - 1, y), (xmax + 1, y)]))
+        for g in getattr(cut, "geoms", [cut]):
+            if g.geom_type == "LineString" and g.length > 0:
+                (x0, _), (x1, _) = g.coords[0], g.coords[-1]
+                segs.append(((min(x0, x1), y), (max(x0, x1), y)))
+                rows.append(row)
+    left = set(range(len(segs)))
+    last = None
+    while left:
+        here = route[-1] if route else segs[0][0]
+        gap = {i: min(math.dist(here, segs[i][0]), math.dist(here, segs[i][1])) for i in left}
+        nxt = None
+        if last is not None:  # boustrophedon: an overlapping segment of the next or previous row
+            lo, hi = segs[last][0][0], segs[last][1][0]
+            cands = [
+                i
+                for i in left
+                if abs(rows[i] - rows[last]) == 1
+                and min(hi, segs[i][1][0]) > max(lo, segs[i][0][0])
+            ]
+            nxt = min(cands, key=gap.__getitem__) if cands else None
+        if nxt is None:
+            nxt = min(left, key=gap.__getitem__)
+        left.remove(nxt)
+        a, b = segs[nxt]
+        go([a, b] if math.dist(here, a) <= math.dist(here, b) else [b, a])
+        last = nxt
+    return resample(route, STEP_M)
+
+
+# -- one plan -------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Case:
-    """One plan with one mapper configuration."""
+    """One plan with every mapper configuration to run on it."""
 
     source: str  # a HouseExpo path or "gen:<seed>"
     noise: str  # "off" or "default"
-    k_estimator: str
-    router_policy: str
+    configs: tuple  # ((label, MapperConfig), ...)
     resolution_m: float
     spacing_m: float
-
-
-def lawnmower(plan: Floorplan, spacing_m: float, step_m: float = 0.05) -> np.ndarray:
-    """Boustrophedon survey points (N, 2) with the robot's clearance from every wall."""
-    region = plan.free_space.buffer(-(ROBOT_RADIUS_M + 0.02))
-    xmin, ymin, xmax, ymax = plan.bounds
-    xs = np.arange(xmin, xmax, step_m)
-    rows = []
-    for i, y in enumerate(np.arange(ymin + spacing_m / 2, ymax, spacing_m)):
-        inside = shapely.contains_xy(region, xs, np.full_like(xs, y))
-        pts = np.stack([xs[inside], np.full(inside.sum(), y)], axis=1)
-        rows.append(pts if i % 2 == 0 else pts[::-1])
-    return np.vstack(rows)
+    wall_follow: bool
+    oracle: bool
 
 
 def load(source: str) -> Floorplan:
@@ -73,7 +219,16 @@ def load(source: str) -> Floorplan:
     return load_floorplan(source)
 
 
-def run_case(case: Case) -> dict[str, float | str]:
+def oracle_map(radio: RadioModel, truth: np.ndarray, grid: GridSpec) -> np.ndarray:
+    """Dense inverse k-visibility from the true k of every free cell (an upper bound)."""
+    xs, ys = grid.cell_centres()
+    k = radio.true_k(np.stack([xs.ravel(), ys.ravel()], axis=1)).T
+    k = k.reshape(radio.n_routers, *grid.shape).astype(np.int64)
+    k[:, truth != 255] = -1
+    return dense_inverse_k_visibility(grid, radio.routers, k, adjacent_steps=False)
+
+
+def run_case(case: Case) -> list[dict]:
     plan = load(case.source)
     rng = np.random.default_rng(0)
     routers = place_routers(plan, 2, rng)
@@ -81,21 +236,50 @@ def run_case(case: Case) -> dict[str, float | str]:
     radio = RadioModel(plan, routers, radio_cfg, rng)
     truth, origin = plan.rasterize(case.resolution_m)
     grid = GridSpec(origin, case.resolution_m, truth.shape)
-    cfg = MapperConfig(k_estimator=case.k_estimator, router_policy=case.router_policy)
-    mapper = SparseInverseKVisibility(grid, routers, cfg)
-    pts = lawnmower(plan, case.spacing_m)
-    true_k = radio.true_k(pts)
-    correct = total = 0
-    for p, k_true in zip(pts, true_k, strict=True):
-        reading = radio.measure(p).astype(np.float64)
-        mapper.update(p, reading)
-        est = mapper.last_k
-        ok = est >= 0
-        correct += int((est[ok] == k_true[ok]).sum())
-        total += int(ok.sum())
-    result = evaluate_map(mapper.occupancy_u8, truth)
-    result["k_accuracy"] = correct / total if total else math.nan
-    return {"plan": plan.name[:12], "samples": len(pts), **result}
+    pts = survey(plan, case.spacing_m, case.wall_follow)
+    readings = np.empty((len(pts), len(routers)))
+    true_k = np.empty((len(pts), len(routers)), np.int64)
+    for i, p in enumerate(pts):  # one reading sequence, shared by every configuration
+        readings[i], true_k[i] = radio.measure_with_k(p)
+    name = plan.name if plan.name.startswith("gen") else plan.name[:12]
+    extra = {}
+    if case.oracle:
+        o = evaluate_map(oracle_map(radio, truth, grid), truth)
+        extra = {"oracle_free_iou": o["free_iou"], "oracle_wall_recall": o["interior_wall_recall"]}
+    results = []
+    for label, cfg in case.configs:
+        mapper = SparseInverseKVisibility(grid, routers, cfg)
+        k_est = np.empty_like(true_k)
+        for i, p in enumerate(pts):
+            mapper.update(p, readings[i])
+            k_est[i] = mapper.last_k
+        res = evaluate_map(mapper.occupancy_u8, truth)
+        res["k_accuracy"] = k_value_accuracy(k_est, true_k, max_k=cfg.max_k)
+        res["k_exact"] = k_value_accuracy(k_est, true_k)
+        results.append({"config": label, "plan": name, "samples": len(pts), **res, **extra})
+    return results
+
+
+def configs_for(table: bool, k0_dbm: float) -> list[tuple[str, MapperConfig]]:
+    """(label, config) pairs: the environment's configuration first, then the comparisons."""
+    env = MapperConfig(robot_radius_m=ROBOT_RADIUS_M, k0_level_dbm=k0_dbm)
+    no_k0 = replace(env, k0_level_dbm=None)
+    kmeans = replace(no_k0, k_estimator="kmeans")
+    if not table:
+        return [("distance_aware+k0 / strongest", env), ("distance_aware / strongest", no_k0)]
+    out = []
+    for policy in ("strongest", "all"):
+        for label, cfg in (
+            ("kmeans", kmeans),
+            ("distance_aware", no_k0),
+            ("distance_aware+k0", env),
+        ):
+            out.append((f"{label} / {policy}", replace(cfg, router_policy=policy)))
+    return out
+
+
+def fmt(v: float) -> str:
+    return "  nan" if v != v else f"{v:.3f}"
 
 
 def main() -> None:
@@ -104,35 +288,54 @@ def main() -> None:
     parser.add_argument("--generated", type=int, default=20, help="generated plans (seeds 0..N-1)")
     parser.add_argument("--resolution", type=float, default=0.1)
     parser.add_argument("--spacing", type=float, default=0.5, help="lawnmower pass spacing, m")
+    parser.add_argument("--survey", choices=["wall+lawnmower", "lawnmower"],
+                        default="wall+lawnmower")  # fmt: skip
     parser.add_argument("--table", action="store_true",
-                        help="all four estimator × policy combinations (aggregates only)")  # fmt: skip
+                        help="estimators x policies x calibration (aggregates only)")  # fmt: skip
+    parser.add_argument("--oracle", action="store_true",
+                        help="also the dense oracle's free IoU, interior-wall recall")  # fmt: skip
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args()
     sources = [str(p) for p in sorted(HOUSEEXPO.glob("*.json"))]
     sources += [f"gen:{s}" for s in range(args.generated)]
-    combos = [("distance_aware", "strongest")]
-    if args.table:
-        combos = [(e, p) for e in ("kmeans", "distance_aware") for p in ("strongest", "all")]
+    radio = RadioConfig()
+    k0 = radio.tx_power_dbm - radio.d0_loss_db  # what the environment passes
+    configs = configs_for(args.table, k0)
+    cases = [Case(s, args.noise, tuple(configs), args.resolution, args.spacing,
+                  args.survey == "wall+lawnmower", args.oracle) for s in sources]  # fmt: skip
     with ProcessPoolExecutor(args.workers) as pool:
-        for estimator, policy in combos:
-            cases = [Case(s, args.noise, estimator, policy, args.resolution, args.spacing)
-                     for s in sources]  # fmt: skip
-            results = list(pool.map(run_case, cases))
-            print(f"\n## noise={args.noise}, k_estimator={estimator}, router_policy={policy}, "
-                  f"{args.resolution} m cells, {args.spacing} m lawnmower")  # fmt: skip
-            if not args.table:
-                print("| plan | samples | " + " | ".join(METRICS) + " |")
-                print("|---" * (len(METRICS) + 2) + "|")
-                for r in results:
-                    cells = " | ".join(f"{r[m]:.3f}" for m in METRICS)
-                    print(f"| {r['plan']} | {r['samples']} | {cells} |")
-            print("| aggregate | " + " | ".join(METRICS) + " |")
-            print("|---" * (len(METRICS) + 1) + "|")
-            for name, agg in (("mean", statistics.fmean), ("min", min)):
-                cells = " | ".join(f"{agg(float(r[m]) for r in results):.3f}" for m in METRICS)
-                print(f"| {name} | {cells} |")
-            fails = [(r["plan"], m) for r in results for m, t in TARGETS.items() if r[m] < t]
-            print(f"plans below a target {TARGETS}: {fails if fails else 'none'}")
+        per_plan = list(pool.map(run_case, cases))
+    print(f"noise={args.noise}, {args.resolution} m cells, survey {args.survey} "
+          f"({args.spacing} m passes, {CLEARANCE_M:.2f} m clearance), k0 = {k0:.1f} dBm, "
+          f"{len(sources)} plans")  # fmt: skip
+    cols = METRICS + (ORACLE_METRICS if args.oracle else ())
+    summary = []
+    for c, (label, _) in enumerate(configs):
+        results = [rs[c] for rs in per_plan]
+        if not args.table and c == 0:
+            print(f"\n## {label}\n")
+            print("| plan | samples | " + " | ".join(cols) + " |")
+            print("|---" * (len(cols) + 2) + "|")
+            for r in results:
+                print(f"| {r['plan']} | {r['samples']} | "
+                      + " | ".join(fmt(r[m]) for m in cols) + " |")  # fmt: skip
+        fails = [(r["plan"], m, round(r[m], 3)) for r in results for m, t in TARGETS.items()
+                 if r[m] < t]  # fmt: skip
+        undefined = [(r["plan"], m) for r in results for m in TARGETS if r[m] != r[m]]
+        summary.append((label, results, fails, undefined))
+    print("\n## aggregate over plans (mean / min)\n")
+    print("| configuration | " + " | ".join(cols) + " | plans below a target |")
+    print("|---" * (len(cols) + 2) + "|")
+    for label, results, fails, _ in summary:
+        cells = []
+        for m in cols:
+            vals = [float(r[m]) for r in results if r[m] == r[m]]
+            cells.append(f"{statistics.fmean(vals):.3f} / {min(vals):.3f}" if vals else "nan")
+        print(f"| {label} | " + " | ".join(cells) + f" | {len({p for p, _, _ in fails})} |")
+    print(f"\ntargets {TARGETS}")
+    for label, _, fails, undefined in summary:
+        print(f"{label}: below a target: {fails if fails else 'none'}"
+              + (f"; undefined (nan): {undefined}" if undefined else ""))  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 """Compare the baseline agents on generated plans and on the HouseExpo plans (issue 5's benchmark).
 
-Usage: ``python scripts/compare_agents.py [--episodes 20] [--houseexpo ../shared/floorplans/houseexpo]
-[--out runs/compare] [--agents frontier,cross-pass,greedy,random] [--workers 2]``
+Usage: ``python scripts/compare_agents.py [--episodes 20] [--houseexpo DIR] [--out runs/compare]
+[--agents frontier,cross-pass,greedy,random] [--workers 2]``
 
 Runs ``sfw_gym.evaluate.evaluate`` twice — ``--episodes`` procedural plans (seeds 0, 1, …) and
 one episode per HouseExpo file (seeds 100, 101, …) — into ``OUT/generated`` and ``OUT/houseexpo``

@@ -487,7 +487,9 @@ def episode_specs(
                     env_kwargs=dict(env_kwargs or {}),
                     agent_params=dict((agent_params or {}).get(name, {})),
                     curve_every=curve_every,
-                    gif_path=str(out / "gifs" / f"{name}_{i:04d}.gif") if i < gif_episodes else None,
+                    gif_path=str(out / "gifs" / f"{name}_{i:04d}.gif")
+                    if i < gif_episodes
+                    else None,
                     npz_path=str(out / "episodes" / f"{name}_{i:04d}.npz"),
                 )
             )

@@ -7,7 +7,8 @@ thirds (:func:`sfw_gym.mapping.grid.classify_u8`): ``<= 84`` wall, ``>= 171`` fr
 What we settled where the paper is ambiguous:
 
 - *k-value accuracy* (Eq. 8): correct / compared, over samples where both values are defined
-  (a router that was not heard, k < 0, is left out).
+  (a router that was not heard, k < 0, is left out). An estimator capped at K reports K for
+  "K or more walls" (the paper's rule); pass ``max_k=K`` to compare with ``min(k_true, K)``.
 - *Paper IoU* (Eq. 9-12): over the cells known (free or wall) in **both** maps, the
   intersection is the cells where both agree on the class and the union is all of those cells.
   It ignores unexplored cells, so a map that only ever marks correct free cells scores 1.0;
@@ -55,12 +56,16 @@ def _ratio(num: int | float, den: int | float) -> float:
     return float(num) / float(den) if den else float("nan")
 
 
-def k_value_accuracy(k_est, k_true) -> float:
+def k_value_accuracy(k_est, k_true, max_k: int | None = None) -> float:
     """Fraction of k-values estimated exactly (paper Eq. 8).
 
     Args:
         k_est: Estimated k-values, any shape; negative = undefined (router not heard).
         k_true: True k-values, same shape; negative = undefined.
+        max_k: The estimator's largest output K, or None. The paper's rule reads K as
+            "K or more walls", so with ``max_k`` the truth is compared as ``min(k_true, K)``:
+            an estimate of K is right wherever K or more walls lie between. None compares with
+            the true k as it is (an estimator capped at K is then wrong wherever k > K).
 
     Returns:
         ``#(k_est == k_true) / #(both defined)``; nan if nothing is comparable.
@@ -69,6 +74,10 @@ def k_value_accuracy(k_est, k_true) -> float:
     t = np.asarray(k_true)
     if e.shape != t.shape:
         raise ConfigError(f"k_est and k_true must have one shape, got {e.shape}, {t.shape}")
+    if max_k is not None:
+        if isinstance(max_k, bool) or not isinstance(max_k, (int, np.integer)) or max_k < 0:
+            raise ConfigError(f"max_k must be None or an int >= 0, got {max_k!r}")
+        t = np.where(t >= 0, np.minimum(t, max_k), t)
     valid = (e >= 0) & (t >= 0)
     return _ratio(np.count_nonzero((e == t) & valid), np.count_nonzero(valid))
 

@@ -35,6 +35,16 @@ def test_transition_between_neighbours_marks_the_far_cell():
     assert (out[~wall] == 255).all()
 
 
+def test_adjacent_steps_off_ignores_steps_without_wall_cells():
+    k = np.zeros(GRID.shape, np.int64)
+    k[:, 5:] = 1  # a step between neighbours: on a rasterised plan, a shadow-line artefact
+    out = dense_inverse_k_visibility(GRID, ROUTER, k, adjacent_steps=False)
+    assert (out == 255).all()
+    k[:, 5] = -1  # the wall has cells of its own: still found
+    out = dense_inverse_k_visibility(GRID, ROUTER, k, adjacent_steps=False)
+    assert (out[1:, 5] == 0).all() and (out[:, 6:] == 255).all() and (out[:, :5] == 255).all()
+
+
 def test_line_of_sight_everywhere_is_all_free_and_unknown_stays_unknown():
     k = np.zeros(GRID.shape, np.int64)
     k[0, :] = -1  # outside the plan, with nothing known beyond

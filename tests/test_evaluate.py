@@ -114,7 +114,7 @@ def test_bad_arguments_are_clear_errors(tmp_path):
         ev.evaluate(["frontier", "nope"], 1, out=tmp_path, **TINY)
     with pytest.raises(ConfigError, match="episodes"):
         ev.evaluate(["frontier"], 0, out=tmp_path, **TINY)
-    with pytest.raises(ConfigError, match="no .json"):
+    with pytest.raises(ConfigError, match=r"no \.json"):
         ev.evaluate(["frontier"], 1, out=tmp_path, floorplans=tmp_path, **TINY)
     with pytest.raises(ConfigError, match="potential_scale"):
         ev.evaluate(["frontier"], 1, out=tmp_path,
@@ -122,8 +122,8 @@ def test_bad_arguments_are_clear_errors(tmp_path):
 
 
 def test_cli_evaluate(tmp_path, capsys):
-    args = ["evaluate", "--agents", "random", "--episodes", "1", "--env", SMALL, "--workers", "1",
-            "--out", str(tmp_path), "--no-progress", "--env-kwargs", '{"max_steps": 20}']  # fmt: skip
+    args = ["evaluate", "--agents", "random", "--episodes", "1", "--env", SMALL, "--workers", "1"]
+    args += ["--out", str(tmp_path), "--no-progress", "--env-kwargs", '{"max_steps": 20}']
     assert main(args) == 0
     assert "| random | 1 |" in capsys.readouterr().out
     assert main(["evaluate", "--agents", "bogus", "--out", str(tmp_path)]) == 2

@@ -77,6 +77,31 @@ def test_sliding_window_mean():
     assert feats == pytest.approx([-40.0, -41.5, -43.0, -46.0])
 
 
+def test_filter_restarts_at_a_step_but_averages_noise():
+    est = KEstimator(1, MapperConfig(k_estimator="kmeans", filter_window=3))
+    assert est.filter_reset_db == pytest.approx(7.0)  # 0.7 of the prior wall loss
+    feats = [est.add([v], [1.0])[0] for v in (-40.0, -41.0, -39.0, -46.0)]
+    # -46 is within 7 dB of a held reading (-39): noise, averaged as by a plain sliding mean
+    assert feats == pytest.approx([-40.0, -40.5, -40.0, -42.0])
+    est = KEstimator(1, MapperConfig(k_estimator="kmeans", filter_window=3))
+    feats = [est.add([v], [1.0])[0] for v in (-40.0, -41.0, -39.0, -50.0, -51.0, -49.0)]
+    # one wall lower: -50 is far from all of -40, -41, -39, so the window restarts there and
+    # no feature lies between the two levels
+    assert feats == pytest.approx([-40.0, -40.5, -40.0, -50.0, -50.5, -50.0])
+    plain = KEstimator(1, MapperConfig(k_estimator="kmeans", filter_window=3, filter_reset_db=0))
+    feats = [plain.add([v], [1.0])[0] for v in (-40.0, -41.0, -39.0, -50.0)]
+    assert feats[3] == pytest.approx(-130.0 / 3)  # the plain sliding mean smears the step
+
+
+def test_fit_finds_sparse_levels_beside_a_dominant_one():
+    # Most samples from one room (k = 0), a few through one and two walls: sample-quantile
+    # starts alone put three clusters in the dominant level and one between the sparse ones.
+    x = levels_data([-20.0], n=180, spread=0.5)
+    x = np.concatenate([x, levels_data([-30.0, -40.0], n=10, spread=0.5)])
+    levels, _ = fit_levels(x, max_k=3, min_gap_db=7.0, min_fraction=0.02)
+    assert levels == pytest.approx([-20.0, -30.0, -40.0], abs=1e-9)
+
+
 def test_prior_before_first_fit():
     est = KEstimator(1, MapperConfig(k_estimator="kmeans", filter_window=1))
     assert est.update([-40.0], [1.0]).tolist() == [0]
@@ -153,6 +178,7 @@ def test_bad_input_raises():
         ("min_level_fraction", 0.6),
         ("outer_bounds_m", (0.0, 0.0, -1.0, 1.0)),
         ("k0_level_dbm", float("nan")),
+        ("filter_reset_db", -1.0),
     ],
 )
 def test_config_validation_names_the_field(field, value):

@@ -124,3 +124,16 @@ def test_evaluate_map_and_entropy():
 def test_shape_mismatch_raises():
     with pytest.raises(ConfigError, match="shape"):
         map_iou(TRUTH[:3], TRUTH)
+
+
+def test_k_value_accuracy_with_max_k_reads_k_as_k_or_more():
+    k_true = np.array([0, 2, 3, 5, 6, -1, 4])
+    k_est = np.array([0, 2, 3, 3, 3, 3, -1])
+    # strict (Eq. 8): 3 of the 5 comparable samples; the capped estimator is wrong at 5 and 6
+    assert k_value_accuracy(k_est, k_true) == pytest.approx(3 / 5)
+    # with K = 3, a true 5 or 6 is "3 or more": every comparable sample is right
+    assert k_value_accuracy(k_est, k_true, max_k=3) == 1.0
+    assert k_value_accuracy(np.array([4]), np.array([6]), max_k=3) == 0.0  # above K: wrong
+    for bad in (-1, 1.5, True):
+        with pytest.raises(ConfigError, match="max_k"):
+            k_value_accuracy(k_est, k_true, max_k=bad)

@@ -220,6 +220,42 @@ def test_decreasing_k_is_inconsistent_and_skipped():
     assert lo[3:20].max() > 0  # router..a still holds its wall evidence
 
 
+def test_equal_readings_at_max_k_are_not_free_evidence():
+    # Both ends read K = 1 ("one wall or more"): the walls between them are unknown.
+    a, b = (2.05, 1.05), (5.05, 1.05)
+    for max_k, expect_free in ((3, True), (1, False)):
+        m = SparseInverseKVisibility(GRID, [ROUTER], replace(EXACT, max_k=max_k))
+        m.update(a, rssi_k(a, 1))
+        m.update(b, rssi_k(b, 1))
+        lo = m.log_odds[10]
+        assert m.last_k.tolist() == [1]
+        assert (lo[21:50] < 0).all() if expect_free else (lo[21:50] == 0).all()
+        assert lo[3:20].max() > 0  # router .. a: one wall either way
+
+
+def test_ray_past_the_robot_is_cut_at_every_earlier_point():
+    # Three points on one ray from the router, all k = 0, visited far to near (1.5 and 2 m
+    # apart: never joined into one trajectory segment).
+    far, mid, near = (5.55, 1.05), (4.05, 1.05), (2.05, 1.05)
+    out = {}
+    for extend in (True, False):
+        m = SparseInverseKVisibility(GRID, [ROUTER], replace(EXACT, extend_past_robot=extend))
+        for p in (far, mid, near):
+            m.update(p, rssi_k(p, 0))
+        out[extend] = m.log_odds[10]
+    lo = out[True]
+    # every piece of the line is freed by every later reading on it: far's own ray, mid's ray
+    # extended past mid to far, near's ray extended past near to mid and on to far
+    assert lo[2:20] == pytest.approx(np.full(18, -1.2))
+    assert lo[21:40] == pytest.approx(np.full(19, -1.2))
+    assert lo[41:55] == pytest.approx(np.full(14, -1.2))
+    # the points' own cells: footprint, plus the rays of the readings taken before, beyond them
+    assert lo[[20, 40, 55]] == pytest.approx([-1.8, -1.4, -1.0])
+    # without the extension only the stretch router -> robot is updated
+    assert out[False][41:55] == pytest.approx(np.full(14, -0.4))
+    assert out[False][21:40] == pytest.approx(np.full(19, -0.8))
+
+
 def test_bump_marks_the_contact_cell():
     m = SparseInverseKVisibility(GRID, [ROUTER], replace(EXACT, robot_radius_m=0.17))
     m.update((3.05, 1.05), [-100.0], bumped=True, heading_rad=0.0)

@@ -3,30 +3,33 @@
 A frontier is an unknown cell next to a believed-free cell of the thresholded belief; frontier
 cells are grouped into 8-connected clusters (:func:`scipy.ndimage.label`). Each reachable cluster
 gets explore_lite's utility ``gain_scale · size_m − potential_scale · path_m``, where ``path_m`` is
-the cost-weighted path distance (unknown cells cost more than free ones; believed walls, inflated
-by the robot's radius, are obstacles) from the robot to the cheapest place from which it can
-resolve one of the cluster's cells.
+the cost-weighted path distance from the robot (unknown cells cost more than free ones, believed
+walls are obstacles with a soft inflation by the robot's radius, turning towards the goal costs a
+little) to the cheapest place from which the robot resolves one of the cluster's cells.
 
 What differs from a LiDAR map, and how the agent deals with it. The mapper updates cells along
 the ray from the strongest router to the robot, between trajectory points with equal k, and marks
-the robot's footprint free; it has no range sensor. So:
+the robot's footprint free; there is no range sensor. So:
 
 - unknown space is everywhere, also behind the robot, and the frontier is long and fragmented;
 - the cells beside walls are never on a ray piece between two trajectory points in the same
   room, so only the footprint resolves them: the robot must *come within its radius* of a
-  frontier cell, not merely see it. A goal is therefore the reachable cell nearest (by path)
-  whose footprint covers a frontier cell, and exploration crawls along walls the way a
-  wall-follower would, while the rays fill the rooms' interiors;
-- there is no range sensor to find walls: unknown space is traversable (at a cost) and walls are
-  found by bumping; a bump while driving forward marks the contact region as an obstacle, backs
-  off one step and replans;
-- frontier cells that the robot's path passed within ``radius + visited_margin_m`` of, or that lie
-  near a bump, stayed unknown although the robot was there: they are walls, not goals.
+  frontier cell, not merely see it. A goal is therefore the reachable cell whose footprint covers
+  the chosen frontier cell, and exploration crawls along walls the way a wall-follower would,
+  while the rays fill the rooms' interiors. A goal reached whose target stayed unknown is a wall:
+  blacklisted;
+- walls are found by bumping: unknown space is traversable (at a cost); a bump while driving
+  forward marks the contact region as an obstacle, backs off one step and replans; frontier
+  cells near a bump are walls, not goals; a goal is blacklisted after ``max_bumps_per_goal``;
+- small unknown pockets enclosed by known cells (blurred wall estimates inside rooms) lead
+  nowhere and fill in as the robot passes: they are not goals.
 
-A goal that makes no progress for ``progress_timeout_steps`` steps is blacklisted; a cluster the
-planner cannot reach is blacklisted at once. When no frontier is left, or every one is
-blacklisted, the agent records why in ``stop_reason`` and keeps sweeping (it drives to the
-reachable cell farthest from its path so far): an episode never stalls while it has time left.
+A goal that makes no progress for ``progress_timeout_steps`` steps is blacklisted (for
+``blacklist_ttl_steps``); a cluster the planner cannot reach is blacklisted at once (for
+``unreachable_ttl_steps``: the map may open a way later). When no frontier is left, or every one
+is blacklisted, the agent records why in ``stop_reason`` and keeps sweeping (it drives to the
+reachable unknown cell farthest from its path so far): an episode never stalls while it has time
+left.
 """
 
 from __future__ import annotations
@@ -108,7 +111,9 @@ def find_frontiers(
     out = []
     for a, b in zip(starts, ends, strict=True):
         cells = np.stack([rows[a:b], cols[a:b]], axis=1)
-        out.append(Frontier(cells, (float(rows[a:b].sum() / (b - a)), float(cols[a:b].sum() / (b - a)))))
+        out.append(
+            Frontier(cells, (float(rows[a:b].sum() / (b - a)), float(cols[a:b].sum() / (b - a))))
+        )
     out.sort(key=lambda f: -f.size)
     return out
 
@@ -121,16 +126,19 @@ def disk_offsets(radius_cells: float) -> np.ndarray:
     return np.stack([dr[keep], dc[keep]], axis=1)
 
 
-def mark_disk(mask: np.ndarray, cell: tuple[int, int], radius_cells: float) -> None:
-    """Set the cells of ``mask`` within ``radius_cells`` of ``cell`` (in place, clipped)."""
+def disk_cells(shape: tuple[int, int], cell: tuple[int, int], radius_cells: float):
+    """``(rows, cols)`` of the cells within ``radius_cells`` of ``cell`` (clipped to ``shape``)."""
     r, c = int(cell[0]), int(cell[1])
     k = int(np.ceil(radius_cells))
-    h, w = mask.shape
-    r0, r1, c0, c1 = max(r - k, 0), min(r + k + 1, h), max(c - k, 0), min(c + k + 1, w)
-    if r0 >= r1 or c0 >= c1:
-        return
-    rr, cc = np.ogrid[r0:r1, c0:c1]
-    mask[r0:r1, c0:c1] |= (rr - r) ** 2 + (cc - c) ** 2 <= radius_cells * radius_cells
+    h, w = shape
+    rr, cc = np.mgrid[max(r - k, 0) : min(r + k + 1, h), max(c - k, 0) : min(c + k + 1, w)]
+    keep = (rr - r) ** 2 + (cc - c) ** 2 <= radius_cells * radius_cells
+    return rr[keep], cc[keep]
+
+
+def mark_disk(mask: np.ndarray, cell: tuple[int, int], radius_cells: float) -> None:
+    """Set the cells of ``mask`` within ``radius_cells`` of ``cell`` (in place, clipped)."""
+    mask[disk_cells(mask.shape, cell, radius_cells)] = True
 
 
 @dataclass
@@ -172,6 +180,8 @@ class FrontierAgent(Agent):
         turn_cost_m_per_rad: Path metres charged per radian of turning towards a goal, so that
             the robot sweeps on instead of turning back and forth.
         max_bumps_per_goal: A goal is blacklisted after this many bumps on the way to it.
+        blacklist_ttl_steps: A failed goal stays blacklisted this long (then it is tried again:
+            the map around it has changed).
         unreachable_ttl_steps: A cluster the planner cannot reach is blacklisted this long (the
             map may open a way later).
         min_unknown_region_m2: Frontier cells of unknown pockets smaller than this (enclosed by
@@ -197,6 +207,7 @@ class FrontierAgent(Agent):
         backoff_steps: int = 1,
         turn_cost_m_per_rad: float = 0.3,
         max_bumps_per_goal: int = 2,
+        blacklist_ttl_steps: int = 600,
         unreachable_ttl_steps: int = 200,
         min_unknown_region_m2: float = 0.5,
         max_steps: int | None = None,
@@ -213,6 +224,7 @@ class FrontierAgent(Agent):
                             ("replan_every_steps", replan_every_steps, 1),
                             ("backoff_steps", backoff_steps, 0),
                             ("max_bumps_per_goal", max_bumps_per_goal, 1),
+                            ("blacklist_ttl_steps", blacklist_ttl_steps, 1),
                             ("unreachable_ttl_steps", unreachable_ttl_steps, 1)):  # fmt: skip
             if isinstance(v, bool) or not isinstance(v, int) or v < lo:
                 raise ConfigError(f"{name} must be an int >= {lo}, got {v!r}")
@@ -220,6 +232,7 @@ class FrontierAgent(Agent):
         self.replan_every_steps = replan_every_steps
         self.backoff_steps = backoff_steps
         self.max_bumps_per_goal = max_bumps_per_goal
+        self.blacklist_ttl_steps = blacklist_ttl_steps
         self.unreachable_ttl_steps = unreachable_ttl_steps
         self.min_unknown_region_m2 = check_fraction("min_unknown_region_m2", min_unknown_region_m2)
         self.turn_cost_m_per_rad = check_fraction("turn_cost_m_per_rad", turn_cost_m_per_rad)
@@ -229,9 +242,10 @@ class FrontierAgent(Agent):
         res = view.grid.resolution_m
         shape = view.grid.shape
         self.visited = np.zeros(shape, bool)  # within the robot's radius of its path
-        self.blacklisted = np.zeros(shape, bool)  # goals that failed (for good)
-        self.unreachable_until = np.zeros(shape, np.int64)  # walled-off frontiers (for a while)
+        # Step until which a cell is no goal: failed goals, walled-off frontier clusters.
+        self.blacklisted_until = np.zeros(shape, np.int64)
         self.bumps = np.zeros(shape, bool)  # contact regions
+        self._res = res
         self._visit_radius_cells = view.radius_m / res
         # A goal cell resolves a target when the robot stops within the follower's tolerance of
         # its centre and the target's centre is within the robot's radius of the robot's centre.
@@ -321,8 +335,10 @@ class FrontierAgent(Agent):
     # -- bookkeeping -----------------------------------------------------------------------------
     def _blacklist(self, goal: Goal) -> None:
         """Blacklist the cells within ``blacklist_radius_m`` of the goal's target."""
-        res_cells = self.blacklist_radius_m / self._cell_m
-        mark_disk(self.blacklisted, goal.target, max(res_cells, 0.5))
+        res_cells = self.blacklist_radius_m / self._res
+        rows, cols = disk_cells(self.blacklisted_until.shape, goal.target, max(res_cells, 0.5))
+        until = self.steps + self.blacklist_ttl_steps
+        self.blacklisted_until[rows, cols] = np.maximum(self.blacklisted_until[rows, cols], until)
         self.n_blacklisted += 1
         self.goal = None
 
@@ -335,8 +351,9 @@ class FrontierAgent(Agent):
         self.n_bumps += 1
 
     @property
-    def _cell_m(self) -> float:
-        return self._res
+    def blacklisted(self) -> np.ndarray:
+        """Cells blacklisted now (failed goals, walled-off frontiers), ``[row, col]``."""
+        return self.blacklisted_until > self.steps
 
     # -- planning --------------------------------------------------------------------------------
     def _costs(self, view: RobotView) -> np.ndarray:
@@ -349,7 +366,6 @@ class FrontierAgent(Agent):
     def _plan(self, view: RobotView) -> None:
         """Pick a goal and a path to it (or fall back to sweeping); re-path a committed goal."""
         self._since_plan = 0
-        self._res = view.grid.resolution_m
         paths = cost_field(self._costs(view), view.cell, view.grid.resolution_m)
         goal = self.goal
         if goal is not None and goal.kind in self._committed_kinds:
@@ -408,7 +424,7 @@ class FrontierAgent(Agent):
         near_bump = ndimage.binary_dilation(
             self.bumps, iterations=max(1, round(self.bump_exclusion_m / res))
         )
-        exclude = near_bump | self.blacklisted | (self.unreachable_until > self.steps)
+        exclude = near_bump | self.blacklisted
         if self.min_unknown_region_m2 > 0:
             _, _, unknown = belief_classes(view.belief_u8)
             labels, n = ndimage.label(unknown, structure=_EIGHT)
@@ -420,7 +436,7 @@ class FrontierAgent(Agent):
 
     def _choose_goal(self, view: RobotView, paths: CostField) -> Goal | None:
         res = view.grid.resolution_m
-        min_cells = max(1, int(round(self.min_frontier_size_m / res)))
+        min_cells = max(1, round(self.min_frontier_size_m / res))
         if not frontier_mask(view.belief_u8).any():
             self._stop("no_frontiers")
             return None
@@ -430,7 +446,7 @@ class FrontierAgent(Agent):
         for f in find_frontiers(view.belief_u8, min_cells, exclude=exclude):
             cost = approach[f.cells[:, 0], f.cells[:, 1]]
             if not np.isfinite(cost).any():  # walled off on the belief map: blacklisted a while
-                self.unreachable_until[f.cells[:, 0], f.cells[:, 1]] = (
+                self.blacklisted_until[f.cells[:, 0], f.cells[:, 1]] = (
                     self.steps + self.unreachable_ttl_steps
                 )
                 self.n_blacklisted += 1

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from itertools import pairwise
 
 import numpy as np
 from scipy import ndimage
@@ -130,7 +131,7 @@ def cost_field(cost: np.ndarray, start_rc: tuple[int, int], resolution_m: float)
 
 
 def simplify_path(path_xy: np.ndarray, spacing_m: float) -> np.ndarray:
-    """Resample a polyline so that consecutive points lie ``spacing_m`` or more apart (ends kept)."""
+    """Thin a polyline so that consecutive points lie ``spacing_m`` or more apart (ends kept)."""
     if len(path_xy) <= 2:
         return path_xy
     keep = [0]
@@ -142,11 +143,11 @@ def simplify_path(path_xy: np.ndarray, spacing_m: float) -> np.ndarray:
 
 
 def densify_path(path_xy: np.ndarray, spacing_m: float) -> np.ndarray:
-    """Insert points along a polyline so that consecutive points lie at most ``spacing_m`` apart."""
+    """Insert points along a polyline so that neighbours lie at most ``spacing_m`` apart."""
     if len(path_xy) < 2:
         return path_xy
     out = [path_xy[:1]]
-    for a, b in zip(path_xy[:-1], path_xy[1:], strict=True):
+    for a, b in pairwise(path_xy):
         n = max(1, int(np.ceil(np.linalg.norm(b - a) / spacing_m)))
         t = np.arange(1, n + 1)[:, None] / n
         out.append(a + (b - a) * t)

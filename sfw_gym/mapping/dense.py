@@ -19,7 +19,7 @@ from sfw_gym.mapping.raycast import ray_buffer_size, traverse_grid
 
 
 @njit(cache=True)
-def _dense_kernel(k_grid, rgx, rgy, wall, free, rows, cols, t0, t1):
+def _dense_kernel(k_grid, rgx, rgy, adjacent, wall, free, rows, cols, t0, t1):
     n_rows, n_cols = k_grid.shape
     for i in range(n_rows):
         for j in range(n_cols):
@@ -37,13 +37,15 @@ def _dense_kernel(k_grid, rgx, rgy, wall, free, rows, cols, t0, t1):
                     if m - last > 1:
                         for q in range(last + 1, m):
                             wall[rows[q], cols[q]] = True
-                    else:
+                    elif adjacent:
                         wall[rows[last], cols[last]] = True
                 last = m
                 k_last = k
 
 
-def dense_inverse_k_visibility(grid: GridSpec, router_xy, k_grid) -> np.ndarray:
+def dense_inverse_k_visibility(
+    grid: GridSpec, router_xy, k_grid, *, adjacent_steps: bool = True
+) -> np.ndarray:
     """Oracle map from the true k-value of every cell (Alg. 1).
 
     Args:
@@ -51,6 +53,11 @@ def dense_inverse_k_visibility(grid: GridSpec, router_xy, k_grid) -> np.ndarray:
         router_xy: Router ``(x, y)`` in metres, or ``(R, 2)`` for several routers.
         k_grid: int ``grid.shape`` array of k-values (``< 0`` = unknown, e.g. inside walls or
             outside the plan), or ``(R, *grid.shape)`` with one layer per router.
+        adjacent_steps: Whether a step in k between two neighbouring cells on a ray (no cell
+            of unknown k between them) marks the farther one (Alg. 1). On a rasterised plan,
+            where every wall has cells of its own, such steps only occur along shadow lines
+            (a cell centre just inside the shadow, its ray grazing cells just outside): False
+            ignores them, which makes the oracle a fair upper bound for map metrics.
 
     Returns:
         uint8 map: 0 wall, 255 free, 127 unknown. With several routers a cell is a wall if any
@@ -82,7 +89,7 @@ def dense_inverse_k_visibility(grid: GridSpec, router_xy, k_grid) -> np.ndarray:
     t1 = np.empty(size, np.float64)
     g = grid.world_to_grid(routers)
     for r in range(routers.shape[0]):
-        _dense_kernel(k[r], g[r, 0], g[r, 1], wall, free, rows, cols, t0, t1)
+        _dense_kernel(k[r], g[r, 0], g[r, 1], bool(adjacent_steps), wall, free, rows, cols, t0, t1)
     out = np.full(grid.shape, U8_UNKNOWN, np.uint8)
     out[free] = U8_FREE
     out[wall] = U8_WALL

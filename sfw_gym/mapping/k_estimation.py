@@ -4,6 +4,10 @@ Per router, each reading becomes a *feature*: the RSSI itself (``"kmeans"``, the
 RSSI with the log-distance term removed, ``rssi + 10 n log10(d)`` (``"distance_aware"``).
 A sliding-window mean smooths the feature, and ``k = #{j : t_j >= feature}`` for descending
 thresholds ``t_1 > t_2 > ...`` (so ``k = 0`` above ``t_1``, ``k = K`` at or below ``t_K``).
+``K`` reads as "K or more walls". The window is edge-preserving: a reading farther than
+``filter_reset_db`` (default 0.7 wall losses) from every reading held restarts it, so a
+step in k (the robot crossing a shadow line) is not smeared into features between two levels,
+which would be misread and, once fitted, become a spurious level of their own.
 
 Thresholds come from 1-D k-means (scikit-learn, single-threaded, deterministic quantile
 initialisation) with ``K + 1`` clusters on the router's samples. With sorted centroids
@@ -106,8 +110,9 @@ def add_samples(
             d = max(dist[r], min_distance)
             f += 10.0 * path_loss_exponent * np.log10(d)
         if reset_db > 0.0 and ring_count[r] > 0:
-            # A new level (the robot crossed a shadow line): restart the window, so no sample
-            # averages two levels. "New" = farther than reset_db from every reading held.
+            # A new level (the robot crossed a shadow line): restart the window, so that no
+            # feature averages two k-values. "New": farther than reset_db from every reading
+            # held (one noisy reading rarely is, when reset_db is well above the noise).
             near = False
             for j in range(ring_count[r]):
                 if abs(ring[r, j] - f) <= reset_db:
@@ -287,7 +292,7 @@ class KEstimator:
         cfg = self.config
         #: Effective restart distance of the edge-preserving filter (0 = plain sliding mean).
         self.filter_reset_db = (
-            0.5 * cfg.prior_wall_loss_db if cfg.filter_reset_db is None else cfg.filter_reset_db
+            0.7 * cfg.prior_wall_loss_db if cfg.filter_reset_db is None else cfg.filter_reset_db
         )
         self._ring = np.zeros((n, cfg.filter_window))
         self._ring_pos = np.zeros(n, np.int64)

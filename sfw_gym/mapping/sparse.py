@@ -11,7 +11,10 @@ router and, in one compiled kernel:
    router -> robot and cuts it at the earlier trajectory points on it (a per-router raster of
    visited cells storing their filtered feature; their k is re-read with the *current*
    thresholds). The router is an anchor with k = 0. With ``extend_past_robot``, the ray also
-   continues past the robot to the first earlier trajectory point beyond it;
+   continues past the robot to the grid's edge and is cut at every earlier trajectory point
+   beyond it too (rule 4 holds along the whole line from the router: two points on it with the
+   same k bound free space wherever they lie, so later readings also clear the stretches
+   between earlier passes);
 4. updates every piece between consecutive anchors by its Delta k:
 
    - Delta k = 0 (rules 2, 4): every cell strictly inside the piece gets ``free_log_odds``;
@@ -31,6 +34,8 @@ router and, in one compiled kernel:
      m equal sub-pieces, each updated as Delta k = 1 (m peaks at the sub-piece midpoints);
    - Delta k < 0, or Delta k > 0 on a piece with no room for a wall (robot centres closer than
      ``2 * robot_radius_m``, or every cell known free): inconsistent, skipped;
+   - both ends at ``k = max_k``: the estimator's K means "K or more walls", so equal readings
+     there do not mean no wall between them: skipped;
 
 5. fuses by adding log-odds (Eq. 7), clamped to ``[log_odds_min, log_odds_max]``, and keeps the
    map entropy, the uint8 map and the cell classes up to date for the touched cells only.
@@ -54,8 +59,6 @@ from sfw_gym.mapping.k_estimation import KEstimator, add_samples, k_from_thresho
 from sfw_gym.mapping.raycast import ray_buffer_size, traverse_grid
 
 _LN2 = math.log(2.0)
-import os
-CENSOR = int(os.environ.get('CENSOR', '0'))
 # Indices into the float64 `state` array of the kernel.
 _S_ENTROPY, _S_UID, _S_PREV_X, _S_PREV_Y, _S_HAS_PREV, _S_N_TOUCHED, _S_N_CHANGED = range(7)
 # Indices into the float64 `params` array of the kernel.
@@ -263,7 +266,6 @@ def _ray_update(
                 anc_s[n_anc] = 0.5 * (t0[j] + t1[j]) * l_tot
                 anc_k[n_anc] = k_from_thresholds(f, thresholds[r], n_thr[r])
                 n_anc += 1
-                break
     rad = params[_P_RADIUS] / params[_P_RES]
     lmin = params[_P_LMIN]
     lmax = params[_P_LMAX]
@@ -276,10 +278,8 @@ def _ray_update(
         if j1 <= j0:
             continue
         dk = anc_k[a + 1] - anc_k[a]
-        if CENSOR >= 1 and anc_k[a] >= k_sat and anc_k[a + 1] >= k_sat:
-            continue
-        if CENSOR >= 2 and anc_k[a + 1] >= k_sat and dk > 0:
-            continue
+        if anc_k[a] >= k_sat and anc_k[a + 1] >= k_sat:
+            continue  # both ends read "K or more": the walls between them are unknown
         if dk == 0:
             for j in range(j0, j1):
                 cell = rows[j] * n_cols + cols[j]
