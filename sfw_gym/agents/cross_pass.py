@@ -3,15 +3,22 @@
 The sparse mapper updates only along the strongest router's ray (Kim et al., arXiv:2408.07757).
 A cell owned by router A near the border of B's zone lies on A-rays only to points beyond it, in
 B's zone, where the robot uses B's rays instead; so a band of unknown cells stays along the
-borders between dominance zones whatever the route. The paper's remedy is to cross those borders
-on purpose. Here the robot estimates the zones itself — a log-distance model of every router
-(``rssi = c − 10 n log10 d``, one tx power for all), corrected near its path by the residuals of
-its own RSSI history (inverse-distance weighting) — finds the unknown cells
-within ``band_m`` of a zone border, and, when such a band lies near its route, inserts a short
-cross-connecting pass: a closed loop of two legs along the border, one on each side, joined by two
-crossings perpendicular to it. The leg on the far side lays trajectory points beyond the band on
-the near router's rays; the leg on the near side then updates the band between them (and the
-second crossing does the same for the other router's side).
+borders between dominance zones. The paper's remedy is to cross those borders on purpose.
+
+The robot estimates the zones itself: a multi-wall log-distance model of every router
+(``rssi = c − 10 n log10 d − wall_loss · walls``, one tx power for all, walls counted on its own
+belief map), corrected near its path by the residuals of its own RSSI history (inverse-distance
+weighting). Cells within ``band_m`` of an estimated zone border form the bands. Then:
+
+- the main route favours the bands: a frontier cluster's size counts its band cells
+  ``1 + band_bonus`` times (in walled homes the borders mostly run along walls, and the unknown
+  band cells are the wall-side cells that only the robot's footprint resolves);
+- where a border crosses open space (no believed wall on the crossing) and an unknown band
+  cluster lies within ``pass_trigger_m`` of the robot, it inserts a short cross-connecting pass:
+  a closed loop of two legs along the border, one on each side ``pass_offset_m`` from it, joined
+  by two crossings perpendicular to it. The far leg lays trajectory points beyond the band on the
+  near router's rays; the near leg then updates the band between them, and the second crossing
+  does the same for the other router's side. Passes keep ``pass_spacing_m`` apart.
 """
 
 from __future__ import annotations
@@ -23,7 +30,7 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from sfw_gym.agents.base import RobotView, check_fraction
-from sfw_gym.agents.frontier import FrontierAgent, Goal
+from sfw_gym.agents.frontier import FrontierAgent, Goal, mark_disk
 from sfw_gym.agents.planning import CostField, belief_classes
 from sfw_gym.errors import ConfigError
 from sfw_gym.mapping.grid import GridSpec
@@ -169,7 +176,7 @@ def dominance_bands(scores: np.ndarray, band_cells: float) -> tuple[np.ndarray, 
 
 
 class CrossPassAgent(FrontierAgent):
-    """:class:`FrontierAgent` with cross-connecting passes across router-zone borders.
+    """:class:`FrontierAgent` that favours router-zone border bands and crosses them in passes.
 
     Args:
         band_m: Half-width of the band along a zone border whose unknown cells a pass targets.
@@ -181,6 +188,7 @@ class CrossPassAgent(FrontierAgent):
         band_bonus: A frontier cluster's size counts its cells in an estimated border band
             ``1 + band_bonus`` times (the main route favours the bands).
         wall_loss_db: Loss per believed wall in the zone model (a prior).
+        pass_spacing_m: No new pass within this distance of an earlier one.
         **frontier_params: Parameters of :class:`FrontierAgent`.
     """
 
@@ -192,14 +200,16 @@ class CrossPassAgent(FrontierAgent):
         band_m: float = 0.8,
         min_band_area_m2: float = 0.3,
         pass_trigger_m: float = 5.0,
-        pass_length_m: float = 2.0,
-        pass_offset_m: float = 0.7,
+        pass_length_m: float = 1.5,
+        pass_offset_m: float = 0.5,
         zones_every_steps: int = 50,
         band_bonus: float = 2.0,
         wall_loss_db: float = 10.0,
+        pass_spacing_m: float = 3.0,
         **frontier_params: Any,
     ) -> None:
         super().__init__(**frontier_params)
+        self.pass_spacing_m = check_fraction("pass_spacing_m", pass_spacing_m)
         self.band_bonus = check_fraction("band_bonus", band_bonus)
         self.wall_loss_db = check_fraction("wall_loss_db", wall_loss_db)
         self.band_m = check_fraction("band_m", band_m, 0.05)
@@ -283,6 +293,8 @@ class CrossPassAgent(FrontierAgent):
             self.passed[rows, cols] = True
             waypoints = self._pass_waypoints(view, paths, rows, cols)
             if len(waypoints) >= 2:
+                centre = (int(np.median(rows)), int(np.median(cols)))
+                mark_disk(self.passed, centre, self.pass_spacing_m / res)
                 return Goal(waypoints[0], waypoints[0], "pass", waypoints=waypoints[1:])
         return None
 
@@ -309,6 +321,10 @@ class CrossPassAgent(FrontierAgent):
         if np.isfinite(slope) and slope > 1e-6:
             centre = centre - normal * np.clip(diff[c_rc] / slope, -self.band_m, self.band_m)
         half, off = 0.5 * self.pass_length_m, self.pass_offset_m
+        _, walls, _ = belief_classes(view.belief_u8)
+        crossing = np.stack([centre - normal * off, centre + normal * off])
+        if wall_crossings(grid, walls | self.bumps, crossing[:1], crossing[1:])[0, 0]:
+            return []  # the border runs along a wall: the band bonus of the route covers it
         corners = [
             centre - normal * off - tangent * half,  # far side (router b's zone)
             centre - normal * off + tangent * half,
