@@ -10,9 +10,9 @@ The survey is one continuous, physically valid path (a sample every 5 cm) inside
 shrunk by the robot's clearance (its 0.17 m radius + 2 cm): first a wall-following pass around
 every boundary of that region, then a lawnmower (boustrophedon) of passes ``--spacing`` apart,
 each pass continuing into an overlapping one of the next row where it can, with collision-free
-transits (straight where possible, else a shortest path on a 5 cm grid) in between. The robot
-never jumps, so the mapper never joins two samples through a wall. ``--survey lawnmower``
-drops the wall-following pass.
+transits (straight where possible, else a breadth-first path on a 5 cm grid, string-pulled)
+in between. The robot never jumps, so the mapper never joins two samples through a wall.
+``--survey lawnmower`` drops the wall-following pass.
 
 The mapper is configured as the environment configures it: ``k0_level_dbm = P_tx - PL(1 m)``
 (the robot knows its routers' transmit power; the free-space loss at 1 m is standard); rows

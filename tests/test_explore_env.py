@@ -116,3 +116,12 @@ def test_discrete_actions_move_or_turn():
     env.step(1)
     assert u.scene.robot.pose[2] != pytest.approx(t0)
     assert u.scene.robot.pose[:2] == pytest.approx((x0, y0), abs=1e-6)
+
+
+def test_mapper_options_reach_the_mapper():
+    env = gym.make("SfW-Explore-v0", mapper={"k_estimator": "kmeans", "router_policy": "all"})
+    env.reset(seed=0)
+    cfg = env.unwrapped.mapper.config
+    assert cfg.k_estimator == "kmeans" and cfg.router_policy == "all" and cfg.k0_level_dbm is None
+    default = gym.make("SfW-Explore-v0").unwrapped.mapper_config
+    assert default.k0_level_dbm == pytest.approx(20.0 - 40.18, abs=0.01)  # P_tx − PL(1 m)

@@ -133,10 +133,11 @@ class SfWExploreEnv(gym.Env):
         self.robot_config = _make_config("robot", robot, RobotConfig)
         # The robot knows its routers: their RSSI at 1 m with no wall (P_tx − PL(1 m)) calibrates
         # k = 0, so a router first heard through a wall is not read one wall short.
-        mapper_defaults = {
-            "robot_radius_m": self.robot_config.radius_m,
-            "k0_level_dbm": self.radio_config.tx_power_dbm - self.radio_config.d0_loss_db,
-        }
+        # (distance-aware estimation only: raw RSSI has no fixed no-wall level).
+        mapper_defaults: dict[str, Any] = {"robot_radius_m": self.robot_config.radius_m}
+        if (mapper or {}).get("k_estimator", "distance_aware") == "distance_aware":
+            k0 = self.radio_config.tx_power_dbm - self.radio_config.d0_loss_db
+            mapper_defaults["k0_level_dbm"] = k0
         self.mapper_config = _make_config(
             "mapper", {**mapper_defaults, **(mapper or {})}, MapperConfig
         )
@@ -267,6 +268,8 @@ class SfWExploreEnv(gym.Env):
             self.tracker.apply(self.mapper.last_changed_cells, self.mapper.occupancy_u8)
             est_k = self.mapper.last_k
             heard = (rssi > NOT_HEARD_DBM) & (est_k >= 0)
+            # k = K means "K or more walls" (sfw_gym.metrics.k_value_accuracy with max_k)
+            true_k = np.minimum(true_k, self.mapper_config.max_k)
             self.k_correct += int((est_k[heard] == true_k[heard]).sum())
             self.k_total += int(heard.sum())
         else:  # odometry drifted off the map: nothing to update (documented in the info)

@@ -57,7 +57,7 @@ def dense_inverse_k_visibility(
             of unknown k between them) marks the farther one (Alg. 1). On a rasterised plan,
             where every wall has cells of its own, such steps only occur along shadow lines
             (a cell centre just inside the shadow, its ray grazing cells just outside): False
-            ignores them, which makes the oracle a fair upper bound for map metrics.
+            ignores them, which makes the oracle a fair reference for map metrics.
 
     Returns:
         uint8 map: 0 wall, 255 free, 127 unknown. With several routers a cell is a wall if any

@@ -9,8 +9,9 @@ thresholds ``t_1 > t_2 > ...`` (so ``k = 0`` above ``t_1``, ``k = K`` at or belo
 step in k (the robot crossing a shadow line) is not smeared into features between two levels,
 which would be misread and, once fitted, become a spurious level of their own.
 
-Thresholds come from 1-D k-means (scikit-learn, single-threaded, deterministic quantile
-initialisation) with ``K + 1`` clusters on the router's samples. With sorted centroids
+Thresholds come from 1-D k-means (scikit-learn, single-threaded; two deterministic starts,
+sample quantiles and evenly spaced over the range, the lower-inertia fit kept) with ``K + 1``
+clusters on the router's samples. With sorted centroids
 ``C_0 > C_1 > ...``:
 
 1. adjacent centroids closer than ``min_cluster_gap_db`` are merged (size-weighted), so data

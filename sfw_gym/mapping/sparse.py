@@ -313,9 +313,8 @@ def _update_kernel(
             return np.nan, False
     (
         kest_da, kest_n, kest_dmin, kest_gap, kest_cal, kest_reset, ring, ring_pos, ring_count,
-        fit_buf,
-        fit_n, fit_stride, n_seen, n_fit_seen, next_refit, thresholds, n_thr, fitted, prior,
-        fit_range, novel, novel_needed,
+        fit_buf, fit_n, fit_stride, n_seen, n_fit_seen, next_refit, thresholds, n_thr, fitted,
+        prior, fit_range, novel, novel_needed,
     ) = kest  # fmt: skip
     lo, _, u8, cls, classified, _, _ = maps
     touched, old_cls, changed, state = track
