@@ -26,15 +26,15 @@ from sfw_gym.agents import (
     router_scores,
 )
 from sfw_gym.agents.base import VIEW_KEYS
-from sfw_gym.agents.planning import (
+from sfw_gym.errors import ConfigError
+from sfw_gym.mapping import GridSpec
+from sfw_gym.navigation import (
     PurePursuit,
     cost_field,
     to_discrete,
     traversal_costs,
     wrap_angle,
 )
-from sfw_gym.errors import ConfigError
-from sfw_gym.mapping import GridSpec
 
 W, U, F = 0, 127, 255  # wall, unknown, free
 SMALL = "SfW-ExploreSmall-v0"

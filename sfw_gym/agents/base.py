@@ -208,7 +208,7 @@ class Agent(ABC):
 
     def _to_action(self, linear: float, angular: float) -> Any:
         if self.action_type == "discrete":
-            from sfw_gym.agents.planning import to_discrete
+            from sfw_gym.navigation import to_discrete
 
             return to_discrete(linear, angular)
         return np.array([linear, angular], np.float32)

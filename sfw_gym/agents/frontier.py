@@ -41,7 +41,8 @@ import numpy as np
 from scipy import ndimage
 
 from sfw_gym.agents.base import Agent, RobotView, check_fraction
-from sfw_gym.agents.planning import (
+from sfw_gym.errors import ConfigError
+from sfw_gym.navigation import (
     CostField,
     PurePursuit,
     belief_classes,
@@ -50,7 +51,6 @@ from sfw_gym.agents.planning import (
     simplify_path,
     traversal_costs,
 )
-from sfw_gym.errors import ConfigError
 
 _EIGHT = np.ones((3, 3), bool)
 

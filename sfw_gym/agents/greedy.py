@@ -9,8 +9,8 @@ import numpy as np
 from sfw_gym.agents.base import RobotView, check_fraction
 from sfw_gym.agents.cross_pass import router_scores
 from sfw_gym.agents.frontier import FrontierAgent, Goal, frontier_mask
-from sfw_gym.agents.planning import CostField, belief_classes
 from sfw_gym.errors import ConfigError
+from sfw_gym.navigation import CostField, belief_classes
 
 
 class GreedyInfoGainAgent(FrontierAgent):

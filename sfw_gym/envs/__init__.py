@@ -39,8 +39,13 @@ def register_envs() -> None:
 
 
 def __getattr__(name: str) -> Any:
+    """Lazy access to the env class and wrappers (``import sfw_gym`` stays light)."""
     if name == "SfWExploreEnv":
         from sfw_gym.envs.explore import SfWExploreEnv
 
         return SfWExploreEnv
+    if name == "WaypointWrapper":
+        from sfw_gym.envs.waypoint import WaypointWrapper
+
+        return WaypointWrapper
     raise AttributeError(name)

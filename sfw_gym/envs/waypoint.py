@@ -76,7 +76,9 @@ class WaypointWrapper(gym.Wrapper):
             if not self._follower.has_path and steps > 0:
                 break
             command = (
-                to_discrete(linear, angular) if discrete else np.array([linear, angular], np.float32)
+                to_discrete(linear, angular)
+                if discrete
+                else np.array([linear, angular], np.float32)
             )
             obs, reward, terminated, truncated, info = self.env.step(command)
             total += float(reward)

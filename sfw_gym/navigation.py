@@ -1,4 +1,4 @@
-"""Grid path planning on the robot's belief map and a pure-pursuit path follower.
+"""Navigation on the belief map: grid path planning and a pure-pursuit path follower.
 
 Costs: a cell believed a wall is an obstacle, inflated by the robot's radius; unknown cells are
 traversable at ``unknown_cost`` (× a free cell); cells near a wall cost extra so that paths keep
