@@ -198,7 +198,7 @@ class TestBadInput:
     def test_bad_kwargs(self):
         with pytest.raises(ConfigError, match="action_type"):
             gym.make("SfW-Explore-v0", action_type="teleport")
-        with pytest.raises(ConfigError, match="(?i)radio"):
+        with pytest.raises(ConfigError, match=r"(?i)radio"):
             gym.make("SfW-Explore-v0", radio={"walls_are_lava": True})
         with pytest.raises(ConfigError, match="preset"):
             gym.make("SfW-Explore-v0", radio_preset="swamp")
