@@ -29,15 +29,15 @@ import json
 import math
 import os
 import re
-import tempfile
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
 
+from sfw_gym.atomic import atomic_path, write_text_atomic
 from sfw_gym.errors import ConfigError
 from sfw_gym.mapping import NOT_HEARD_DBM, GridSpec, MapperConfig, SparseInverseKVisibility
 
@@ -418,20 +418,6 @@ def _progress(total: int, desc: str) -> Any:
 
 
 # -- writing -------------------------------------------------------------------------------------
-def write_bytes_atomic(path: Path, write: Callable[[IO[bytes]], object]) -> Path:
-    """Call ``write(fh)`` on a temp file beside ``path``, then rename it onto ``path``."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            write(fh)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
-
-
 def write_map(result: OfflineMap, out: str | os.PathLike[str], *, y_down: bool = False) -> dict:
     """Write the map: ``out`` (PNG), and beside it ``.npy`` (occupancy_u8) and ``.json`` (grid).
 
@@ -457,7 +443,8 @@ def write_map(result: OfflineMap, out: str | os.PathLike[str], *, y_down: bool =
         raise ConfigError(f"--out must be a .png file, got {str(out)!r}")
     npy, meta = out.with_suffix(".npy"), out.with_suffix(".json")
     occ = np.array(result.mapper.occupancy_u8)
-    write_bytes_atomic(npy, lambda fh: np.save(fh, occ, allow_pickle=False))
+    with atomic_path(npy) as tmp:
+        np.save(tmp, occ, allow_pickle=False)
     info = {
         "source": str(result.log.path),
         "origin_xy_m": list(result.grid.origin_xy),
@@ -473,8 +460,9 @@ def write_map(result: OfflineMap, out: str | os.PathLike[str], *, y_down: bool =
         "mapper_config": result.mapper.config.to_dict(),
     }
     text = json.dumps(info, indent=2) + "\n"
-    write_bytes_atomic(meta, lambda fh: fh.write(text.encode("utf-8")))
-    write_bytes_atomic(out, lambda fh: _draw(result, occ, fh, y_down))
+    write_text_atomic(meta, text)
+    with atomic_path(out) as tmp, open(tmp, "wb") as fh:
+        _draw(result, occ, fh, y_down)
     return {"png": out, "npy": npy, "json": meta}
 
 

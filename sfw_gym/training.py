@@ -14,7 +14,6 @@ Layout of an output folder::
 from __future__ import annotations
 
 import ast
-import os
 import re
 import sys
 import time
@@ -24,6 +23,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from sfw_gym.atomic import atomic_path, write_text_atomic
 from sfw_gym.errors import ConfigError
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
@@ -201,22 +201,14 @@ def train_ppo(
         "command": " ".join(sys.argv),
         "model": str(out / "model.zip"),
     }
-    _write_yaml_atomic(out / "config.yml", summary)
+    write_text_atomic(out / "config.yml", yaml.safe_dump(summary, sort_keys=False))
     plot_training_curve(out)
     return summary
 
 
 def _save_atomic(model: Any, path: Path) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.stem}.tmp.zip")
-    model.save(tmp)
-    os.replace(tmp, path)
-
-
-def _write_yaml_atomic(path: Path, data: dict[str, Any]) -> None:
-    from sfw_gym.world.floorplan import write_text_atomic
-
-    write_text_atomic(path, yaml.safe_dump(data, sort_keys=False))
+    with atomic_path(path) as tmp:
+        model.save(tmp)
 
 
 def plot_training_curve(out_dir: str | Path) -> Path | None:
@@ -261,8 +253,7 @@ def plot_training_curve(out_dir: str | Path) -> Path | None:
     ax.grid(alpha=0.3)
     fig.tight_layout()
     path = out / "training_curve.png"
-    tmp = out / ".training_curve.tmp.png"
-    fig.savefig(tmp, dpi=110)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)
-    os.replace(tmp, path)
     return path

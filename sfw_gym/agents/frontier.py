@@ -27,9 +27,10 @@ the robot's footprint free; there is no range sensor. So:
 A goal that makes no progress for ``progress_timeout_steps`` steps is blacklisted (for
 ``blacklist_ttl_steps``); a cluster the planner cannot reach is blacklisted at once (for
 ``unreachable_ttl_steps``: the map may open a way later). When no frontier is left, or every one
-is blacklisted, the agent records why in ``stop_reason`` and keeps sweeping (it drives to the
-reachable unknown cell farthest from its path so far): an episode never stalls while it has time
-left.
+is blacklisted, the agent records why in ``stop_reason`` and does not stall: if frontiers are
+only walled off on its map, it doubts the map (walls cost instead of block) and tries the cheapest
+one (an ``escape`` goal: a doorway that blurred or bump-made walls closed opens up again); else it
+sweeps, driving to the reachable unknown cell farthest from its path so far.
 """
 
 from __future__ import annotations
@@ -186,6 +187,10 @@ class FrontierAgent(Agent):
             map may open a way later).
         min_unknown_region_m2: Frontier cells of unknown pockets smaller than this (enclosed by
             known cells) are not goals: they lead nowhere and fill in as the robot passes by.
+        escape_wall_cost: When every frontier is walled off on the map, the agent plans once
+            more with believed walls (and bumps) costing this much per cell instead of blocking,
+            and drives to the cheapest walled-off frontier: a doorway the map closed by mistake
+            opens up; a real wall ends in bumps and a blacklisted goal.
         max_steps: Optional step limit of the agent (then ``stop_reason = "max_steps"``).
     """
 
@@ -210,6 +215,7 @@ class FrontierAgent(Agent):
         blacklist_ttl_steps: int = 600,
         unreachable_ttl_steps: int = 200,
         min_unknown_region_m2: float = 0.5,
+        escape_wall_cost: float = 25.0,
         max_steps: int | None = None,
     ) -> None:
         super().__init__(max_steps=max_steps)
@@ -236,14 +242,16 @@ class FrontierAgent(Agent):
         self.unreachable_ttl_steps = unreachable_ttl_steps
         self.min_unknown_region_m2 = check_fraction("min_unknown_region_m2", min_unknown_region_m2)
         self.turn_cost_m_per_rad = check_fraction("turn_cost_m_per_rad", turn_cost_m_per_rad)
+        self.escape_wall_cost = check_fraction("escape_wall_cost", escape_wall_cost, 1.0)
 
     # -- episode ---------------------------------------------------------------------------------
     def _on_reset(self, view: RobotView) -> None:
         res = view.grid.resolution_m
         shape = view.grid.shape
         self.visited = np.zeros(shape, bool)  # within the robot's radius of its path
-        # Step until which a cell is no goal: failed goals, walled-off frontier clusters.
+        # Step until which a cell is no goal: failed goals; walled-off frontier clusters.
         self.blacklisted_until = np.zeros(shape, np.int64)
+        self.unreachable_until = np.zeros(shape, np.int64)
         self.bumps = np.zeros(shape, bool)  # contact regions
         self._res = res
         self._visit_radius_cells = view.radius_m / res
@@ -294,7 +302,11 @@ class FrontierAgent(Agent):
             goal.best_remaining_m, goal.steps_without_progress, goal.bumps = np.inf, 0, 0
             self._plan(view)
             return
-        if goal is not None and goal.kind == "frontier" and self._still_unknown(view, goal.target):
+        if (
+            goal is not None
+            and goal.kind in ("frontier", "escape")
+            and self._still_unknown(view, goal.target)
+        ):
             self._blacklist(goal)  # the footprint covered it and it stayed unknown: a wall
         self.goal = None
         self._plan(view)
@@ -353,30 +365,60 @@ class FrontierAgent(Agent):
     @property
     def blacklisted(self) -> np.ndarray:
         """Cells blacklisted now (failed goals, walled-off frontiers), ``[row, col]``."""
-        return self.blacklisted_until > self.steps
+        return (self.blacklisted_until > self.steps) | self.unreachable
+
+    @property
+    def unreachable(self) -> np.ndarray:
+        """Frontier cells that the planner found walled off (blacklisted for a while)."""
+        return self.unreachable_until > self.steps
 
     # -- planning --------------------------------------------------------------------------------
-    def _costs(self, view: RobotView) -> np.ndarray:
-        cost = traversal_costs(
-            view.belief_u8, view.grid.resolution_m, view.radius_m,
-            unknown_cost=self.unknown_cost, blocked=self.bumps,
-        )  # fmt: skip
+    def _costs(self, view: RobotView, relaxed: bool = False) -> np.ndarray:
+        """Planner costs; ``relaxed``: believed walls and bumps cost ``escape_wall_cost``."""
+        res, radius = view.grid.resolution_m, view.radius_m
+        if not relaxed:
+            cost = traversal_costs(
+                view.belief_u8, res, radius, unknown_cost=self.unknown_cost, blocked=self.bumps
+            )
+        else:
+            _, walls, _ = belief_classes(view.belief_u8)
+            cost = traversal_costs(view.belief_u8, res, radius, unknown_cost=self.unknown_cost)
+            cost[walls | self.bumps] = self.escape_wall_cost
         return free_start(cost, view.cell)
 
     def _plan(self, view: RobotView) -> None:
         """Pick a goal and a path to it (or fall back to sweeping); re-path a committed goal."""
         self._since_plan = 0
-        paths = cost_field(self._costs(view), view.cell, view.grid.resolution_m)
         goal = self.goal
-        if goal is not None and goal.kind in self._committed_kinds:
+        relaxed = goal is not None and goal.kind == "escape"
+        paths = cost_field(self._costs(view, relaxed), view.cell, view.grid.resolution_m)
+        if goal is not None and goal.kind in (*self._committed_kinds, "escape"):
             if np.isfinite(paths.cumulative[goal.cell]):
                 self._set_goal(view, paths, goal)
                 return
             self._blacklist(goal)
         goal = self._choose_goal(view, paths)
+        if goal is None and self.unreachable.any():
+            # Frontiers exist but the map walls them off: the map may be wrong (a doorway
+            # closed by blurred or bump-made walls). Doubt it: walls cost, not block.
+            escape = cost_field(self._costs(view, True), view.cell, view.grid.resolution_m)
+            goal = self._escape_goal(view, escape)
+            if goal is not None:
+                paths = escape
         if goal is None:
             goal = self._sweep_goal(view, paths)
         self._set_goal(view, paths, goal)
+
+    def _escape_goal(self, view: RobotView, paths: CostField) -> Goal | None:
+        """The cheapest walled-off frontier cell on a map whose walls are merely costly."""
+        mask = frontier_mask(view.belief_u8, self.blacklisted_until > self.steps)
+        mask &= self.unreachable
+        approach = np.where(mask, self._approach(paths), np.inf)
+        if not np.isfinite(approach).any():
+            return None
+        r, c = np.unravel_index(int(np.argmin(approach)), approach.shape)
+        target = (int(r), int(c))
+        return Goal(self._approach_cell(paths, target), target, "escape")
 
     def _set_goal(self, view: RobotView, paths: CostField, goal: Goal | None) -> None:
         prev = self.goal
@@ -446,7 +488,7 @@ class FrontierAgent(Agent):
         for f in find_frontiers(view.belief_u8, min_cells, exclude=exclude):
             cost = approach[f.cells[:, 0], f.cells[:, 1]]
             if not np.isfinite(cost).any():  # walled off on the belief map: blacklisted a while
-                self.blacklisted_until[f.cells[:, 0], f.cells[:, 1]] = (
+                self.unreachable_until[f.cells[:, 0], f.cells[:, 1]] = (
                     self.steps + self.unreachable_ttl_steps
                 )
                 self.n_blacklisted += 1

@@ -99,6 +99,8 @@ class GreedyInfoGainAgent(FrontierAgent):
             return None
         mask &= ~self._frontier_exclusion(view)
         approach = self._approach(paths)
+        walled_off = mask & ~np.isfinite(approach)
+        self.unreachable_until[walled_off] = self.steps + self.unreachable_ttl_steps
         mask &= np.isfinite(approach)
         cells = np.argwhere(mask)
         if len(cells) == 0:

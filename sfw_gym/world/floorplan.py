@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 import math
 import os
-import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -16,6 +15,7 @@ import shapely
 from shapely.geometry import Polygon
 from shapely.validation import explain_validity
 
+from sfw_gym.atomic import write_text_atomic
 from sfw_gym.errors import FloorplanError
 from sfw_gym.world.wall_crossing import DEFAULT_MIN_PIECE_M, cross_walls, cross_walls_parallel
 
@@ -202,20 +202,6 @@ class Floorplan:
     def save(self, path: str | os.PathLike[str]) -> Path:
         """Write the plan as sfw_gym JSON, atomically (temp file + rename). Returns the path."""
         return write_text_atomic(Path(path), json.dumps(self.to_dict()))
-
-
-def write_text_atomic(path: Path, text: str) -> Path:
-    """Write ``text`` to ``path`` via a temp file in the same folder and an atomic rename."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
 
 
 def load_floorplan(source: str | os.PathLike[str] | Mapping[str, Any]) -> Floorplan:

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from sfw_gym.atomic import atomic_path
 from sfw_gym.world.floorplan import Floorplan
 from sfw_gym.world.radio import RadioModel
 
@@ -67,12 +68,9 @@ def draw_world(
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
     fig.tight_layout()
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(f".{out.stem}.tmp{out.suffix}")
-    fig.savefig(tmp, dpi=110)
+    with atomic_path(out) as tmp:
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)
-    tmp.replace(out)
     return out
 
 
