@@ -25,9 +25,7 @@ from __future__ import annotations
 import json
 import math
 import multiprocessing as mp
-import os
-import tempfile
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Iterable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from sfw_gym.atomic import atomic_path, write_text_atomic
 from sfw_gym.errors import ConfigError
 
 #: Metrics of the results table: (record key, column label, format).
@@ -204,44 +203,23 @@ def _py(v: Any) -> Any:
 
 
 # ---------------------------------------------------------------------------------- atomic I/O
-def _atomic(path: Path, write: Callable[[str], None], suffix: str = "") -> Path:
-    """Write via ``write(tmp_path)`` to a temp file beside ``path``, then rename it over."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp" + suffix)
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
-
-
-def write_text_atomic(path: Path, text: str) -> Path:
-    """Write ``text`` to ``path`` atomically."""
-    return _atomic(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
-
-
 def _write_npz(path: Path, **arrays: np.ndarray) -> None:
-    def write(tmp: str) -> None:
-        with open(tmp, "wb") as fh:
-            np.savez_compressed(fh, **arrays)
-
-    _atomic(path, write)
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+        np.savez_compressed(fh, **arrays)
 
 
 def _write_gif(path: Path, frames: list[np.ndarray], fps: int) -> None:
     import imageio.v3 as iio
 
-    _atomic(path, lambda tmp: iio.imwrite(tmp, np.stack(frames), extension=".gif",
-                                          duration=1000 / fps, loop=0))  # fmt: skip
+    with atomic_path(path) as tmp:
+        iio.imwrite(tmp, np.stack(frames), extension=".gif", duration=1000 / fps, loop=0)
 
 
 def _save_figure(fig: Any, path: Path) -> Path:
     import matplotlib.pyplot as plt
 
-    _atomic(path, lambda tmp: fig.savefig(tmp, format="png", dpi=110, bbox_inches="tight"))
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=110, bbox_inches="tight")
     plt.close(fig)
     return path
 

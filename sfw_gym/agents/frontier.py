@@ -27,10 +27,11 @@ the robot's footprint free; there is no range sensor. So:
 A goal that makes no progress for ``progress_timeout_steps`` steps is blacklisted (for
 ``blacklist_ttl_steps``); a cluster the planner cannot reach is blacklisted at once (for
 ``unreachable_ttl_steps``: the map may open a way later). When no frontier is left, or every one
-is blacklisted, the agent records why in ``stop_reason`` and does not stall: if frontiers are
-only walled off on its map, it doubts the map (walls cost instead of block) and tries the cheapest
-one (an ``escape`` goal: a doorway that blurred or bump-made walls closed opens up again); else it
-sweeps, driving to the reachable unknown cell farthest from its path so far.
+is blacklisted, the agent records why in ``stop_reason`` and does not stall: while frontiers are
+left that are only walled off on its map or lie by bumps, it doubts the map (walls cost instead
+of block) and tries the cheapest (an ``escape`` goal: a doorway that blurred or bump-made walls
+closed opens up again); else it sweeps, driving to the reachable unknown cell farthest from its
+path so far.
 """
 
 from __future__ import annotations
@@ -187,10 +188,11 @@ class FrontierAgent(Agent):
             map may open a way later).
         min_unknown_region_m2: Frontier cells of unknown pockets smaller than this (enclosed by
             known cells) are not goals: they lead nowhere and fill in as the robot passes by.
-        escape_wall_cost: When every frontier is walled off on the map, the agent plans once
-            more with believed walls (and bumps) costing this much per cell instead of blocking,
-            and drives to the cheapest walled-off frontier: a doorway the map closed by mistake
-            opens up; a real wall ends in bumps and a blacklisted goal.
+        escape_wall_cost: When every frontier is walled off on the map or lies by a bump, the
+            agent plans once more with believed walls (and bumps) costing this much per cell
+            instead of blocking, and drives to the cheapest frontier cell that has not failed as
+            a goal: a doorway the map closed by mistake opens up; a real wall ends in bumps and
+            a blacklisted goal.
         max_steps: Optional step limit of the agent (then ``stop_reason = "max_steps"``).
     """
 
@@ -398,9 +400,9 @@ class FrontierAgent(Agent):
                 return
             self._blacklist(goal)
         goal = self._choose_goal(view, paths)
-        if goal is None and self.unreachable.any():
-            # Frontiers exist but the map walls them off: the map may be wrong (a doorway
-            # closed by blurred or bump-made walls). Doubt it: walls cost, not block.
+        if goal is None and self.stop_reason == "all_blacklisted":
+            # Frontiers exist but are walled off or lie by bumps: the map may be wrong (a
+            # doorway closed by blurred or bump-made walls). Doubt it: walls cost, not block.
             escape = cost_field(self._costs(view, True), view.cell, view.grid.resolution_m)
             goal = self._escape_goal(view, escape)
             if goal is not None:
@@ -410,9 +412,8 @@ class FrontierAgent(Agent):
         self._set_goal(view, paths, goal)
 
     def _escape_goal(self, view: RobotView, paths: CostField) -> Goal | None:
-        """The cheapest walled-off frontier cell on a map whose walls are merely costly."""
+        """The cheapest frontier cell (not a failed goal) on a map whose walls merely cost."""
         mask = frontier_mask(view.belief_u8, self.blacklisted_until > self.steps)
-        mask &= self.unreachable
         approach = np.where(mask, self._approach(paths), np.inf)
         if not np.isfinite(approach).any():
             return None
