@@ -265,17 +265,28 @@ class FrontierAgent(Agent):
         self.follower = PurePursuit(lookahead_m=self.lookahead_m, goal_tolerance_m=tolerance_m)
         self._since_plan = 0
         self._backoff = 0
+        self._slides = 0
+        self._last_xy = view.xy
         self.n_blacklisted = 0
         self.n_goals = 0
         self.n_bumps = 0
 
     def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
         mark_disk(self.visited, view.cell, self._visit_radius_cells)
-        # A bump while driving forward: remember the wall ahead, back off (continuous) and
-        # replan. Contact while turning or reversing says nothing about what lies ahead.
-        bumped_ahead = view.bumped and self.last_command[0] > 0
+        # A bump that stopped the robot driving forward: remember a wall ahead, back off
+        # (continuous) and replan. Contact while turning or reversing, or while sliding along
+        # a wall (brushing a door frame), says little about what lies ahead: replan only, and
+        # back off if the sliding goes on (3 steps).
+        moved = float(np.linalg.norm(view.xy - self._last_xy))
+        wanted = self.last_command[0] * view.max_linear_speed_m_s * view.control_period_s
+        bumped_ahead = view.bumped and wanted > 0 and moved < 0.5 * wanted
+        slid = view.bumped and wanted > 0 and not bumped_ahead
+        self._slides = self._slides + 1 if slid else 0
+        self._last_xy = view.xy
         if bumped_ahead:
             self._mark_bump(view)
+        if bumped_ahead or self._slides >= 3:
+            self._slides = 0
             if self.action_type == "continuous" and self.backoff_steps:
                 self._backoff = self.backoff_steps
         self._track_progress(view, bumped_ahead)
@@ -283,7 +294,7 @@ class FrontierAgent(Agent):
             self._backoff -= 1
             self.follower.set_path(np.zeros((0, 2)))
             return -1.0, 0.0
-        if self._needs_plan(view, bumped_ahead):
+        if self._needs_plan(view, bumped_ahead or slid):
             self._plan(view)
         self._since_plan += 1
         for _ in range(2):
