@@ -210,6 +210,20 @@ def _wall_candidates(j0, j1, dk, s_mid, ray, l_tot, cls, n_cols):
 
 
 @njit(cache=True)
+def _push_anchors(raster_r, rows, cols, t0, t1, l_tot, thresholds_r, n_thr_r, lo, hi,
+                  anc_j, anc_s, anc_k, n_anc):  # fmt: skip
+    """Append the visited ray cells lo..hi-1 (trajectory points) as anchors with their k."""
+    for j in range(lo, hi):
+        f = raster_r[rows[j], cols[j]]
+        if f == f:  # visited (not NaN)
+            anc_j[n_anc] = j
+            anc_s[n_anc] = 0.5 * (t0[j] + t1[j]) * l_tot
+            anc_k[n_anc] = k_from_thresholds(f, thresholds_r, n_thr_r)
+            n_anc += 1
+    return n_anc
+
+
+@njit(cache=True)
 def _ray_update(
     r, k_robot, gx, gy, rgx, rgy, extend, params, raster, thresholds, n_thr, maps, track, ray,
     anchors,
@@ -247,25 +261,15 @@ def _ray_update(
     anc_s[0] = 0.0
     anc_k[0] = 0
     n_anc = 1
-    for j in range(i_r):
-        f = raster[r, rows[j], cols[j]]
-        if f == f:
-            anc_j[n_anc] = j
-            anc_s[n_anc] = 0.5 * (t0[j] + t1[j]) * l_tot
-            anc_k[n_anc] = k_from_thresholds(f, thresholds[r], n_thr[r])
-            n_anc += 1
+    n_anc = _push_anchors(raster[r], rows, cols, t0, t1, l_tot, thresholds[r], n_thr[r],
+                          0, i_r, anc_j, anc_s, anc_k, n_anc)  # fmt: skip
     anc_j[n_anc] = i_r
     anc_s[n_anc] = dist
     anc_k[n_anc] = k_robot
     n_anc += 1
     if extend:
-        for j in range(i_r + 1, n):
-            f = raster[r, rows[j], cols[j]]
-            if f == f:
-                anc_j[n_anc] = j
-                anc_s[n_anc] = 0.5 * (t0[j] + t1[j]) * l_tot
-                anc_k[n_anc] = k_from_thresholds(f, thresholds[r], n_thr[r])
-                n_anc += 1
+        n_anc = _push_anchors(raster[r], rows, cols, t0, t1, l_tot, thresholds[r], n_thr[r],
+                              i_r + 1, n, anc_j, anc_s, anc_k, n_anc)  # fmt: skip
     rad = params[_P_RADIUS] / params[_P_RES]
     lmin = params[_P_LMIN]
     lmax = params[_P_LMAX]
