@@ -350,6 +350,7 @@ def plot_curves(records: list[dict[str, Any]], agents: Sequence[str], out: Path)
     )
     for fname, xi, yi, xlabel, ylabel in specs:
         fig, ax = plt.subplots(figsize=(6.4, 4.2))
+        lowest = 1.0
         for name in agents:
             curves = []
             for r in records:
@@ -366,9 +367,11 @@ def plot_curves(records: list[dict[str, Any]], agents: Sequence[str], out: Path)
             ax.plot(grid, mean, color=colours[name], label=f"{name} (n={len(curves)})")
             lo, hi = np.clip(mean - half, 0, 1), np.clip(mean + half, 0, 1)
             ax.fill_between(grid, lo, hi, color=colours[name], alpha=0.2)
+            lowest = min(lowest, float(lo[len(lo) // 20 :].min()))  # past the first few steps
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
-        ax.set_ylim(0, 1.0)
+        # Coverage spans [0, 1]; IoU stays high: zoom in on its range.
+        ax.set_ylim(0.0 if yi == 1 else max(0.0, np.floor(lowest * 20 - 1) / 20), 1.0)
         ax.grid(alpha=0.3)
         ax.legend(loc="lower right")
         written.append(_save_figure(fig, out / fname))
