@@ -220,3 +220,13 @@ class TestRasterize:
     def test_bad_resolution(self, two_rooms):
         with pytest.raises(FloorplanError, match="resolution_m"):
             two_rooms.rasterize(0.0)
+
+
+def test_saved_files_get_the_usual_permissions(tmp_path, two_rooms):
+    import os
+    import stat
+
+    path = two_rooms.save(tmp_path / "p.json")
+    mask = os.umask(0)
+    os.umask(mask)
+    assert stat.S_IMODE(path.stat().st_mode) == 0o666 & ~mask
