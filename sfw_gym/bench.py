@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import resource
 import statistics
 import time
@@ -21,7 +22,7 @@ class EnvTiming:
 
 
 def time_env(env_id: str, steps: int, resets: int, seed: int = 0, **kwargs) -> EnvTiming:
-    """Median-free, plain timing: ``steps`` random steps (resetting at episode ends), ``resets``
+    """Plain timing: ``steps`` random steps (resetting at episode ends), ``resets``
     resets. Actions are sampled before timing so that only the env is measured."""
     env = gym.make(env_id, **kwargs)
     env.reset(seed=seed)
@@ -45,21 +46,13 @@ def time_env(env_id: str, steps: int, resets: int, seed: int = 0, **kwargs) -> E
     return EnvTiming(env_id, steps_per_s, statistics.median(reset_times))
 
 
-def rss_mib() -> float:
-    """Peak resident set size of this process so far, MiB (Linux reports KiB)."""
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-
-
 def current_rss_mib() -> float:
-    """Current resident set size, MiB (from /proc; falls back to the peak)."""
+    """Current resident set size, MiB (Linux /proc; elsewhere the peak so far)."""
     try:
         with open("/proc/self/statm") as fh:
-            pages = int(fh.read().split()[1])
-        import os
-
-        return pages * os.sysconf("SC_PAGE_SIZE") / 2**20
+            return int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
     except OSError:
-        return rss_mib()
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
 def memory_run(env_id: str, steps: int, seed: int = 0) -> tuple[float, float, int]:

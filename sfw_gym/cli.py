@@ -115,7 +115,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
         progress_bar=not args.no_progress,
     )
     print(
-        f"trained {summary['env_id'] if 'env_id' in summary else args.env} to "
+        f"trained {args.env} to "
         f"{summary['steps']:,} steps in {summary['wall_time_s']:.0f} s; model: {summary['model']}"
     )
     return 0

@@ -49,25 +49,28 @@ def _assert_same(a, b) -> None:
         np.testing.assert_array_equal(a, b)
 
 
+def _assert_no_unlisted_warnings(check, env) -> None:
+    """Run a checker on env; fail on any warning not in WARNING_WHITELIST."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        check(env)
+    bad = [str(w.message) for w in caught if not str(w.message).startswith(WARNING_WHITELIST)]
+    assert not bad, bad
+
+
 @pytest.mark.parametrize("env_id", ENV_IDS)
 class TestEveryEnv:
     def test_gymnasium_check_env(self, env_id):
-        env = gym.make(env_id)
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            gym_check_env(env.unwrapped, skip_render_check=False)
-        bad = [str(w.message) for w in caught if not str(w.message).startswith(WARNING_WHITELIST)]
-        assert not bad, bad
+        _assert_no_unlisted_warnings(
+            lambda env: gym_check_env(env, skip_render_check=False), gym.make(env_id).unwrapped
+        )
 
     def test_sb3_check_env(self, env_id):
         from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
-        env = gym.make(env_id)
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            sb3_check_env(env.unwrapped, warn=True)
-        bad = [str(w.message) for w in caught if not str(w.message).startswith(WARNING_WHITELIST)]
-        assert not bad, bad
+        _assert_no_unlisted_warnings(
+            lambda env: sb3_check_env(env, warn=True), gym.make(env_id).unwrapped
+        )
 
     def test_same_seed_same_rollout(self, env_id):
         _assert_same(_rollout(env_id, 3, 100), _rollout(env_id, 3, 100))

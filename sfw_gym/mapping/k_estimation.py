@@ -47,11 +47,11 @@ import warnings
 import numpy as np
 from numba import njit
 
+from sfw_gym._threads import single_threaded_openmp
 from sfw_gym.errors import ConfigError
 from sfw_gym.mapping.config import MapperConfig
 
 NOT_HEARD_DBM = -100.0
-_THREADPOOLS = None  # threadpoolctl.ThreadpoolController, created at the first fit
 
 
 @njit(cache=True)
@@ -232,10 +232,8 @@ def fit_levels(data: np.ndarray, max_k: int, min_gap_db: float, min_fraction: fl
         ``(levels, (lowest, highest))``: the merged descending levels and the extreme raw
         centroids, or None when the data has fewer than 2 distinct values.
     """
-    global _THREADPOOLS
     from sklearn.cluster import KMeans  # imported here: ~0.5 s that only fitting needs
     from sklearn.exceptions import ConvergenceWarning
-    from threadpoolctl import ThreadpoolController
 
     x = np.asarray(data, dtype=np.float64)
     uniq = np.unique(x)
@@ -250,11 +248,9 @@ def fit_levels(data: np.ndarray, max_k: int, min_gap_db: float, min_fraction: fl
     if np.unique(q).size < n_clusters:
         q = np.quantile(uniq, (np.arange(n_clusters) + 0.5) / n_clusters)
     spread = np.linspace(uniq[0], uniq[-1], n_clusters)
-    if _THREADPOOLS is None:
-        _THREADPOOLS = ThreadpoolController()
     best = None
-    # One thread: the fit is tiny, and OpenMP spin-waits on a shared machine cost milliseconds.
-    with _THREADPOOLS.limit(limits=1, user_api="openmp"), warnings.catch_warnings():
+    # One thread: the fit is tiny, OpenMP spin-waits cost milliseconds, and a fork stays safe.
+    with single_threaded_openmp(), warnings.catch_warnings():
         # Fewer distinct clusters than asked (repeated values) is fine: empty ones are dropped.
         warnings.simplefilter("ignore", ConvergenceWarning)
         for init in (q, spread):
