@@ -235,3 +235,26 @@ def to_discrete(linear: float, angular: float, deadband: float = 0.35) -> int:
     if abs(angular) > deadband or linear <= 0.0:
         return 1 if angular > 0 else 2
     return 0
+
+
+def disk_offsets(radius_cells: float) -> np.ndarray:
+    """``(K, 2)`` integer offsets ``(dr, dc)`` with ``dr² + dc² ≤ radius_cells²``."""
+    k = int(np.floor(radius_cells))
+    dr, dc = np.mgrid[-k : k + 1, -k : k + 1]
+    keep = dr**2 + dc**2 <= radius_cells**2 + 1e-9
+    return np.stack([dr[keep], dc[keep]], axis=1)
+
+
+def disk_cells(shape: tuple[int, int], cell: tuple[int, int], radius_cells: float):
+    """``(rows, cols)`` of the cells within ``radius_cells`` of ``cell`` (clipped to ``shape``)."""
+    r, c = int(cell[0]), int(cell[1])
+    k = int(np.ceil(radius_cells))
+    h, w = shape
+    rr, cc = np.mgrid[max(r - k, 0) : min(r + k + 1, h), max(c - k, 0) : min(c + k + 1, w)]
+    keep = (rr - r) ** 2 + (cc - c) ** 2 <= radius_cells * radius_cells
+    return rr[keep], cc[keep]
+
+
+def mark_disk(mask: np.ndarray, cell: tuple[int, int], radius_cells: float) -> None:
+    """Set the cells of ``mask`` within ``radius_cells`` of ``cell`` (in place, clipped)."""
+    mask[disk_cells(mask.shape, cell, radius_cells)] = True

@@ -4,7 +4,7 @@ Layout of an output folder::
 
     OUT/checkpoints/ppo_<steps>_steps.zip   every ``checkpoint_every`` env steps
     OUT/tb/                                 TensorBoard logs
-    OUT/train_<start>.monitor.csv           episode returns (one file per run segment)
+    OUT/train_<start>.monitor.csv           episode return, length, floorplan (one per run segment)
     OUT/eval/evaluations.npz                held-out evaluation (EvalCallback)
     OUT/model.zip                           the final model (written atomically)
     OUT/config.yml                          hyperparameters, env, seeds, command, wall time
@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import ast
 import re
+import shutil
 import sys
 import time
 from pathlib import Path
@@ -49,7 +50,8 @@ def load_hyperparams(env_id: str, path: str | Path = DEFAULT_HYPERPARAMS) -> dic
     params = dict(table[env_id])
     if isinstance(params.get("policy_kwargs"), str):
         params["policy_kwargs"] = parse_policy_kwargs(params["policy_kwargs"])
-    unknown = set(params) - _PPO_KEYS - {"policy", "n_timesteps", "n_envs", "normalize"}
+    wrapper_specs(params.get("env_wrapper"))  # fail early on a malformed entry
+    unknown = set(params) - _PPO_KEYS - {"policy", "n_timesteps", "n_envs", "env_wrapper"}
     if unknown:
         raise ConfigError(f"{path}: unknown keys for {env_id!r}: {sorted(unknown)}")
     return params
@@ -85,6 +87,41 @@ def parse_policy_kwargs(text: str) -> dict[str, Any]:
     return out
 
 
+def wrapper_specs(value: Any) -> list[tuple[str, dict[str, Any]]]:
+    """rl-zoo's ``env_wrapper`` entry as ``[(dotted class path, kwargs), ...]``.
+
+    Accepted forms: ``"pkg.mod.Class"``, ``{"pkg.mod.Class": {kwargs}}``, or a list of those
+    (applied in order, innermost first).
+    """
+    if value is None:
+        return []
+    specs = []
+    for entry in value if isinstance(value, list) else [value]:
+        if isinstance(entry, str):
+            specs.append((entry, {}))
+        elif isinstance(entry, dict) and len(entry) == 1:
+            ((name, kwargs),) = entry.items()
+            if not isinstance(name, str) or not isinstance(kwargs or {}, dict):
+                raise ConfigError(f"env_wrapper: bad entry {entry!r}")
+            specs.append((name, dict(kwargs or {})))
+        else:
+            raise ConfigError(
+                f"env_wrapper: expected 'pkg.mod.Class' or {{'pkg.mod.Class': {{kwargs}}}}, "
+                f"got {entry!r}"
+            )
+    return specs
+
+
+def _import_wrapper(name: str) -> Any:
+    import importlib
+
+    module, _, attr = name.rpartition(".")
+    try:
+        return getattr(importlib.import_module(module), attr)
+    except (ImportError, AttributeError, ValueError) as exc:
+        raise ConfigError(f"env_wrapper: cannot import {name!r}: {exc}") from None
+
+
 def latest_checkpoint(out_dir: Path) -> tuple[Path, int] | None:
     """The checkpoint with the most env steps in ``OUT/checkpoints``, if any."""
     found = []
@@ -98,24 +135,35 @@ def latest_checkpoint(out_dir: Path) -> tuple[Path, int] | None:
     return path, steps
 
 
-def _make_env_fn(env_id: str, env_kwargs: dict[str, Any]):
+def _make_env_fn(env_id: str, env_kwargs: dict[str, Any], wrappers: list[tuple[str, dict]]):
     def make() -> Any:
         import gymnasium as gym
 
-        return gym.make(env_id, **env_kwargs)
+        env = gym.make(env_id, **env_kwargs)
+        for name, kwargs in wrappers:
+            env = _import_wrapper(name)(env, **kwargs)
+        return env
 
     return make
 
 
-def _make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], monitor: Path):
+def _make_venv(
+    env_id: str,
+    n_envs: int,
+    seed: int,
+    env_kwargs: dict[str, Any],
+    wrappers: list[tuple[str, dict]],
+    monitor: Path,
+):
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecMonitor
 
     # Workers start by forkserver and have not imported sfw_gym: name the module in the id.
     qualified = env_id if ":" in env_id else f"sfw_gym:{env_id}"
-    fns = [_make_env_fn(qualified, env_kwargs) for _ in range(n_envs)]
+    fns = [_make_env_fn(qualified, env_kwargs, wrappers) for _ in range(n_envs)]
     venv = SubprocVecEnv(fns) if n_envs > 1 else DummyVecEnv(fns)
     venv.seed(seed)
-    return VecMonitor(venv, filename=str(monitor))
+    # The floorplan column lets a later comparison prove its plans were never trained on.
+    return VecMonitor(venv, filename=str(monitor), info_keywords=("floorplan",))
 
 
 def train_ppo(
@@ -154,15 +202,21 @@ def train_ppo(
     policy = params.get("policy", "MultiInputPolicy")
     ppo_kwargs = {k: v for k, v in params.items() if k in _PPO_KEYS}
     env_kwargs = dict(env_kwargs or {})
+    wrappers = wrapper_specs(params.get("env_wrapper"))
+    for name, _ in wrappers:
+        _import_wrapper(name)
 
     previous = latest_checkpoint(out) if resume else None
     start_steps = previous[1] if previous else 0
-    if start_steps >= timesteps:
+    if start_steps >= timesteps:  # already there (e.g. killed after its last checkpoint)
+        if not (out / "model.zip").exists():
+            with atomic_path(out / "model.zip") as tmp:
+                shutil.copyfile(previous[0], tmp)
         return {"steps": start_steps, "resumed_from": str(previous[0]), "wall_time_s": 0.0,
                 "model": str(out / "model.zip")}  # fmt: skip
-    venv = _make_venv(env_id, n_envs, seed + start_steps, env_kwargs,
+    venv = _make_venv(env_id, n_envs, seed + start_steps, env_kwargs, wrappers,
                       out / f"train_{start_steps}.monitor.csv")  # fmt: skip
-    eval_env = _make_venv(env_id, 1, seed + HELD_OUT_SEED_OFFSET, env_kwargs,
+    eval_env = _make_venv(env_id, 1, seed + HELD_OUT_SEED_OFFSET, env_kwargs, wrappers,
                           out / f"eval_{start_steps}.monitor.csv")  # fmt: skip
     try:
         if previous:
@@ -212,7 +266,7 @@ def _save_atomic(model: Any, path: Path) -> None:
 
 
 def plot_training_curve(out_dir: str | Path) -> Path | None:
-    """Episode return (training, smoothed) and held-out evaluation return vs env steps → PNG."""
+    """Episode return (training, smoothed) and held-out evaluation return vs agent steps → PNG."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -229,7 +283,7 @@ def plot_training_curve(out_dir: str | Path) -> Path | None:
         lines = csv.read_text().splitlines()[2:]  # a JSON header line, then the column names
         if not lines:
             continue
-        data = np.loadtxt(lines, delimiter=",", ndmin=2)
+        data = np.loadtxt(lines, delimiter=",", ndmin=2, usecols=(0, 1))
         # columns r, l, t: cumulative episode lengths give the env step at each episode's end
         steps.extend(offset_steps + np.cumsum(data[:, 1]) * 1.0)
         returns.extend(data[:, 0])
@@ -247,7 +301,7 @@ def plot_training_curve(out_dir: str | Path) -> Path | None:
         ev = np.load(evals)
         ax.errorbar(ev["timesteps"], ev["results"].mean(1), yerr=ev["results"].std(1), fmt="o-",
                     label="held-out seeds")  # fmt: skip
-    ax.set_xlabel("env steps")
+    ax.set_xlabel("agent steps (waypoints with WaypointWrapper)")
     ax.set_ylabel("episode return (≈ m² mapped)")
     ax.legend()
     ax.grid(alpha=0.3)

@@ -22,6 +22,7 @@ from sfw_gym.agents import (
     dominance_bands,
     find_frontiers,
     frontier_mask,
+    hidden_rooms,
     make_agent,
     router_scores,
 )
@@ -71,6 +72,20 @@ def test_a_doorway_in_the_wall_is_a_frontier():
     fronts = find_frontiers(b)
     assert len(fronts) == 1
     assert {tuple(c) for c in fronts[0].cells} == {(12, 6), (12, 7), (12, 8), (12, 9)}
+
+
+def test_hidden_room_is_found_behind_a_closed_doorway_but_not_outside_the_building():
+    b = np.full((30, 40), U, np.uint8)  # the building's surroundings are unknown too
+    b[5:10, 5:35] = F  # an explored corridor ...
+    b[4, 5:35] = b[10, 5:35] = W  # ... whose walls the map closed all along
+    b[11:25, 5:20] = F  # an explored room below it, so the explored extent spans rows 5..24
+    depth = hidden_rooms(b, min_depth_cells=3)
+    # the unexplored 14 x 15 block beside the room (rows 11-24, cols 20-34) is a hidden room
+    assert depth[18, 27] >= 3 and depth[11:25, 20:35].max() == depth.max()
+    assert not depth[:4].any() and not depth[:, :5].any()  # outside the explored extent: never
+    assert not depth[5:11].any()  # the corridor and its walls are known
+    assert hidden_rooms(b, min_depth_cells=10).max() == 0  # the block is only ~7 cells deep
+    assert not hidden_rooms(np.full((10, 10), U, np.uint8), 1).any()  # nothing explored yet
 
 
 def test_clusters_are_sorted_filtered_and_excludable():

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import math
+
 import gymnasium as gym
 import numpy as np
 import pytest
 
 import sfw_gym  # noqa: F401
 from sfw_gym import metrics
+from sfw_gym.errors import ConfigError
 from sfw_gym.world import generate_floorplan
 from tests.conftest import two_rooms_polygon
 
@@ -62,6 +65,29 @@ def test_truncates_at_max_steps():
         _, _, terminated, truncated, info = env.step(env.action_space.sample())
         assert truncated == (i == 6) and not terminated
     assert info["summary"]["steps"] == 7
+
+
+def test_step_budget_scales_with_the_plan_area():
+    env = gym.make("SfW-ExploreSmall-v0", steps_per_m2=0.2, coverage_target=1.0)
+    _, info = env.reset(seed=0)
+    area = env.unwrapped.scene.floorplan.area_m2
+    budget = info["max_steps"]
+    assert budget == math.ceil(0.2 * area) and 2 <= budget < 300
+    steps = 0
+    while True:
+        steps += 1
+        _, _, terminated, truncated, info = env.step(env.action_space.sample())
+        if terminated or truncated:
+            break
+    assert truncated and steps == budget == info["summary"]["steps"]
+    capped = gym.make("SfW-ExploreSmall-v0", steps_per_m2=1000.0, max_steps=50)
+    assert capped.reset(seed=0)[1]["max_steps"] == 50  # max_steps caps the scaled budget
+    full = gym.make("SfW-ExploreFull-v0")
+    _, info = full.reset(seed=1)
+    assert info["max_steps"] == math.ceil(60 * full.unwrapped.scene.floorplan.area_m2)
+    for bad in (-1.0, float("nan"), "60"):
+        with pytest.raises(ConfigError, match="steps_per_m2"):
+            gym.make("SfW-Explore-v0", steps_per_m2=bad)
 
 
 def test_reset_options(tmp_path):

@@ -11,14 +11,16 @@ from typing import Any
 
 from sfw_gym.agents.base import STOP_REASONS, Agent, RobotView, RobotViewHandle
 from sfw_gym.agents.cross_pass import CrossPassAgent, dominance_bands, router_scores
-from sfw_gym.agents.frontier import FrontierAgent, find_frontiers, frontier_mask
+from sfw_gym.agents.frontier import FrontierAgent, find_frontiers, frontier_mask, hidden_rooms
 from sfw_gym.agents.greedy import GreedyInfoGainAgent
+from sfw_gym.agents.ppo import PPOAgent
 from sfw_gym.agents.random_agent import RandomAgent
 from sfw_gym.errors import ConfigError
 
 #: Agents by their command-line name.
 AGENTS: dict[str, type[Agent]] = {
-    cls.name: cls for cls in (FrontierAgent, CrossPassAgent, GreedyInfoGainAgent, RandomAgent)
+    cls.name: cls
+    for cls in (FrontierAgent, CrossPassAgent, GreedyInfoGainAgent, RandomAgent, PPOAgent)
 }
 
 
@@ -39,12 +41,14 @@ __all__ = [
     "CrossPassAgent",
     "FrontierAgent",
     "GreedyInfoGainAgent",
+    "PPOAgent",
     "RandomAgent",
     "RobotView",
     "RobotViewHandle",
     "dominance_bands",
     "find_frontiers",
     "frontier_mask",
+    "hidden_rooms",
     "make_agent",
     "router_scores",
 ]

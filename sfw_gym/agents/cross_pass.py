@@ -30,10 +30,10 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from sfw_gym.agents.base import RobotView, check_fraction
-from sfw_gym.agents.frontier import FrontierAgent, Goal, mark_disk
+from sfw_gym.agents.frontier import FrontierAgent, Goal
 from sfw_gym.errors import ConfigError
 from sfw_gym.mapping.grid import GridSpec
-from sfw_gym.navigation import CostField, belief_classes
+from sfw_gym.navigation import CostField, belief_classes, mark_disk
 from sfw_gym.world import NOT_HEARD_DBM
 
 

@@ -30,8 +30,11 @@ A goal that makes no progress for ``progress_timeout_steps`` steps is blackliste
 is blacklisted, the agent records why in ``stop_reason`` and does not stall: while frontiers are
 left that are only walled off on its map or lie by bumps, it doubts the map (walls cost instead
 of block) and tries the cheapest (an ``escape`` goal: a doorway that blurred or bump-made walls
-closed opens up again); else it sweeps, driving to the reachable unknown cell farthest from its
-path so far.
+closed opens up again). The same escape reaches *hidden rooms*: unknown regions enclosed by
+believed walls (a room whose doorway the map closed has no frontier at all), found as
+room-deep unknown pockets within the explored extent; the goal is the pocket's deepest cell, so
+the path crosses the map's walls where they are thinnest. Else it sweeps, driving to the
+reachable unknown cell farthest from its path so far.
 """
 
 from __future__ import annotations
@@ -49,7 +52,10 @@ from sfw_gym.navigation import (
     PurePursuit,
     belief_classes,
     cost_field,
+    disk_cells,
+    disk_offsets,
     free_start,
+    mark_disk,
     simplify_path,
     traversal_costs,
 )
@@ -82,6 +88,20 @@ def frontier_mask(belief_u8: np.ndarray, exclude: np.ndarray | None = None) -> n
     if exclude is not None:
         mask &= ~exclude
     return mask
+
+
+def hidden_rooms(belief_u8: np.ndarray, min_depth_cells: float) -> np.ndarray:
+    """Per cell, its depth (cells to the nearest known cell) in the unknown space inside the
+    bounding box of the believed-free cells, where that depth is at least ``min_depth_cells``
+    (room-sized pockets, not the band of unknown cells along a wall); else 0."""
+    free, _, unknown = belief_classes(belief_u8)
+    rows, cols = np.flatnonzero(free.any(1)), np.flatnonzero(free.any(0))
+    if not len(rows):
+        return np.zeros(belief_u8.shape)
+    inside = np.zeros(belief_u8.shape, bool)
+    inside[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1] = True
+    depth = ndimage.distance_transform_edt(unknown & inside)
+    return np.where(depth >= min_depth_cells, depth, 0.0)
 
 
 def find_frontiers(
@@ -118,29 +138,6 @@ def find_frontiers(
         )
     out.sort(key=lambda f: -f.size)
     return out
-
-
-def disk_offsets(radius_cells: float) -> np.ndarray:
-    """``(K, 2)`` integer offsets ``(dr, dc)`` with ``dr² + dc² ≤ radius_cells²``."""
-    k = int(np.floor(radius_cells))
-    dr, dc = np.mgrid[-k : k + 1, -k : k + 1]
-    keep = dr**2 + dc**2 <= radius_cells**2 + 1e-9
-    return np.stack([dr[keep], dc[keep]], axis=1)
-
-
-def disk_cells(shape: tuple[int, int], cell: tuple[int, int], radius_cells: float):
-    """``(rows, cols)`` of the cells within ``radius_cells`` of ``cell`` (clipped to ``shape``)."""
-    r, c = int(cell[0]), int(cell[1])
-    k = int(np.ceil(radius_cells))
-    h, w = shape
-    rr, cc = np.mgrid[max(r - k, 0) : min(r + k + 1, h), max(c - k, 0) : min(c + k + 1, w)]
-    keep = (rr - r) ** 2 + (cc - c) ** 2 <= radius_cells * radius_cells
-    return rr[keep], cc[keep]
-
-
-def mark_disk(mask: np.ndarray, cell: tuple[int, int], radius_cells: float) -> None:
-    """Set the cells of ``mask`` within ``radius_cells`` of ``cell`` (in place, clipped)."""
-    mask[disk_cells(mask.shape, cell, radius_cells)] = True
 
 
 @dataclass
@@ -188,11 +185,18 @@ class FrontierAgent(Agent):
             map may open a way later).
         min_unknown_region_m2: Frontier cells of unknown pockets smaller than this (enclosed by
             known cells) are not goals: they lead nowhere and fill in as the robot passes by.
-        escape_wall_cost: When every frontier is walled off on the map or lies by a bump, the
-            agent plans once more with believed walls (and bumps) costing this much per cell
-            instead of blocking, and drives to the cheapest frontier cell that has not failed as
-            a goal: a doorway the map closed by mistake opens up; a real wall ends in bumps and
-            a blacklisted goal.
+        escape_wall_cost: When no frontier is left to drive to (none, or every one walled off
+            on the map or lying by a bump), the agent plans once more with believed walls
+            costing this much per cell (bumps 4×) instead of blocking, and drives to the
+            cheapest frontier cell or hidden room (see the module doc) that has not failed as a
+            goal: a doorway the map closed by mistake opens up; a real wall ends in bumps and a
+            blacklisted goal.
+        min_hidden_room_depth_m: Unknown pockets this deep (see :func:`hidden_rooms`) are
+            escape goals.
+        stall_steps, stall_gain_m2: The exploration has stalled when the map grew by less than
+            ``stall_gain_m2`` over the last ``stall_steps`` steps; the agent then drives to the
+            cheapest hidden room, if there is one, before it takes frontier goals again.
+        escape_blacklist_radius_m: A failed escape goal blacklists the cells this close.
         max_steps: Optional step limit of the agent (then ``stop_reason = "max_steps"``).
     """
 
@@ -218,6 +222,10 @@ class FrontierAgent(Agent):
         unreachable_ttl_steps: int = 200,
         min_unknown_region_m2: float = 0.5,
         escape_wall_cost: float = 25.0,
+        min_hidden_room_depth_m: float = 0.5,
+        escape_blacklist_radius_m: float = 1.0,
+        stall_steps: int = 300,
+        stall_gain_m2: float = 1.0,
         max_steps: int | None = None,
     ) -> None:
         super().__init__(max_steps=max_steps)
@@ -233,7 +241,8 @@ class FrontierAgent(Agent):
                             ("backoff_steps", backoff_steps, 0),
                             ("max_bumps_per_goal", max_bumps_per_goal, 1),
                             ("blacklist_ttl_steps", blacklist_ttl_steps, 1),
-                            ("unreachable_ttl_steps", unreachable_ttl_steps, 1)):  # fmt: skip
+                            ("unreachable_ttl_steps", unreachable_ttl_steps, 1),
+                            ("stall_steps", stall_steps, 1)):  # fmt: skip
             if isinstance(v, bool) or not isinstance(v, int) or v < lo:
                 raise ConfigError(f"{name} must be an int >= {lo}, got {v!r}")
         self.progress_timeout_steps = progress_timeout_steps
@@ -242,9 +251,17 @@ class FrontierAgent(Agent):
         self.max_bumps_per_goal = max_bumps_per_goal
         self.blacklist_ttl_steps = blacklist_ttl_steps
         self.unreachable_ttl_steps = unreachable_ttl_steps
+        self.stall_steps = stall_steps
+        self.stall_gain_m2 = check_fraction("stall_gain_m2", stall_gain_m2)
         self.min_unknown_region_m2 = check_fraction("min_unknown_region_m2", min_unknown_region_m2)
         self.turn_cost_m_per_rad = check_fraction("turn_cost_m_per_rad", turn_cost_m_per_rad)
         self.escape_wall_cost = check_fraction("escape_wall_cost", escape_wall_cost, 1.0)
+        self.min_hidden_room_depth_m = check_fraction(
+            "min_hidden_room_depth_m", min_hidden_room_depth_m
+        )
+        self.escape_blacklist_radius_m = check_fraction(
+            "escape_blacklist_radius_m", escape_blacklist_radius_m
+        )
 
     # -- episode ---------------------------------------------------------------------------------
     def _on_reset(self, view: RobotView) -> None:
@@ -267,6 +284,7 @@ class FrontierAgent(Agent):
         self._backoff = 0
         self._slides = 0
         self._last_xy = view.xy
+        self._known_log: list[tuple[int, int]] = []
         self.n_blacklisted = 0
         self.n_goals = 0
         self.n_bumps = 0
@@ -360,7 +378,8 @@ class FrontierAgent(Agent):
     # -- bookkeeping -----------------------------------------------------------------------------
     def _blacklist(self, goal: Goal) -> None:
         """Blacklist the cells within ``blacklist_radius_m`` of the goal's target."""
-        res_cells = self.blacklist_radius_m / self._res
+        radius_m = self.escape_blacklist_radius_m if goal.kind == "escape" else None
+        res_cells = (radius_m or self.blacklist_radius_m) / self._res
         rows, cols = disk_cells(self.blacklisted_until.shape, goal.target, max(res_cells, 0.5))
         until = self.steps + self.blacklist_ttl_steps
         self.blacklisted_until[rows, cols] = np.maximum(self.blacklisted_until[rows, cols], until)
@@ -396,7 +415,8 @@ class FrontierAgent(Agent):
         else:
             _, walls, _ = belief_classes(view.belief_u8)
             cost = traversal_costs(view.belief_u8, res, radius, unknown_cost=self.unknown_cost)
-            cost[walls | self.bumps] = self.escape_wall_cost
+            cost[walls] = self.escape_wall_cost
+            cost[self.bumps] = 4 * self.escape_wall_cost
         return free_start(cost, view.cell)
 
     def _plan(self, view: RobotView) -> None:
@@ -410,21 +430,48 @@ class FrontierAgent(Agent):
                 self._set_goal(view, paths, goal)
                 return
             self._blacklist(goal)
-        goal = self._choose_goal(view, paths)
-        if goal is None and self.stop_reason == "all_blacklisted":
-            # Frontiers exist but are walled off or lie by bumps: the map may be wrong (a
-            # doorway closed by blurred or bump-made walls). Doubt it: walls cost, not block.
+        stalled = self._stalled(view)
+        goal = None if stalled else self._choose_goal(view, paths)
+        if goal is None:
+            # No frontier to drive to (or the map stopped growing), yet unknown space may hide
+            # behind the map's walls (a doorway closed by blurred or bump-made walls). Doubt
+            # them: walls cost, not block.
             escape = cost_field(self._costs(view, True), view.cell, view.grid.resolution_m)
-            goal = self._escape_goal(view, escape)
+            goal = self._escape_goal(view, escape, rooms_only=stalled)
             if goal is not None:
                 paths = escape
+            elif stalled:
+                goal = self._choose_goal(view, paths)
         if goal is None:
             goal = self._sweep_goal(view, paths)
         self._set_goal(view, paths, goal)
 
-    def _escape_goal(self, view: RobotView, paths: CostField) -> Goal | None:
-        """The cheapest frontier cell (not a failed goal) on a map whose walls merely cost."""
-        mask = frontier_mask(view.belief_u8, self.blacklisted_until > self.steps)
+    def _stalled(self, view: RobotView) -> bool:
+        """Whether the map grew by less than ``stall_gain_m2`` over the last ``stall_steps``."""
+        _, _, unknown = belief_classes(view.belief_u8)
+        known = unknown.size - int(np.count_nonzero(unknown))
+        self._known_log.append((self.steps, known))
+        while len(self._known_log) > 1 and self._known_log[1][0] <= self.steps - self.stall_steps:
+            self._known_log.pop(0)
+        step0, known0 = self._known_log[0]
+        grown_m2 = (known - known0) * view.grid.resolution_m**2
+        return self.steps - step0 >= self.stall_steps and grown_m2 < self.stall_gain_m2
+
+    def _escape_goal(
+        self, view: RobotView, paths: CostField, rooms_only: bool = False
+    ) -> Goal | None:
+        """The cheapest frontier cell or hidden room's deepest cell (not a failed goal; only
+        hidden rooms with ``rooms_only``) on a map whose walls merely cost."""
+        failed = self.blacklisted_until > self.steps
+        mask = frontier_mask(view.belief_u8, failed)
+        if rooms_only:
+            mask[:] = False
+        min_depth = max(self.min_hidden_room_depth_m / view.grid.resolution_m, 1.0)
+        depth = np.where(failed, 0.0, hidden_rooms(view.belief_u8, min_depth))
+        if depth.any():
+            labels, n = ndimage.label(depth > 0, structure=_EIGHT)
+            deepest = ndimage.maximum_position(depth, labels, range(1, n + 1))
+            mask[tuple(np.array(deepest).T)] = True
         approach = np.where(mask, self._approach(paths), np.inf)
         if not np.isfinite(approach).any():
             return None

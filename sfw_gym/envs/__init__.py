@@ -11,6 +11,8 @@ ENTRY_POINT = "sfw_gym.envs.explore:SfWExploreEnv"
 #: Every registered id with its kwargs (also the parametrisation of the env test suite).
 ENV_IDS: dict[str, dict[str, Any]] = {
     "SfW-Explore-v0": {},
+    # Explore the whole building: the step budget grows with the plan (steps per m² of free area).
+    "SfW-ExploreFull-v0": {"steps_per_m2": 60.0, "max_steps": 30_000},
     "SfW-ExploreDiscrete-v0": {"action_type": "discrete"},
     "SfW-ExploreThick-v0": {"radio_preset": "thick"},
     "SfW-ExploreResidential-v0": {"radio_preset": "residential"},

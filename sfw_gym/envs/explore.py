@@ -64,9 +64,13 @@ class SfWExploreEnv(gym.Env):
 
     ## Episode End
     Terminated when the ground-truth coverage (fraction of free cells the map has classified)
-    reaches ``coverage_target`` (0.95). Truncated by the env itself after ``max_steps`` (3,000 by
-    default: 300 m of driving at full speed, room for a typical 100 m² plan; see BENCHMARKS.md), so
-    that the final ``info["summary"]`` (episode metrics, steps to 50/90 % coverage) is always there.
+    reaches ``coverage_target`` (0.95). Truncated by the env itself after the episode's step
+    budget, so that the final ``info["summary"]`` (episode metrics, steps to 50/90 % coverage) is
+    always there. ``SfW-Explore-v0``: ``max_steps`` = 3,000 steps (300 m of driving at full speed)
+    whatever the plan's size, the benchmark of how much a robot maps in a fixed time.
+    ``SfW-ExploreFull-v0``: ``steps_per_m2`` = 60 steps per m² of the plan's free area (capped by
+    ``max_steps`` = 30,000), room for a frontier explorer to map 90 % of any plan (see
+    BENCHMARKS.md). The episode's budget is ``info["max_steps"]``.
     ``gym.make(..., max_episode_steps=N)`` still works but truncates from outside, without it.
 
     ## Arguments
@@ -78,7 +82,9 @@ class SfWExploreEnv(gym.Env):
     ("2.4" | "5"), ``radio`` / ``robot`` / ``mapper`` (dicts of RadioConfig / RobotConfig /
     MapperConfig overrides), ``resolution_m`` (0.1), ``map_px`` (64), ``crop_px`` (48),
     ``coverage_target`` (0.95), ``collision_penalty`` (0.1), ``reward_scale`` (0.01),
-    ``max_steps`` (3000), ``render_mode`` (None | "rgb_array" | "human").
+    ``max_steps`` (3000), ``steps_per_m2`` (None: the budget is ``max_steps``; a number: the
+    budget is ``min(max_steps, ceil(steps_per_m2 × free area))``), ``render_mode`` (None |
+    "rgb_array" | "human").
     ``reset(options=…)``: ``floorplan`` (a Floorplan, a path or a generator seed), ``routers``
     (positions (R, 2) or a count ≤ n_routers), ``start_pose`` ((x, y, θ)).
 
@@ -106,6 +112,7 @@ class SfWExploreEnv(gym.Env):
         collision_penalty: float = 0.1,
         reward_scale: float = 0.01,
         max_steps: int = 3000,
+        steps_per_m2: float | None = None,
         render_mode: str | None = None,
     ) -> None:
         if action_type not in ACTION_TYPES:
@@ -119,6 +126,8 @@ class SfWExploreEnv(gym.Env):
         _check_int("map_px", map_px, 36, 512)
         _check_int("crop_px", crop_px, 36, 512)
         _check_int("max_steps", max_steps, 1, 10**7)
+        if steps_per_m2 is not None:
+            _check_number("steps_per_m2", steps_per_m2, 1e-3, 1e5)
         _check_number("resolution_m", resolution_m, 0.02, 1.0)
         _check_number("coverage_target", coverage_target, 0.0, 1.0)
         _check_number("collision_penalty", collision_penalty, 0.0, 1e6)
@@ -147,6 +156,8 @@ class SfWExploreEnv(gym.Env):
         self.collision_penalty = float(collision_penalty)
         self.reward_scale = float(reward_scale)
         self.max_steps = max_steps
+        self.steps_per_m2 = None if steps_per_m2 is None else float(steps_per_m2)
+        self.episode_max_steps = max_steps
         self.render_mode = render_mode
         self._folder_plans = _folder_plans(floorplan)
 
@@ -188,6 +199,10 @@ class SfWExploreEnv(gym.Env):
         self.obs_builder = ObservationBuilder(
             self.grid, s.radio.routers, self.n_routers, self.map_px, self.crop_px
         )
+        self.episode_max_steps = self.max_steps
+        if self.steps_per_m2 is not None:
+            budget = math.ceil(self.steps_per_m2 * s.floorplan.area_m2)
+            self.episode_max_steps = max(1, min(self.max_steps, budget))
         self.steps = 0
         self.path_length_m = 0.0
         self.collisions = 0
@@ -218,7 +233,7 @@ class SfWExploreEnv(gym.Env):
             if self.steps_to[level] < 0 and coverage >= level:
                 self.steps_to[level] = self.steps
         terminated = coverage >= self.coverage_target
-        truncated = not terminated and self.steps >= self.max_steps
+        truncated = not terminated and self.steps >= self.episode_max_steps
         info = self._info(terminal=terminated or truncated)
         if self.render_mode == "human":
             self.render()
@@ -301,6 +316,7 @@ class SfWExploreEnv(gym.Env):
             "steps_to_coverage_50": self.steps_to[0.5],
             "steps_to_coverage_90": self.steps_to[0.9],
             "floorplan": s.floorplan.name,
+            "max_steps": self.episode_max_steps,
         }
         if terminal:
             info["summary"] = {k: v for k, v in info.items() if np.isscalar(v)} | {
@@ -371,6 +387,7 @@ class SfWExploreEnv(gym.Env):
             "mapper": self.mapper_config.to_dict(),
             "resolution_m": self.resolution_m,
             "max_steps": self.max_steps,
+            "steps_per_m2": self.steps_per_m2,
         }
 
 

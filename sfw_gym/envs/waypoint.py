@@ -13,25 +13,109 @@ import numpy as np
 from gymnasium import spaces
 
 from sfw_gym.errors import ConfigError
+from sfw_gym.mapping import GridSpec
 from sfw_gym.navigation import (
     PurePursuit,
     cells_to_world,
     cost_field,
     free_start,
+    mark_disk,
     to_discrete,
     traversal_costs,
 )
 
 
+class WaypointDriver:
+    """Drives to one waypoint at a time: plans on the belief map, follows the path (pure pursuit).
+
+    A waypoint ends when its goal is reached, after ``max_steps`` env steps, or at a bump: the
+    driver remembers the contact region ahead of the robot as an obstacle for its later plans
+    (the mapper marks one cell; walls are longer) and, with continuous actions, reverses one
+    step first, so the next waypoint starts clear of the wall. A goal no path reaches costs one
+    step standing still. Shared by :class:`WaypointWrapper` (training) and
+    :class:`sfw_gym.agents.PPOAgent` (evaluation), so both drive alike.
+    """
+
+    def __init__(self, grid_cells: int = 8, max_steps: int = 60) -> None:
+        for name, value in (("grid_cells", grid_cells), ("max_steps_per_waypoint", max_steps)):
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise ConfigError(f"{name} must be a positive integer, got {value!r}")
+        self.grid_cells, self.max_steps = grid_cells, max_steps
+        self.follower = PurePursuit()
+        self.bumps = np.zeros((0, 0), bool)
+        self.path = np.zeros((0, 2))
+        self.goal = np.zeros(2)
+        self.steps = 0
+        self.active = self._backing_off = False
+
+    def reset(self) -> None:
+        """Forget the last episode's bumps."""
+        self.bumps = np.zeros((0, 0), bool)
+        self.active = self._backing_off = False
+
+    def start(self, view: dict[str, Any], action: int) -> None:
+        """Plan from the robot's view (``belief_u8``, ``grid``, ``radius_m``, ``odometry_pose``,
+        ``action_type``) to coarse cell ``action``."""
+        grid = view["grid"]
+        if self.bumps.shape != grid.shape:
+            self.bumps = np.zeros(grid.shape, bool)
+        self._grid, self._radius_m = grid, float(view["radius_m"])
+        self._reverse = view["action_type"] == "continuous"
+        self.goal = waypoint_goal_xy(grid, self.grid_cells, action)
+        self.path = plan_path(
+            view["belief_u8"], grid, self._radius_m, view["odometry_pose"], self.goal, self.bumps
+        )
+        self.follower.set_path(self.path)
+        self.steps = 0
+        self.active, self._backing_off = True, False
+
+    def command(self, pose: tuple[float, float, float], bumped: bool) -> tuple[float, float] | None:
+        """(linear, angular) for the next step, or None when the waypoint is over.
+
+        ``bumped``: whether the previous step touched a wall.
+        """
+        if not self.active:
+            return None
+        if self._backing_off or self.steps >= self.max_steps:
+            self.active = False
+            return None
+        if self.steps > 0 and bumped:
+            self._mark_bump(pose)
+            self.follower.set_path(np.zeros((0, 2)))
+            if not self._reverse:
+                self.active = False
+                return None
+            self._backing_off = True
+            self.steps += 1
+            return -1.0, 0.0
+        linear, angular = self.follower.command(pose)
+        if not self.follower.has_path and self.steps > 0:
+            self.active = False
+            return None
+        self.steps += 1
+        return linear, angular
+
+    @property
+    def reached(self) -> bool:
+        """Whether the current (or last) waypoint's path was driven to its end."""
+        return len(self.path) > 0 and not self.follower.has_path and not self._backing_off
+
+    def _mark_bump(self, pose: tuple[float, float, float]) -> None:
+        x, y, theta = pose
+        reach = self._radius_m + 0.5 * self._grid.resolution_m
+        contact = np.array([x + reach * np.cos(theta), y + reach * np.sin(theta)])
+        mark_disk(self.bumps, tuple(self._grid.world_to_cell(contact)), 1.0)
+
+
 class WaypointWrapper(gym.Wrapper):
     """``Discrete(n × n)`` actions: drive to the middle of coarse cell ``a`` (row ``a // n``).
 
-    Each wrapper step plans a path on the belief map to the reachable fine cell nearest the
-    coarse cell's centre and follows it (pure pursuit) for at most ``max_steps_per_waypoint``
-    env steps, stopping early at the goal, at the episode's end, or after a bump (the planner
-    then sees the bump on the map next time). The reward is the sum of the env steps' rewards;
-    ``info["waypoint_steps"]`` counts them and ``info["waypoint_reached"]`` says whether the
-    goal was reached. A goal no path reaches costs one env step standing still.
+    The coarse cells tile the observation's ``map`` image (see :func:`waypoint_goal_xy`). Each
+    wrapper step plans a path on the belief map to the reachable fine cell nearest the coarse
+    cell's centre and drives it with a :class:`WaypointDriver`, until the goal, the step cap, a
+    bump, or the episode's end. The reward is the sum of the env steps'
+    rewards; ``info["waypoint_steps"]`` counts them and ``info["waypoint_reached"]`` says
+    whether the goal was reached.
 
     Args:
         env: an SfW-Explore env (continuous or discrete actions).
@@ -39,26 +123,27 @@ class WaypointWrapper(gym.Wrapper):
         max_steps_per_waypoint: the most env steps one waypoint may take.
     """
 
-    def __init__(self, env: gym.Env, grid_cells: int = 8, max_steps_per_waypoint: int = 60):
+    def __init__(
+        self,
+        env: gym.Env,
+        grid_cells: int = 8,
+        max_steps_per_waypoint: int = 60,
+    ):
         super().__init__(env)
         if not hasattr(env.unwrapped, "robot_view"):
             raise ConfigError("WaypointWrapper needs an SfW-Explore env (with robot_view())")
-        for name, value in (("grid_cells", grid_cells), ("max_steps_per_waypoint",
-                                                          max_steps_per_waypoint)):  # fmt: skip
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ConfigError(f"{name} must be a positive integer, got {value!r}")
+        self.driver = WaypointDriver(grid_cells, max_steps_per_waypoint)
         self.grid_cells = grid_cells
-        self.max_steps_per_waypoint = max_steps_per_waypoint
         self.action_space = spaces.Discrete(grid_cells * grid_cells)
-        self._follower = PurePursuit()
+
+    def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
+        """Reset the env and the driver's bump memory."""
+        self.driver.reset()
+        return self.env.reset(**kwargs)
 
     def goal_xy(self, action: int) -> np.ndarray:
         """World (x, y) of the centre of coarse cell ``action``."""
-        grid = self.env.unwrapped.robot_view()["grid"]
-        x0, y0, x1, y1 = grid.bounds
-        row, col = divmod(int(action), self.grid_cells)
-        return np.array([x0 + (col + 0.5) * (x1 - x0) / self.grid_cells,
-                         y0 + (row + 0.5) * (y1 - y0) / self.grid_cells])  # fmt: skip
+        return waypoint_goal_xy(self.env.unwrapped.robot_view()["grid"], self.grid_cells, action)
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         """Plan to waypoint ``action`` and drive there (see the class doc)."""
@@ -67,44 +152,62 @@ class WaypointWrapper(gym.Wrapper):
             raise ValueError(
                 f"waypoint action must be an integer in [0, {self.action_space.n}), got {action!r}"
             )
-        path, pose = self._plan(self.goal_xy(int(a)))
-        self._follower.set_path(path)
-        discrete = self.env.unwrapped.action_type == "discrete"
-        total, steps, collisions = 0.0, 0, self.env.unwrapped.collisions
-        while True:
-            linear, angular = self._follower.command(pose)
-            if not self._follower.has_path and steps > 0:
-                break
-            command = (
-                to_discrete(linear, angular)
-                if discrete
-                else np.array([linear, angular], np.float32)
+        unwrapped = self.env.unwrapped
+        view = unwrapped.robot_view()
+        self.driver.start(view, int(a))
+        pose, bumped = view["odometry_pose"], False
+        total, collisions = 0.0, unwrapped.collisions
+        while (command := self.driver.command(pose, bumped)) is not None:
+            action_ = (
+                to_discrete(*command)
+                if unwrapped.action_type == "discrete"
+                else np.array(command, np.float32)
             )
-            obs, reward, terminated, truncated, info = self.env.step(command)
+            obs, reward, terminated, truncated, info = self.env.step(action_)
             total += float(reward)
-            steps += 1
             pose = tuple(info["odometry_pose"])
-            bumped = info["collisions"] > collisions
-            collisions = info["collisions"]
-            if terminated or truncated or bumped or steps >= self.max_steps_per_waypoint:
+            bumped, collisions = info["collisions"] > collisions, info["collisions"]
+            if terminated or truncated:
                 break
-        reached = len(path) > 0 and not self._follower.has_path
-        info = dict(info, waypoint_steps=steps, waypoint_reached=reached)
+        info = dict(info, waypoint_steps=self.driver.steps, waypoint_reached=self.driver.reached)
         return obs, total, terminated, truncated, info
 
-    def _plan(self, goal_xy: np.ndarray) -> tuple[np.ndarray, tuple[float, float, float]]:
-        """A world path to the reachable cell nearest ``goal_xy`` and the current odometry pose."""
-        view = self.env.unwrapped.robot_view()
-        pose = view["odometry_pose"]
-        grid = view["grid"]
-        cost = traversal_costs(view["belief_u8"], grid.resolution_m, view["radius_m"])
-        start = tuple(int(v) for v in grid.world_to_cell(np.array(pose[:2])))
-        field = cost_field(free_start(cost, start), start, grid.resolution_m)
-        reachable = field.reachable()
-        if not reachable.any():
-            return np.zeros((0, 2)), pose
-        rows, cols = np.nonzero(reachable)
-        goal_rc = grid.world_to_cell(goal_xy)
-        nearest = np.argmin((rows - goal_rc[0]) ** 2 + (cols - goal_rc[1]) ** 2)
-        cells = field.path((int(rows[nearest]), int(cols[nearest])))
-        return cells_to_world(grid, cells), pose
+
+def waypoint_goal_xy(grid: GridSpec, grid_cells: int, action: int) -> np.ndarray:
+    """World (x, y) of the centre of coarse cell ``action`` (row ``action // grid_cells``).
+
+    The coarse cells tile the square that the observation's ``map`` image shows (the grid
+    fitted with its aspect kept and centred), so action ``a`` names the same block of pixels
+    in every episode: rows grow with y, columns with x.
+    """
+    x0, y0, x1, y1 = grid.bounds
+    side = max(x1 - x0, y1 - y0)
+    left, bottom = (x0 + x1 - side) / 2, (y0 + y1 - side) / 2
+    row, col = divmod(int(action), grid_cells)
+    step = side / grid_cells
+    return np.array([left + (col + 0.5) * step, bottom + (row + 0.5) * step])
+
+
+def plan_path(
+    belief_u8: np.ndarray,
+    grid: GridSpec,
+    radius_m: float,
+    pose: tuple[float, float, float],
+    goal_xy: np.ndarray,
+    blocked: np.ndarray | None = None,
+) -> np.ndarray:
+    """A world path on the belief map from ``pose`` to the reachable cell nearest ``goal_xy``.
+
+    Believed walls (and ``blocked`` cells) are obstacles, unknown cells cost more than free
+    ones; an empty (0, 2) array when nothing is reachable.
+    """
+    cost = traversal_costs(belief_u8, grid.resolution_m, radius_m, blocked=blocked)
+    start = tuple(int(v) for v in grid.world_to_cell(np.array(pose[:2])))
+    field = cost_field(free_start(cost, start), start, grid.resolution_m)
+    reachable = field.reachable()
+    if not reachable.any():
+        return np.zeros((0, 2))
+    rows, cols = np.nonzero(reachable)
+    goal_rc = grid.world_to_cell(np.asarray(goal_xy, np.float64))
+    nearest = np.argmin((rows - goal_rc[0]) ** 2 + (cols - goal_rc[1]) ** 2)
+    return cells_to_world(grid, field.path((int(rows[nearest]), int(cols[nearest]))))

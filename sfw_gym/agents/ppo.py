@@ -1,0 +1,107 @@
+"""A trained PPO policy (stable-baselines3) behind the agents' interface.
+
+The shipped policy picks waypoints (:class:`sfw_gym.envs.waypoint.WaypointWrapper`): every few
+steps it looks at the observation and names a block of the map; the agent then drives there
+step by step with the wrapper's own :class:`~sfw_gym.envs.waypoint.WaypointDriver`, so it
+acts exactly as in training. Policies trained on the env's own continuous actions are driven
+directly.
+"""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from sfw_gym.agents.base import Agent, RobotView
+from sfw_gym.errors import ConfigError
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+#: The pretrained policy shipped with the repository (trained by ``sfw-gym train ppo``).
+DEFAULT_MODEL_DIR = REPO_ROOT / "agents" / "ppo" / "SfW-Explore-v0_1"
+WAYPOINT_WRAPPER = "sfw_gym.envs.waypoint.WaypointWrapper"
+
+
+@functools.lru_cache(maxsize=4)
+def _load_model(path: str, device: str) -> Any:
+    from stable_baselines3 import PPO
+
+    return PPO.load(path, device=device)
+
+
+def waypoint_settings(config: dict[str, Any]) -> dict[str, int] | None:
+    """The WaypointWrapper's kwargs from a training ``config.yml``, or None without one."""
+    from sfw_gym.training import wrapper_specs
+
+    for name, kwargs in wrapper_specs(config.get("hyperparameters", {}).get("env_wrapper")):
+        if name == WAYPOINT_WRAPPER:
+            return {"grid_cells": 8, "max_steps_per_waypoint": 60, **kwargs}
+    return None
+
+
+class PPOAgent(Agent):
+    """Acts with a PPO model trained by ``sfw-gym train ppo`` (by default the shipped one).
+
+    Args:
+        model_dir: A training output folder holding ``model.zip`` and ``config.yml``.
+        deterministic: Take the policy's most likely action (else sample it).
+        device: Torch device of the policy (``"cpu"`` is plenty for one env).
+        max_steps: Optional step limit of the agent.
+    """
+
+    name = "ppo"
+
+    def __init__(
+        self,
+        model_dir: str | Path = DEFAULT_MODEL_DIR,
+        deterministic: bool = True,
+        device: str = "cpu",
+        max_steps: int | None = None,
+    ) -> None:
+        super().__init__(max_steps=max_steps)
+        self.model_dir = Path(model_dir)
+        self.deterministic = bool(deterministic)
+        self.device = device
+        model_path = self.model_dir / "model.zip"
+        config_path = self.model_dir / "config.yml"
+        for path in (model_path, config_path):
+            if not path.is_file():
+                raise ConfigError(
+                    f"PPOAgent: {path} not found; train one with `sfw-gym train ppo --out "
+                    f"{self.model_dir}` or pass model_dir="
+                )
+        try:
+            config = yaml.safe_load(config_path.read_text(encoding="utf-8")) or {}
+        except yaml.YAMLError as exc:
+            raise ConfigError(f"PPOAgent: {config_path}: not valid YAML ({exc})") from None
+        self.waypoints = waypoint_settings(config)
+        self.model = _load_model(str(model_path), device)
+        if self.waypoints is None:
+            self.action_types = ("continuous",)
+
+    def _on_reset(self, view: RobotView) -> None:
+        from sfw_gym.envs.waypoint import WaypointDriver
+
+        if self.waypoints is not None:
+            self.driver = WaypointDriver(
+                self.waypoints["grid_cells"], self.waypoints["max_steps_per_waypoint"]
+            )
+        self.goals: list[tuple[float, float]] = []
+
+    def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
+        if obs is None:
+            raise ConfigError("PPOAgent.act(obs) needs the env's observation")
+        if self.waypoints is None:
+            action, _ = self.model.predict(obs, deterministic=self.deterministic)
+            linear, angular = np.clip(np.asarray(action, np.float64).ravel()[:2], -1.0, 1.0)
+            return float(linear), float(angular)
+        command = self.driver.command(view.odometry_pose, view.bumped)
+        if command is None:  # the waypoint is over: the policy names the next one
+            action, _ = self.model.predict(obs, deterministic=self.deterministic)
+            self.driver.start(vars(view), int(action))
+            self.goals.append((float(self.driver.goal[0]), float(self.driver.goal[1])))
+            command = self.driver.command(view.odometry_pose, False)
+        return command

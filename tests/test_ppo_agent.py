@@ -1,0 +1,82 @@
+"""PPOAgent: a policy trained with waypoints acts through the agents' interface as in training."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import yaml
+
+import sfw_gym  # noqa: F401
+from sfw_gym.agents import PPOAgent
+from sfw_gym.envs.waypoint import WaypointWrapper
+from sfw_gym.errors import ConfigError
+from sfw_gym.training import train_ppo, wrapper_specs
+
+SMALL = "SfW-ExploreSmall-v0"
+WAYPOINTS = {"grid_cells": 4, "max_steps_per_waypoint": 20}
+
+
+@pytest.fixture(scope="module")
+def waypoint_model(tmp_path_factory):
+    """A tiny waypoint policy trained by train_ppo from an rl-zoo YAML with env_wrapper."""
+    root = tmp_path_factory.mktemp("ppo")
+    hyper = root / "ppo.yml"
+    block = {
+        "policy": "MultiInputPolicy",
+        "n_envs": 1,
+        "env_wrapper": [{"sfw_gym.envs.waypoint.WaypointWrapper": WAYPOINTS}],
+        "n_steps": 32,
+        "batch_size": 32,
+        "n_epochs": 1,
+        "policy_kwargs": "dict(net_arch=dict(pi=[16], vf=[16]))",
+    }
+    hyper.write_text(yaml.safe_dump({SMALL: block}))
+    out = root / "run"
+    train_ppo(SMALL, 64, out, hyperparams_path=hyper, env_kwargs={"max_steps": 120},
+              eval_every=10**9, progress_bar=False)  # fmt: skip
+    return out
+
+
+def test_agent_drives_the_raw_env_exactly_as_the_wrapper_did_in_training(waypoint_model):
+    agent = PPOAgent(model_dir=waypoint_model)
+    assert agent.waypoints == WAYPOINTS
+
+    wrapped = WaypointWrapper(gym.make(SMALL, max_steps=120), **WAYPOINTS)
+    obs, _ = wrapped.reset(seed=3)
+    goals = []
+    while True:
+        action, _ = agent.model.predict(obs, deterministic=True)
+        goals.append(tuple(wrapped.goal_xy(int(action))))
+        obs, _, terminated, truncated, info = wrapped.step(int(action))
+        if terminated or truncated:
+            break
+    expected = np.array(wrapped.unwrapped.trajectory)
+
+    env = gym.make(SMALL, max_steps=120)
+    obs, _ = env.reset(seed=3)
+    agent.reset(env, seed=0)
+    while True:
+        obs, _, terminated, truncated, info2 = env.step(agent.act(obs))
+        if terminated or truncated:
+            break
+    np.testing.assert_allclose(np.array(env.unwrapped.trajectory), expected)
+    assert agent.goals == [pytest.approx(g) for g in goals]
+    assert info2["coverage"] == info["coverage"]
+
+
+def test_missing_model_is_a_clear_error(tmp_path):
+    with pytest.raises(ConfigError, match=r"model\.zip not found"):
+        PPOAgent(model_dir=tmp_path)
+
+
+def test_env_wrapper_entries_in_rl_zoo_forms():
+    name = "sfw_gym.envs.waypoint.WaypointWrapper"
+    assert wrapper_specs(None) == []
+    assert wrapper_specs(name) == [(name, {})]
+    specs = wrapper_specs([{name: {"grid_cells": 4}}, name])
+    assert specs == [(name, {"grid_cells": 4}), (name, {})]
+    with pytest.raises(ConfigError, match="env_wrapper"):
+        wrapper_specs([{"a": 1, "b": 2}])
+    with pytest.raises(ConfigError, match="env_wrapper"):
+        wrapper_specs(3)
