@@ -154,12 +154,35 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_demo(args: argparse.Namespace) -> int:
+    from sfw_gym.demo import run_demo
+
+    start = time.perf_counter()
+    index = run_demo(args.out, args.episodes, args.seed, workers=args.workers,
+                     progress=not args.no_progress)  # fmt: skip
+    print(index.parent.joinpath("results.md").read_text(encoding="utf-8"), end="")
+    print(f"report: {index} ({time.perf_counter() - start:.0f} s)")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of every subcommand."""
     parser = argparse.ArgumentParser(
         prog="sfw-gym", description="Active WiFi exploration: worlds, mapping, agents."
     )
     sub = parser.add_subparsers(dest="command", required=True)
+
+    from sfw_gym.demo import DEMO_SEED
+
+    demo = sub.add_parser(
+        "demo", help="frontier, cross-pass and the pretrained PPO on fresh plans → sfw-report/"
+    )
+    demo.add_argument("--out", default="sfw-report", help="report folder (default sfw-report)")
+    demo.add_argument("--episodes", type=int, default=3, help="floorplans (default 3)")
+    demo.add_argument("--seed", type=int, default=DEMO_SEED, help="seed of the first floorplan")
+    demo.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    demo.add_argument("--no-progress", action="store_true", help="no progress bar")
+    demo.set_defaults(func=_cmd_demo)
 
     world = sub.add_parser("world", help="draw a floorplan, its routers, RSSI and true k-regions")
     source = world.add_mutually_exclusive_group()
@@ -234,7 +257,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     ev.add_argument(
         "--agents", default="frontier,cross-pass,random",
-        help="comma-separated: frontier, cross-pass, greedy, random (default: all but greedy)",
+        help="comma-separated: frontier, cross-pass, greedy, random, ppo (default: "
+        "frontier,cross-pass,random)",
     )  # fmt: skip
     ev.add_argument("--episodes", type=int, default=10, help="episodes per agent (default 10)")
     ev.add_argument("--seed", type=int, default=0, help="episode i uses reset(seed=SEED + i)")

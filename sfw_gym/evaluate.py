@@ -43,6 +43,7 @@ TABLE_METRICS: tuple[tuple[str, str, str], ...] = (
     ("free_iou", "free IoU", "{:.3f}"),
     ("k_accuracy", "k-accuracy", "{:.3f}"),
     ("path_length_m", "path [m]", "{:.0f}"),
+    ("info_gain_per_m", "info gain [bits/m]", "{:.0f}"),
     ("collisions", "collisions", "{:.0f}"),
     ("steps_to_coverage_50", "steps to 50 %", "{:.0f}"),
     ("steps_to_coverage_90", "steps to 90 %", "{:.0f}"),
@@ -147,6 +148,7 @@ def run_episode(spec: EpisodeSpec) -> dict[str, Any]:
     env = gym.make(spec.env_id, render_mode=render, **spec.env_kwargs)
     options = {"floorplan": spec.floorplan} if spec.floorplan else None
     obs, info = env.reset(seed=spec.seed, options=options)
+    entropy_at_start = info["entropy_bits"]
     agent = make_agent(spec.agent, **spec.agent_params)
     agent.reset(env, seed=spec.seed)
     frames = [env.render()] if render else []
@@ -161,6 +163,10 @@ def run_episode(spec: EpisodeSpec) -> dict[str, Any]:
             frames.append(env.render())
     summary = dict(info.get("summary", {}))
     summary.update(zone_band_unknown(env, spec.band_m))
+    # The map's information gain per metre driven: what the reward pays for, per unit of effort.
+    summary["info_gain_total_bits"] = entropy_at_start - info["entropy_bits"]
+    path_m = info["path_length_m"]
+    summary["info_gain_per_m"] = summary["info_gain_total_bits"] / path_m if path_m > 0 else None
     u = env.unwrapped
     reason = agent.stop_reason or ("coverage_target" if terminated else "max_steps")
     record = {
