@@ -1,7 +1,7 @@
 """Compare the baseline agents on generated plans and on the HouseExpo plans (issue 5's benchmark).
 
 Usage: ``python scripts/compare_agents.py [--episodes 20] [--houseexpo DIR] [--out runs/compare]
-[--agents frontier,cross-pass,greedy,random] [--workers 2]``
+[--agents frontier,cross-pass,random] [--env SfW-ExploreFull-v0] [--workers 2]``
 
 Runs ``sfw_gym.evaluate.evaluate`` twice — ``--episodes`` procedural plans (seeds 0, 1, …) and
 one episode per HouseExpo file (seeds 100, 101, …) — into ``OUT/generated`` and ``OUT/houseexpo``
@@ -20,10 +20,10 @@ DEFAULT_HOUSEEXPO = Path(__file__).resolve().parents[2] / "shared" / "floorplans
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--agents", default="frontier,cross-pass,greedy,random")
+    p.add_argument("--agents", default="frontier,cross-pass,random")
     p.add_argument("--episodes", type=int, default=20, help="generated plans (default 20)")
     p.add_argument("--houseexpo", default=str(DEFAULT_HOUSEEXPO), help="HouseExpo folder")
-    p.add_argument("--env", default="SfW-Explore-v0")
+    p.add_argument("--env", default="SfW-ExploreFull-v0")
     p.add_argument("--out", default="runs/compare")
     p.add_argument("--workers", type=int, default=2)
     args = p.parse_args()

@@ -112,14 +112,14 @@ def wrapper_specs(value: Any) -> list[tuple[str, dict[str, Any]]]:
     return specs
 
 
-def _import_wrapper(name: str) -> Any:
+def _import_dotted(name: str) -> Any:
     import importlib
 
     module, _, attr = name.rpartition(".")
     try:
         return getattr(importlib.import_module(module), attr)
     except (ImportError, AttributeError, ValueError) as exc:
-        raise ConfigError(f"env_wrapper: cannot import {name!r}: {exc}") from None
+        raise ConfigError(f"cannot import {name!r}: {exc}") from None
 
 
 def latest_checkpoint(out_dir: Path) -> tuple[Path, int] | None:
@@ -141,7 +141,7 @@ def _make_env_fn(env_id: str, env_kwargs: dict[str, Any], wrappers: list[tuple[s
 
         env = gym.make(env_id, **env_kwargs)
         for name, kwargs in wrappers:
-            env = _import_wrapper(name)(env, **kwargs)
+            env = _import_dotted(name)(env, **kwargs)
         return env
 
     return make
@@ -200,11 +200,13 @@ def train_ppo(
     params = load_hyperparams(env_id, hyperparams_path)
     n_envs = int(n_envs or params.get("n_envs", 1))
     policy = params.get("policy", "MultiInputPolicy")
+    if "." in policy:  # a policy class of one's own, by dotted path
+        policy = _import_dotted(policy)
     ppo_kwargs = {k: v for k, v in params.items() if k in _PPO_KEYS}
     env_kwargs = dict(env_kwargs or {})
     wrappers = wrapper_specs(params.get("env_wrapper"))
     for name, _ in wrappers:
-        _import_wrapper(name)
+        _import_dotted(name)
 
     previous = latest_checkpoint(out) if resume else None
     start_steps = previous[1] if previous else 0

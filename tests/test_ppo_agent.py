@@ -80,3 +80,20 @@ def test_env_wrapper_entries_in_rl_zoo_forms():
         wrapper_specs([{"a": 1, "b": 2}])
     with pytest.raises(ConfigError, match="env_wrapper"):
         wrapper_specs(3)
+
+
+def test_waypoint_policy_scores_every_block_with_one_network():
+    import torch
+
+    from sfw_gym.agents.waypoint_policy import WaypointPolicy
+
+    env = WaypointWrapper(gym.make(SMALL), grid_cells=3)
+    policy = WaypointPolicy(env.observation_space, env.action_space, lambda _: 1e-3)
+    obs, _ = env.reset(seed=0)
+    batch = {k: torch.as_tensor(v)[None] for k, v in obs.items()}
+    logits = policy.get_distribution(batch).distribution.logits[0]
+    perm = torch.randperm(9)
+    batch["blocks"] = batch["blocks"][:, perm]
+    permuted = policy.get_distribution(batch).distribution.logits[0]
+    # a block's logit depends on its own features only (softmax logits are shift-free)
+    torch.testing.assert_close(permuted - permuted.mean(), (logits - logits.mean())[perm])

@@ -24,8 +24,10 @@ TINY = {"max_steps": 40}
 
 def test_hyperparams_load_for_every_block():
     params = load_hyperparams("SfW-Explore-v0")
-    assert params["policy"] == "MultiInputPolicy"
-    assert params["policy_kwargs"]["net_arch"] == {"pi": [128], "vf": [128]}
+    assert params["policy"] == "sfw_gym.agents.waypoint_policy.WaypointPolicy"
+    assert params["env_wrapper"][0]["sfw_gym.envs.waypoint.WaypointWrapper"]["grid_cells"] == 8
+    small = load_hyperparams("SfW-ExploreSmall-v0")
+    assert small["policy_kwargs"]["net_arch"] == {"pi": [64], "vf": [64]}
     with pytest.raises(ConfigError, match="no hyperparameters"):
         load_hyperparams("CartPole-v1", DEFAULT_HYPERPARAMS)
 

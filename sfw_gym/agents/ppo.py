@@ -17,6 +17,7 @@ import numpy as np
 import yaml
 
 from sfw_gym.agents.base import Agent, RobotView
+from sfw_gym.envs.waypoint import WaypointDriver, block_features
 from sfw_gym.errors import ConfigError
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
@@ -27,8 +28,11 @@ WAYPOINT_WRAPPER = "sfw_gym.envs.waypoint.WaypointWrapper"
 
 @functools.lru_cache(maxsize=4)
 def _load_model(path: str, device: str) -> Any:
+    import torch
     from stable_baselines3 import PPO
 
+    # One env's forward pass is tiny: threads only fight the evaluation's other workers.
+    torch.set_num_threads(1)
     return PPO.load(path, device=device)
 
 
@@ -62,11 +66,11 @@ class PPOAgent(Agent):
         max_steps: int | None = None,
     ) -> None:
         super().__init__(max_steps=max_steps)
-        self.model_dir = Path(model_dir)
+        self.model_dir = str(model_dir)
         self.deterministic = bool(deterministic)
         self.device = device
-        model_path = self.model_dir / "model.zip"
-        config_path = self.model_dir / "config.yml"
+        model_path = Path(model_dir) / "model.zip"
+        config_path = Path(model_dir) / "config.yml"
         for path in (model_path, config_path):
             if not path.is_file():
                 raise ConfigError(
@@ -83,8 +87,6 @@ class PPOAgent(Agent):
             self.action_types = ("continuous",)
 
     def _on_reset(self, view: RobotView) -> None:
-        from sfw_gym.envs.waypoint import WaypointDriver
-
         if self.waypoints is not None:
             self.driver = WaypointDriver(
                 self.waypoints["grid_cells"], self.waypoints["max_steps_per_waypoint"]
@@ -100,6 +102,11 @@ class PPOAgent(Agent):
             return float(linear), float(angular)
         command = self.driver.command(view.odometry_pose, view.bumped)
         if command is None:  # the waypoint is over: the policy names the next one
+            if "blocks" in self.model.observation_space.spaces:  # as WaypointWrapper adds it
+                blocks = block_features(
+                    view.belief_u8, view.grid, view.odometry_pose, self.driver.grid_cells
+                )
+                obs = {**obs, "blocks": blocks}
             action, _ = self.model.predict(obs, deterministic=self.deterministic)
             self.driver.start(vars(view), int(action))
             self.goals.append((float(self.driver.goal[0]), float(self.driver.goal[1])))

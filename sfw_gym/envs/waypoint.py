@@ -16,6 +16,7 @@ from sfw_gym.errors import ConfigError
 from sfw_gym.mapping import GridSpec
 from sfw_gym.navigation import (
     PurePursuit,
+    belief_classes,
     cells_to_world,
     cost_field,
     free_start,
@@ -115,7 +116,8 @@ class WaypointWrapper(gym.Wrapper):
     cell's centre and drives it with a :class:`WaypointDriver`, until the goal, the step cap, a
     bump, or the episode's end. The reward is the sum of the env steps'
     rewards; ``info["waypoint_steps"]`` counts them and ``info["waypoint_reached"]`` says
-    whether the goal was reached.
+    whether the goal was reached. The observation gains ``blocks``: what the robot knows of each
+    block (:func:`block_features`), so that a policy can score the blocks one by one.
 
     Args:
         env: an SfW-Explore env (continuous or discrete actions).
@@ -135,11 +137,14 @@ class WaypointWrapper(gym.Wrapper):
         self.driver = WaypointDriver(grid_cells, max_steps_per_waypoint)
         self.grid_cells = grid_cells
         self.action_space = spaces.Discrete(grid_cells * grid_cells)
+        blocks = spaces.Box(0.0, 2.0, (grid_cells * grid_cells, len(BLOCK_FEATURES)), np.float32)
+        self.observation_space = spaces.Dict({**env.observation_space.spaces, "blocks": blocks})
 
     def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
         """Reset the env and the driver's bump memory."""
         self.driver.reset()
-        return self.env.reset(**kwargs)
+        obs, info = self.env.reset(**kwargs)
+        return self._with_blocks(obs), info
 
     def goal_xy(self, action: int) -> np.ndarray:
         """World (x, y) of the centre of coarse cell ``action``."""
@@ -170,7 +175,13 @@ class WaypointWrapper(gym.Wrapper):
             if terminated or truncated:
                 break
         info = dict(info, waypoint_steps=self.driver.steps, waypoint_reached=self.driver.reached)
-        return obs, total, terminated, truncated, info
+        return self._with_blocks(obs), total, terminated, truncated, info
+
+    def _with_blocks(self, obs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        view = self.env.unwrapped.robot_view()
+        blocks = block_features(view["belief_u8"], view["grid"], view["odometry_pose"],
+                                self.grid_cells)  # fmt: skip
+        return {**obs, "blocks": blocks}
 
 
 def waypoint_goal_xy(grid: GridSpec, grid_cells: int, action: int) -> np.ndarray:
@@ -211,3 +222,44 @@ def plan_path(
     goal_rc = grid.world_to_cell(np.asarray(goal_xy, np.float64))
     nearest = np.argmin((rows - goal_rc[0]) ** 2 + (cols - goal_rc[1]) ** 2)
     return cells_to_world(grid, field.path((int(rows[nearest]), int(cols[nearest]))))
+
+
+#: Per-block features of :func:`block_features`, in column order.
+BLOCK_FEATURES = ("unknown", "free", "wall", "inside", "distance", "robot")
+
+
+def block_features(
+    belief_u8: np.ndarray, grid: GridSpec, pose: tuple[float, float, float], grid_cells: int
+) -> np.ndarray:
+    """``float32 (n², 6)``: per waypoint block, what the robot knows of it (row-major blocks).
+
+    Columns (:data:`BLOCK_FEATURES`): the fractions of the block's grid cells believed unknown,
+    free and wall; the fraction of the block inside the grid; the distance from the robot to
+    the block's centre over the square's side; 1 for the robot's own block.
+    """
+    free, wall, unknown = belief_classes(belief_u8)
+    rows, cols = grid.shape
+    side = max(rows, cols)
+    # the square the blocks tile, in cells, and each block's cell range (clipped to the grid)
+    top, left = (rows - side) / 2, (cols - side) / 2
+    edges_r = np.clip(np.round(top + np.arange(grid_cells + 1) * side / grid_cells), 0, rows)
+    edges_c = np.clip(np.round(left + np.arange(grid_cells + 1) * side / grid_cells), 0, cols)
+    block_area = (side / grid_cells) ** 2
+    out = np.zeros((grid_cells * grid_cells, len(BLOCK_FEATURES)), np.float32)
+    x, y = pose[0], pose[1]
+    x0, y0, x1, y1 = grid.bounds
+    side_m = max(x1 - x0, y1 - y0)
+    robot_r, robot_c = (int(v) for v in grid.world_to_cell(np.array([x, y])))
+    for b in range(grid_cells * grid_cells):
+        i, j = divmod(b, grid_cells)
+        r0, r1, c0, c1 = int(edges_r[i]), int(edges_r[i + 1]), int(edges_c[j]), int(edges_c[j + 1])
+        n = max((r1 - r0) * (c1 - c0), 0)
+        if n:
+            out[b, 0] = unknown[r0:r1, c0:c1].mean()
+            out[b, 1] = free[r0:r1, c0:c1].mean()
+            out[b, 2] = wall[r0:r1, c0:c1].mean()
+        out[b, 3] = n / block_area
+        cx, cy = waypoint_goal_xy(grid, grid_cells, b)
+        out[b, 4] = np.hypot(cx - x, cy - y) / side_m
+        out[b, 5] = float(r0 <= robot_r < r1 and c0 <= robot_c < c1)
+    return out
