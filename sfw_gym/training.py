@@ -211,43 +211,43 @@ def train_ppo(
     previous = latest_checkpoint(out) if resume else None
     start_steps = previous[1] if previous else 0
     if start_steps >= timesteps:  # already there (e.g. killed after its last checkpoint)
-        if not (out / "model.zip").exists():
-            with atomic_path(out / "model.zip") as tmp:
-                shutil.copyfile(previous[0], tmp)
-        return {"steps": start_steps, "resumed_from": str(previous[0]), "wall_time_s": 0.0,
-                "model": str(out / "model.zip")}  # fmt: skip
-    venv = _make_venv(env_id, n_envs, seed + start_steps, env_kwargs, wrappers,
-                      out / f"train_{start_steps}.monitor.csv")  # fmt: skip
-    eval_env = _make_venv(env_id, 1, seed + HELD_OUT_SEED_OFFSET, env_kwargs, wrappers,
-                          out / f"eval_{start_steps}.monitor.csv")  # fmt: skip
-    try:
-        if previous:
-            model = PPO.load(previous[0], env=venv, device=device,
-                             tensorboard_log=str(out / "tb"))  # fmt: skip
-        else:
-            model = PPO(policy, venv, seed=seed, device=device, verbose=0,
-                        tensorboard_log=str(out / "tb"), **ppo_kwargs)  # fmt: skip
-        callbacks = CallbackList([
-            CheckpointCallback(max(checkpoint_every // n_envs, 1), str(out / "checkpoints"),
-                               name_prefix="ppo"),
-            EvalCallback(eval_env, n_eval_episodes=eval_episodes,
-                         eval_freq=max(eval_every // n_envs, 1), log_path=str(out / "eval"),
-                         best_model_save_path=None, deterministic=True, verbose=0),
-        ])  # fmt: skip
-        start = time.perf_counter()
-        model.learn(total_timesteps=timesteps - start_steps, callback=callbacks,
-                    reset_num_timesteps=previous is None, progress_bar=progress_bar,
-                    tb_log_name="ppo")  # fmt: skip
-        wall = time.perf_counter() - start
-        _save_atomic(model, out / "model.zip")
-        # A final checkpoint, so that a later resume starts from the end of this run.
-        _save_atomic(model, out / "checkpoints" / f"ppo_{model.num_timesteps}_steps.zip")
-    finally:
-        venv.close()
-        eval_env.close()
+        with atomic_path(out / "model.zip") as tmp:
+            shutil.copyfile(previous[0], tmp)
+        steps, wall = start_steps, 0.0
+    else:
+        venv = _make_venv(env_id, n_envs, seed + start_steps, env_kwargs, wrappers,
+                          out / f"train_{start_steps}.monitor.csv")  # fmt: skip
+        eval_env = _make_venv(env_id, 1, seed + HELD_OUT_SEED_OFFSET, env_kwargs, wrappers,
+                              out / f"eval_{start_steps}.monitor.csv")  # fmt: skip
+        try:
+            if previous:
+                model = PPO.load(previous[0], env=venv, device=device,
+                                 tensorboard_log=str(out / "tb"))  # fmt: skip
+            else:
+                model = PPO(policy, venv, seed=seed, device=device, verbose=0,
+                            tensorboard_log=str(out / "tb"), **ppo_kwargs)  # fmt: skip
+            callbacks = CallbackList([
+                CheckpointCallback(max(checkpoint_every // n_envs, 1), str(out / "checkpoints"),
+                                   name_prefix="ppo"),
+                EvalCallback(eval_env, n_eval_episodes=eval_episodes,
+                             eval_freq=max(eval_every // n_envs, 1), log_path=str(out / "eval"),
+                             best_model_save_path=None, deterministic=False, verbose=0),
+            ])  # fmt: skip
+            start = time.perf_counter()
+            model.learn(total_timesteps=timesteps - start_steps, callback=callbacks,
+                        reset_num_timesteps=previous is None, progress_bar=progress_bar,
+                        tb_log_name="ppo")  # fmt: skip
+            wall = time.perf_counter() - start
+            _save_atomic(model, out / "model.zip")
+            # A final checkpoint, so that a later resume starts from the end of this run.
+            _save_atomic(model, out / "checkpoints" / f"ppo_{model.num_timesteps}_steps.zip")
+        finally:
+            venv.close()
+            eval_env.close()
+        steps = int(model.num_timesteps)
     summary = {
         "env_id": env_id,
-        "steps": int(model.num_timesteps),
+        "steps": steps,
         "resumed_from": str(previous[0]) if previous else None,
         "wall_time_s": round(wall, 1),
         "n_envs": n_envs,

@@ -39,7 +39,7 @@ def waypoint_model(tmp_path_factory):
 
 
 def test_agent_drives_the_raw_env_exactly_as_the_wrapper_did_in_training(waypoint_model):
-    agent = PPOAgent(model_dir=waypoint_model)
+    agent = PPOAgent(model_dir=waypoint_model, deterministic=True)
     assert agent.waypoints == WAYPOINTS
 
     wrapped = WaypointWrapper(gym.make(SMALL, max_steps=120), **WAYPOINTS)
@@ -63,6 +63,19 @@ def test_agent_drives_the_raw_env_exactly_as_the_wrapper_did_in_training(waypoin
     np.testing.assert_allclose(np.array(env.unwrapped.trajectory), expected)
     assert agent.goals == [pytest.approx(g) for g in goals]
     assert info2["coverage"] == info["coverage"]
+
+
+def test_sampled_waypoints_are_reproducible_from_the_agent_seed(waypoint_model):
+    def goals(seed):
+        agent = PPOAgent(model_dir=waypoint_model)
+        env = gym.make(SMALL, max_steps=60)
+        obs, _ = env.reset(seed=3)
+        agent.reset(env, seed=seed)
+        for _ in range(60):
+            obs, *_ = env.step(agent.act(obs))
+        return agent.goals
+
+    assert goals(1) == goals(1) and len(goals(1)) >= 2
 
 
 def test_missing_model_is_a_clear_error(tmp_path):

@@ -51,7 +51,10 @@ class PPOAgent(Agent):
 
     Args:
         model_dir: A training output folder holding ``model.zip`` and ``config.yml``.
-        deterministic: Take the policy's most likely action (else sample it).
+        deterministic: Take the policy's most likely waypoint; else (the default) sample it from
+            the policy with the agent's seeded generator, as in training. A deterministic
+            policy repeats a waypoint it cannot reach forever (nothing in the observation
+            changes); sampling does not.
         device: Torch device of the policy (``"cpu"`` is plenty for one env).
         max_steps: Optional step limit of the agent.
     """
@@ -61,7 +64,7 @@ class PPOAgent(Agent):
     def __init__(
         self,
         model_dir: str | Path = DEFAULT_MODEL_DIR,
-        deterministic: bool = True,
+        deterministic: bool = False,
         device: str = "cpu",
         max_steps: int | None = None,
     ) -> None:
@@ -86,6 +89,19 @@ class PPOAgent(Agent):
         if self.waypoints is None:
             self.action_types = ("continuous",)
 
+    def _choose(self, obs: dict[str, np.ndarray]) -> int:
+        """The policy's waypoint for ``obs``: its mode, or a sample drawn with ``self.rng``."""
+        import torch
+
+        policy = self.model.policy
+        with torch.no_grad():
+            tensor, _ = policy.obs_to_tensor(obs)
+            probs = policy.get_distribution(tensor).distribution.probs[0].cpu().numpy()
+        if self.deterministic:
+            return int(np.argmax(probs))
+        probs = probs.astype(np.float64)
+        return int(self.rng.choice(len(probs), p=probs / probs.sum()))
+
     def _on_reset(self, view: RobotView) -> None:
         if self.waypoints is not None:
             self.driver = WaypointDriver(
@@ -107,8 +123,7 @@ class PPOAgent(Agent):
                     view.belief_u8, view.grid, view.odometry_pose, self.driver.grid_cells
                 )
                 obs = {**obs, "blocks": blocks}
-            action, _ = self.model.predict(obs, deterministic=self.deterministic)
-            self.driver.start(vars(view), int(action))
+            self.driver.start(vars(view), self._choose(obs))
             self.goals.append((float(self.driver.goal[0]), float(self.driver.goal[1])))
             command = self.driver.command(view.odometry_pose, False)
         return command
