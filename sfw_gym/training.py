@@ -298,7 +298,8 @@ def plot_training_curve(out_dir: str | Path) -> Path | None:
         s, r = np.asarray(steps)[order], np.asarray(returns)[order]
         ax.plot(s, r, ".", alpha=0.25, label="training episodes")
         k = max(1, len(r) // 20)
-        ax.plot(s, np.convolve(r, np.ones(k) / k, mode="same"), label=f"training (mean of {k})")
+        smooth = np.convolve(r, np.ones(k) / k, mode="valid")  # trailing mean, no edge dip
+        ax.plot(s[k - 1 :], smooth, label=f"training (mean of last {k})")
     if evals.exists():
         ev = np.load(evals)
         ax.errorbar(ev["timesteps"], ev["results"].mean(1), yerr=ev["results"].std(1), fmt="o-",

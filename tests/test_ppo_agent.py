@@ -78,6 +78,24 @@ def test_sampled_waypoints_are_reproducible_from_the_agent_seed(waypoint_model):
     assert goals(1) == goals(1) and len(goals(1)) >= 2
 
 
+def test_a_policy_on_raw_continuous_actions_drives_directly(tmp_path):
+    train_ppo(SMALL, 32, tmp_path, n_envs=1, env_kwargs={"max_steps": 40}, eval_every=10**9,
+              progress_bar=False)  # fmt: skip
+    agent = PPOAgent(model_dir=tmp_path)
+    assert agent.waypoints is None
+    env = gym.make(SMALL, max_steps=40)
+    obs, _ = env.reset(seed=0)
+    agent.reset(env, seed=0)
+    for _ in range(5):
+        action = agent.act(obs)
+        assert env.action_space.contains(action)
+        obs, *_ = env.step(action)
+    discrete = gym.make("SfW-ExploreDiscrete-v0")
+    discrete.reset(seed=0)
+    with pytest.raises(ConfigError, match="action types"):
+        agent.reset(discrete)
+
+
 def test_missing_model_is_a_clear_error(tmp_path):
     with pytest.raises(ConfigError, match=r"model\.zip not found"):
         PPOAgent(model_dir=tmp_path)
