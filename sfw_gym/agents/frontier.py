@@ -193,10 +193,10 @@ class FrontierAgent(Agent):
             blacklisted goal.
         min_hidden_room_depth_m: Unknown pockets this deep (see :func:`hidden_rooms`) are
             escape goals.
+        escape_blacklist_radius_m: A failed escape goal blacklists the cells this close.
         stall_steps, stall_gain_m2: The exploration has stalled when the map grew by less than
             ``stall_gain_m2`` over the last ``stall_steps`` steps; the agent then drives to the
             cheapest hidden room, if there is one, before it takes frontier goals again.
-        escape_blacklist_radius_m: A failed escape goal blacklists the cells this close.
         max_steps: Optional step limit of the agent (then ``stop_reason = "max_steps"``).
     """
 
