@@ -249,7 +249,8 @@ def train_ppo(
         "env_id": env_id,
         "steps": steps,
         "resumed_from": str(previous[0]) if previous else None,
-        "wall_time_s": round(wall, 1),
+        "wall_time_s": round(wall, 1),  # this call's
+        "total_wall_time_s": round(_monitored_seconds(out), 1),  # every segment's, from the logs
         "n_envs": n_envs,
         "seed": seed,
         "hyperparameters": params,
@@ -260,6 +261,16 @@ def train_ppo(
     write_text_atomic(out / "config.yml", yaml.safe_dump(summary, sort_keys=False))
     plot_training_curve(out)
     return summary
+
+
+def _monitored_seconds(out: Path) -> float:
+    """Training wall time over every run segment: the last episode end time of each monitor."""
+    total = 0.0
+    for csv in out.glob("train_*.monitor.csv"):
+        lines = csv.read_text(encoding="utf-8").splitlines()[2:]
+        if lines:
+            total += float(lines[-1].split(",")[2])
+    return total
 
 
 def _save_atomic(model: Any, path: Path) -> None:
