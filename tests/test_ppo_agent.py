@@ -96,6 +96,15 @@ def test_a_policy_on_raw_continuous_actions_drives_directly(tmp_path):
         agent.reset(discrete)
 
 
+def test_an_env_with_other_observations_is_refused(waypoint_model):
+    agent = PPOAgent(model_dir=waypoint_model)  # trained on SMALL's 36 x 36 images
+    env = gym.make("SfW-Explore-v0")
+    obs, _ = env.reset(seed=0)
+    agent.reset(env)
+    with pytest.raises(ConfigError, match="map_px"):
+        agent.act(obs)
+
+
 def test_missing_model_is_a_clear_error(tmp_path):
     with pytest.raises(ConfigError, match=r"model\.zip not found"):
         PPOAgent(model_dir=tmp_path)

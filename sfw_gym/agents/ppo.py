@@ -108,10 +108,26 @@ class PPOAgent(Agent):
                 self.waypoints["grid_cells"], self.waypoints["max_steps_per_waypoint"]
             )
         self.goals: list[tuple[float, float]] = []
+        self._obs_checked = False
+
+    def _check_obs(self, obs: Any) -> None:
+        """The env's observations must be those the policy was trained on."""
+        trained = self.model.observation_space.spaces
+        differ = {k: v.shape for k, v in trained.items()
+                  if k != "blocks" and np.shape(obs.get(k)) != v.shape}  # fmt: skip
+        if differ:
+            got = {k: np.shape(obs.get(k)) for k in differ}
+            raise ConfigError(
+                f"PPOAgent: the policy in {self.model_dir} was trained on observations {differ}; "
+                f"this env gives {got} (map_px, crop_px and n_routers must match)"
+            )
+        self._obs_checked = True
 
     def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
-        if obs is None:
-            raise ConfigError("PPOAgent.act(obs) needs the env's observation")
+        if not isinstance(obs, dict):
+            raise ConfigError("PPOAgent.act(obs) needs the env's (Dict) observation")
+        if not self._obs_checked:
+            self._check_obs(obs)
         if self.waypoints is None:
             action, _ = self.model.predict(obs, deterministic=self.deterministic)
             linear, angular = np.clip(np.asarray(action, np.float64).ravel()[:2], -1.0, 1.0)
