@@ -15,6 +15,7 @@ from sfw_gym.atomic import write_text_atomic
 from sfw_gym.evaluate import evaluate
 
 DEMO_AGENTS = ("frontier", "cross-pass", "ppo")
+DEMO_ENV = "SfW-Explore-v0"  # the shipped policy's env
 #: Floorplan seeds far from those the shipped policy was trained on (its training resets used
 #: seeds 0-3 and their RNG streams; its held-out evaluation 1,000,000+).
 DEMO_SEED = 2_000_000
@@ -25,7 +26,6 @@ def run_demo(
     episodes: int = 3,
     seed: int = DEMO_SEED,
     *,
-    env_id: str = "SfW-Explore-v0",
     workers: int = 2,
     progress: bool = True,
 ) -> Path:
@@ -33,25 +33,23 @@ def run_demo(
     out = Path(out)
     start = time.perf_counter()
     result = evaluate(
-        list(DEMO_AGENTS), episodes, seed, out=out, env_id=env_id, workers=workers,
+        list(DEMO_AGENTS), episodes, seed, out=out, env_id=DEMO_ENV, workers=workers,
         gif_episodes=1, progress=progress,
     )  # fmt: skip
     index = out / "index.md"
     wall_s = time.perf_counter() - start
-    write_text_atomic(index, _index_markdown(out, result, env_id, seed, wall_s))
+    write_text_atomic(index, _index_markdown(out, result, seed, wall_s))
     return index
 
 
-def _index_markdown(
-    out: Path, result: dict[str, Any], env_id: str, seed: int, wall_s: float
-) -> str:
+def _index_markdown(out: Path, result: dict[str, Any], seed: int, wall_s: float) -> str:
     records = result["records"]
     episodes = sorted({r["episode"] for r in records})
     plans = {r["episode"]: (r["floorplan"], r["area_m2"]) for r in records}
     lines = [
         "# sfw_gym demo: WiFi-only exploration",
         "",
-        f"`{env_id}` (default radio, two routers, 3,000-step budget): frontier exploration, "
+        f"`{DEMO_ENV}` (default radio, two routers, 3,000-step budget): frontier exploration, "
         "frontier with cross-connecting passes, and the pretrained PPO waypoint policy "
         "(`agents/ppo/SfW-Explore-v0_1`) on the same procedural floorplans, start poses and "
         f"seeds ({seed}–{seed + len(episodes) - 1}; never used in training). "
