@@ -258,3 +258,14 @@ def disk_cells(shape: tuple[int, int], cell: tuple[int, int], radius_cells: floa
 def mark_disk(mask: np.ndarray, cell: tuple[int, int], radius_cells: float) -> None:
     """Set the cells of ``mask`` within ``radius_cells`` of ``cell`` (in place, clipped)."""
     mask[disk_cells(mask.shape, cell, radius_cells)] = True
+
+
+def mark_contact(
+    mask: np.ndarray, grid: GridSpec, pose: tuple[float, float, float], radius_m: float
+) -> None:
+    """Mark where a bumper fired, just ahead of the robot, as an obstacle (a 1-cell disk; the
+    mapper marks one cell, walls are longer)."""
+    x, y, theta = pose
+    reach = radius_m + 0.5 * grid.resolution_m
+    contact = np.array([x + reach * np.cos(theta), y + reach * np.sin(theta)])
+    mark_disk(mask, tuple(grid.world_to_cell(contact)), 1.0)

@@ -55,6 +55,7 @@ from sfw_gym.navigation import (
     disk_cells,
     disk_offsets,
     free_start,
+    mark_contact,
     mark_disk,
     simplify_path,
     traversal_costs,
@@ -387,11 +388,8 @@ class FrontierAgent(Agent):
         self.goal = None
 
     def _mark_bump(self, view: RobotView) -> None:
-        """Remember a wall where the bumper fired (the mapper marks one cell; walls are longer)."""
-        x, y, th = view.odometry_pose
-        reach = view.radius_m + 0.5 * view.grid.resolution_m
-        contact = np.array([x + reach * np.cos(th), y + reach * np.sin(th)])
-        mark_disk(self.bumps, tuple(view.grid.world_to_cell(contact)), 1.0)
+        """Remember a wall where the bumper fired."""
+        mark_contact(self.bumps, view.grid, view.odometry_pose, view.radius_m)
         self.n_bumps += 1
 
     @property
@@ -463,9 +461,7 @@ class FrontierAgent(Agent):
         """The cheapest frontier cell or hidden room's deepest cell (not a failed goal; only
         hidden rooms with ``rooms_only``) on a map whose walls merely cost."""
         failed = self.blacklisted_until > self.steps
-        mask = frontier_mask(view.belief_u8, failed)
-        if rooms_only:
-            mask[:] = False
+        mask = np.zeros_like(failed) if rooms_only else frontier_mask(view.belief_u8, failed)
         min_depth = max(self.min_hidden_room_depth_m / view.grid.resolution_m, 1.0)
         depth = np.where(failed, 0.0, hidden_rooms(view.belief_u8, min_depth))
         if depth.any():

@@ -37,12 +37,13 @@ def _load_model(path: str, device: str) -> Any:
 
 
 def waypoint_settings(config: dict[str, Any]) -> dict[str, int] | None:
-    """The WaypointWrapper's kwargs from a training ``config.yml``, or None without one."""
+    """The WaypointWrapper's kwargs from a training ``config.yml`` (``{}``: its defaults), or
+    None if the policy was trained without it."""
     from sfw_gym.training import wrapper_specs
 
     for name, kwargs in wrapper_specs(config.get("hyperparameters", {}).get("env_wrapper")):
         if name == WAYPOINT_WRAPPER:
-            return {"grid_cells": 8, "max_steps_per_waypoint": 60, **kwargs}
+            return dict(kwargs)
     return None
 
 
@@ -104,9 +105,7 @@ class PPOAgent(Agent):
 
     def _on_reset(self, view: RobotView) -> None:
         if self.waypoints is not None:
-            self.driver = WaypointDriver(
-                self.waypoints["grid_cells"], self.waypoints["max_steps_per_waypoint"]
-            )
+            self.driver = WaypointDriver(**self.waypoints)
         self.goals: list[tuple[float, float]] = []
         self._obs_checked = False
 

@@ -157,7 +157,6 @@ class SfWExploreEnv(gym.Env):
         self.reward_scale = float(reward_scale)
         self.max_steps = max_steps
         self.steps_per_m2 = None if steps_per_m2 is None else float(steps_per_m2)
-        self.episode_max_steps = max_steps
         self.render_mode = render_mode
         self._folder_plans = _folder_plans(floorplan)
 

@@ -20,7 +20,7 @@ from sfw_gym.navigation import (
     cells_to_world,
     cost_field,
     free_start,
-    mark_disk,
+    mark_contact,
     to_discrete,
     traversal_costs,
 )
@@ -29,7 +29,8 @@ from sfw_gym.navigation import (
 class WaypointDriver:
     """Drives to one waypoint at a time: plans on the belief map, follows the path (pure pursuit).
 
-    A waypoint ends when its goal is reached, after ``max_steps`` env steps, or at a bump: the
+    A waypoint ends when its goal is reached, after ``max_steps_per_waypoint`` env steps, or at
+    a bump: the
     driver remembers the contact region ahead of the robot as an obstacle for its later plans
     (the mapper marks one cell; walls are longer) and, with continuous actions, reverses one
     step first, so the next waypoint starts clear of the wall. A goal no path reaches costs one
@@ -37,11 +38,12 @@ class WaypointDriver:
     :class:`sfw_gym.agents.PPOAgent` (evaluation), so both drive alike.
     """
 
-    def __init__(self, grid_cells: int = 8, max_steps: int = 60) -> None:
-        for name, value in (("grid_cells", grid_cells), ("max_steps_per_waypoint", max_steps)):
+    def __init__(self, grid_cells: int = 8, max_steps_per_waypoint: int = 60) -> None:
+        for name, value in (("grid_cells", grid_cells),
+                            ("max_steps_per_waypoint", max_steps_per_waypoint)):  # fmt: skip
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise ConfigError(f"{name} must be a positive integer, got {value!r}")
-        self.grid_cells, self.max_steps = grid_cells, max_steps
+        self.grid_cells, self.max_steps = grid_cells, max_steps_per_waypoint
         self.follower = PurePursuit()
         self.bumps = np.zeros((0, 0), bool)
         self.path = np.zeros((0, 2))
@@ -81,7 +83,7 @@ class WaypointDriver:
             self.active = False
             return None
         if self.steps > 0 and bumped:
-            self._mark_bump(pose)
+            mark_contact(self.bumps, self._grid, pose, self._radius_m)
             self.follower.set_path(np.zeros((0, 2)))
             if not self._reverse:
                 self.active = False
@@ -100,12 +102,6 @@ class WaypointDriver:
     def reached(self) -> bool:
         """Whether the current (or last) waypoint's path was driven to its end."""
         return len(self.path) > 0 and not self.follower.has_path and not self._backing_off
-
-    def _mark_bump(self, pose: tuple[float, float, float]) -> None:
-        x, y, theta = pose
-        reach = self._radius_m + 0.5 * self._grid.resolution_m
-        contact = np.array([x + reach * np.cos(theta), y + reach * np.sin(theta)])
-        mark_disk(self.bumps, tuple(self._grid.world_to_cell(contact)), 1.0)
 
 
 class WaypointWrapper(gym.Wrapper):
@@ -135,7 +131,6 @@ class WaypointWrapper(gym.Wrapper):
         if not hasattr(env.unwrapped, "robot_view"):
             raise ConfigError("WaypointWrapper needs an SfW-Explore env (with robot_view())")
         self.driver = WaypointDriver(grid_cells, max_steps_per_waypoint)
-        self.grid_cells = grid_cells
         self.action_space = spaces.Discrete(grid_cells * grid_cells)
         blocks = spaces.Box(0.0, 2.0, (grid_cells * grid_cells, len(BLOCK_FEATURES)), np.float32)
         self.observation_space = spaces.Dict({**env.observation_space.spaces, "blocks": blocks})
@@ -148,7 +143,8 @@ class WaypointWrapper(gym.Wrapper):
 
     def goal_xy(self, action: int) -> np.ndarray:
         """World (x, y) of the centre of coarse cell ``action``."""
-        return waypoint_goal_xy(self.env.unwrapped.robot_view()["grid"], self.grid_cells, action)
+        grid = self.env.unwrapped.robot_view()["grid"]
+        return waypoint_goal_xy(grid, self.driver.grid_cells, action)
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         """Plan to waypoint ``action`` and drive there (see the class doc)."""
@@ -180,12 +176,13 @@ class WaypointWrapper(gym.Wrapper):
     def _with_blocks(self, obs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         view = self.env.unwrapped.robot_view()
         blocks = block_features(view["belief_u8"], view["grid"], view["odometry_pose"],
-                                self.grid_cells)  # fmt: skip
+                                self.driver.grid_cells)  # fmt: skip
         return {**obs, "blocks": blocks}
 
 
-def waypoint_goal_xy(grid: GridSpec, grid_cells: int, action: int) -> np.ndarray:
-    """World (x, y) of the centre of coarse cell ``action`` (row ``action // grid_cells``).
+def waypoint_goal_xy(grid: GridSpec, grid_cells: int, action: int | np.ndarray) -> np.ndarray:
+    """World (x, y) of the centre of coarse cell ``action`` (row ``action // grid_cells``);
+    ``(..., 2)`` for an array of actions.
 
     The coarse cells tile the square that the observation's ``map`` image shows (the grid
     fitted with its aspect kept and centred), so action ``a`` names the same block of pixels
@@ -194,9 +191,9 @@ def waypoint_goal_xy(grid: GridSpec, grid_cells: int, action: int) -> np.ndarray
     x0, y0, x1, y1 = grid.bounds
     side = max(x1 - x0, y1 - y0)
     left, bottom = (x0 + x1 - side) / 2, (y0 + y1 - side) / 2
-    row, col = divmod(int(action), grid_cells)
+    row, col = np.divmod(np.asarray(action, np.int64), grid_cells)
     step = side / grid_cells
-    return np.array([left + (col + 0.5) * step, bottom + (row + 0.5) * step])
+    return np.stack([left + (col + 0.5) * step, bottom + (row + 0.5) * step], axis=-1)
 
 
 def plan_path(
@@ -246,10 +243,10 @@ def block_features(
     edges_c = np.clip(np.round(left + np.arange(grid_cells + 1) * side / grid_cells), 0, cols)
     block_area = (side / grid_cells) ** 2
     out = np.zeros((grid_cells * grid_cells, len(BLOCK_FEATURES)), np.float32)
-    x, y = pose[0], pose[1]
     x0, y0, x1, y1 = grid.bounds
-    side_m = max(x1 - x0, y1 - y0)
-    robot_r, robot_c = (int(v) for v in grid.world_to_cell(np.array([x, y])))
+    centres = waypoint_goal_xy(grid, grid_cells, np.arange(grid_cells * grid_cells))
+    out[:, 4] = np.hypot(centres[:, 0] - pose[0], centres[:, 1] - pose[1]) / max(x1 - x0, y1 - y0)
+    robot_r, robot_c = (int(v) for v in grid.world_to_cell(np.array(pose[:2])))
     for b in range(grid_cells * grid_cells):
         i, j = divmod(b, grid_cells)
         r0, r1, c0, c1 = int(edges_r[i]), int(edges_r[i + 1]), int(edges_c[j]), int(edges_c[j + 1])
@@ -259,7 +256,5 @@ def block_features(
             out[b, 1] = free[r0:r1, c0:c1].mean()
             out[b, 2] = wall[r0:r1, c0:c1].mean()
         out[b, 3] = n / block_area
-        cx, cy = waypoint_goal_xy(grid, grid_cells, b)
-        out[b, 4] = np.hypot(cx - x, cy - y) / side_m
         out[b, 5] = float(r0 <= robot_r < r1 and c0 <= robot_c < c1)
     return out
