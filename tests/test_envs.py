@@ -84,6 +84,7 @@ class TestEveryEnv:
     def test_pickle_round_trip_continues_identically(self, env_id):
         env = gym.make(env_id)
         env.reset(seed=5)
+        env.action_space.seed(0)  # reproducible: see the known divergence below
         for _ in range(10):
             env.step(env.action_space.sample())
         clone = pickle.loads(pickle.dumps(env))
@@ -212,3 +213,21 @@ class TestBadInput:
         env = gym.make("SfW-ExploreSmall-v0").unwrapped
         with pytest.raises(gym.error.ResetNeeded):
             env.step(np.zeros(2))
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="known: a pickled robot's first wall contact can resolve ~4 mm apart from the "
+    "original's (pymunk rebuilds its collision state on unpickling); 1 in ~300 random prefixes",
+)
+def test_pickled_env_continues_identically_through_a_first_contact():
+    env = gym.make("SfW-ExploreDiscrete-v0")
+    env.reset(seed=5)
+    env.action_space.seed(219)
+    for _ in range(10):
+        env.step(env.action_space.sample())
+    clone = pickle.loads(pickle.dumps(env))
+    env.action_space.seed(9)
+    for action in [env.action_space.sample() for _ in range(20)]:
+        a, b = env.step(action), clone.step(action)
+        np.testing.assert_array_equal(a[4]["true_pose"], b[4]["true_pose"])
