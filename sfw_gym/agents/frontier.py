@@ -289,6 +289,7 @@ class FrontierAgent(Agent):
         self.n_blacklisted = 0
         self.n_goals = 0
         self.n_bumps = 0
+        self.candidates: list[tuple[tuple[int, int], float]] = []
 
     def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
         mark_disk(self.visited, view.cell, self._visit_radius_cells)
@@ -532,6 +533,7 @@ class FrontierAgent(Agent):
         return exclude
 
     def _choose_goal(self, view: RobotView, paths: CostField) -> Goal | None:
+        self.candidates = []
         res = view.grid.resolution_m
         min_cells = max(1, round(self.min_frontier_size_m / res))
         if not frontier_mask(view.belief_u8).any():
@@ -550,8 +552,10 @@ class FrontierAgent(Agent):
                 continue
             i = int(np.argmin(cost))
             u = self._utility(view, f, float(cost[i]))
+            cell = (int(f.cells[i, 0]), int(f.cells[i, 1]))
+            self.candidates.append((cell, u))
             if best is None or u > best[0]:
-                best = (u, f, (int(f.cells[i, 0]), int(f.cells[i, 1])))
+                best = (u, f, cell)
         if best is None:
             self._stop("all_blacklisted")
             return None

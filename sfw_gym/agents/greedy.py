@@ -93,6 +93,7 @@ class GreedyInfoGainAgent(FrontierAgent):
         return gain + unknown[fr, fc].sum(axis=1)
 
     def _choose_goal(self, view: RobotView, paths: CostField) -> Goal | None:
+        self.candidates = []
         mask = frontier_mask(view.belief_u8)
         if not mask.any():
             self._stop("no_frontiers")
@@ -110,6 +111,7 @@ class GreedyInfoGainAgent(FrontierAgent):
             cells = cells[np.linspace(0, len(cells) - 1, self.max_candidates).astype(int)]
         dist = approach[cells[:, 0], cells[:, 1]]
         score = self.expected_gain(view, cells) / (dist + self.distance_offset_m)
+        self.candidates = list(zip(map(tuple, cells.tolist()), score.tolist(), strict=True))
         i = int(np.argmax(score))
         target = (int(cells[i, 0]), int(cells[i, 1]))
         self._resume()

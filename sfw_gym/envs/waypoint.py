@@ -30,11 +30,12 @@ class WaypointDriver:
     """Drives to one waypoint at a time: plans on the belief map, follows the path (pure pursuit).
 
     A waypoint ends when its goal is reached, after ``max_steps_per_waypoint`` env steps, or at
-    a bump: the
-    driver remembers the contact region ahead of the robot as an obstacle for its later plans
-    (the mapper marks one cell; walls are longer) and, with continuous actions, reverses one
-    step first, so the next waypoint starts clear of the wall. A goal no path reaches costs one
-    step standing still. Shared by :class:`WaypointWrapper` (training) and
+    a bump while driving forward: the driver remembers the contact region ahead of the robot as
+    an obstacle for its later plans (the mapper marks one cell; walls are longer) and, with
+    continuous actions, reverses one step first, so the next waypoint starts clear of the wall.
+    With discrete actions, contact while turning in place (the robot still touching the wall it
+    bumped) does not end the waypoint: the robot turns away and drives on. A goal no path
+    reaches costs one step standing still. Shared by :class:`WaypointWrapper` (training) and
     :class:`sfw_gym.agents.PPOAgent` (evaluation), so both drive alike.
     """
 
@@ -71,6 +72,7 @@ class WaypointDriver:
         self.follower.set_path(self.path)
         self.steps = 0
         self.active, self._backing_off = True, False
+        self._drove_forward = False
 
     def command(self, pose: tuple[float, float, float], bumped: bool) -> tuple[float, float] | None:
         """(linear, angular) for the next step, or None when the waypoint is over.
@@ -82,7 +84,7 @@ class WaypointDriver:
         if self._backing_off or self.steps >= self.max_steps:
             self.active = False
             return None
-        if self.steps > 0 and bumped:
+        if self.steps > 0 and bumped and self._drove_forward:
             mark_contact(self.bumps, self._grid, pose, self._radius_m)
             self.follower.set_path(np.zeros((0, 2)))
             if not self._reverse:
@@ -96,6 +98,8 @@ class WaypointDriver:
             self.active = False
             return None
         self.steps += 1
+        # a continuous command always moves the robot; a discrete one only as "forward"
+        self._drove_forward = self._reverse or to_discrete(linear, angular) == 0
         return linear, angular
 
     @property

@@ -1,0 +1,127 @@
+"""Reward bookkeeping: what the learner is paid, step by step and summed over wrapper steps, and
+when an episode ends."""
+
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import sfw_gym  # noqa: F401  (registers the envs)
+from sfw_gym.agents import FrontierAgent
+from sfw_gym.envs.waypoint import WaypointWrapper
+
+SMALL = "SfW-ExploreSmall-v0"
+
+
+class RecordSteps(gym.Wrapper):
+    """Keeps every inner step's reward and end flags."""
+
+    def __init__(self, env: gym.Env) -> None:
+        super().__init__(env)
+        self.rewards: list[float] = []
+        self.ends: list[tuple[bool, bool]] = []
+
+    def step(self, action):
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        self.rewards.append(reward)
+        self.ends.append((terminated, truncated))
+        return obs, reward, terminated, truncated, info
+
+
+@pytest.mark.parametrize("env_id", ["SfW-Explore-v0", "SfW-ExploreDiscrete-v0"])
+def test_reward_is_the_entropy_decrease_in_bits_minus_the_collision_penalty(env_id):
+    env = gym.make(env_id, reward_scale=0.01, collision_penalty=0.1)
+    _, info = env.reset(seed=5)
+    env.action_space.seed(5)
+    entropy, collisions, bumps, gained = info["entropy_bits"], 0, 0, 0.0
+    for _ in range(400):
+        _, reward, terminated, truncated, info = env.step(env.action_space.sample())
+        bumped = info["collisions"] - collisions
+        gain = entropy - info["entropy_bits"]
+        assert bumped in (0, 1)
+        assert info["info_gain_bits"] == pytest.approx(gain, abs=1e-6)
+        assert reward == pytest.approx(0.01 * gain - 0.1 * bumped, abs=1e-8)
+        entropy, collisions = info["entropy_bits"], info["collisions"]
+        bumps += bumped
+        gained += gain
+        if terminated or truncated:
+            break
+    assert bumps > 0 and gained > 100  # both terms were exercised
+
+
+def test_reward_scale_and_penalty_scale_the_two_terms():
+    def rewards(**kwargs):
+        env = gym.make("SfW-Explore-v0", **kwargs)
+        env.reset(seed=5)
+        env.action_space.seed(5)
+        return np.array([env.step(env.action_space.sample())[1] for _ in range(400)])
+
+    base = rewards(reward_scale=0.01, collision_penalty=0.0)
+    np.testing.assert_allclose(rewards(reward_scale=0.03, collision_penalty=0.0), 3 * base)
+    penalised = rewards(reward_scale=0.01, collision_penalty=0.5)
+    assert np.all(np.isclose(penalised - base, 0.0) | np.isclose(penalised - base, -0.5))
+    assert np.isclose(penalised - base, -0.5).any()
+
+
+@pytest.mark.parametrize("env_id", ["SfW-Explore-v0", "SfW-ExploreDiscrete-v0"])
+def test_waypoint_reward_is_the_sum_of_the_env_steps_it_covers(env_id):
+    inner = RecordSteps(gym.make(env_id, max_steps=400))
+    env = WaypointWrapper(inner, grid_cells=4, max_steps_per_waypoint=40)
+    env.reset(seed=7)
+    env.action_space.seed(7)
+    total, n_multi = 0.0, 0
+    while True:
+        before = len(inner.rewards)
+        _, reward, terminated, truncated, info = env.step(env.action_space.sample())
+        covered = inner.rewards[before:]
+        assert info["waypoint_steps"] == len(covered)
+        assert reward == pytest.approx(sum(covered), abs=1e-9)
+        assert (terminated, truncated) == inner.ends[-1]
+        total += reward
+        n_multi += len(covered) > 1 and len({round(r, 9) for r in covered}) > 1
+        if terminated or truncated:
+            break
+    assert n_multi >= 3  # waypoints whose steps paid different rewards
+    assert total == pytest.approx(sum(inner.rewards), abs=1e-6)
+
+
+def test_truncated_exactly_at_the_step_budget_with_a_summary():
+    env = gym.make(SMALL, max_steps=50, coverage_target=1.0)
+    env.reset(seed=0)
+    env.action_space.seed(0)
+    for step in range(1, 51):
+        _, _, terminated, truncated, info = env.step(env.action_space.sample())
+        assert not terminated
+        assert truncated == (step == 50)
+        assert ("summary" in info) == (step == 50)
+    assert info["summary"]["steps"] == 50
+
+
+def test_terminated_at_the_first_step_that_reaches_the_coverage_target():
+    env = gym.make(SMALL, coverage_target=0.2, max_steps=2000)
+    obs, info = env.reset(seed=1)
+    agent = FrontierAgent()
+    agent.reset(env, seed=1)
+    coverage = [info["coverage"]]
+    while True:
+        obs, _, terminated, truncated, info = env.step(agent.act(obs))
+        coverage.append(info["coverage"])
+        if terminated or truncated:
+            break
+    assert terminated and not truncated
+    assert coverage[-1] >= 0.2 and max(coverage[:-1]) < 0.2
+    assert info["summary"]["coverage"] == coverage[-1]
+    assert info["steps_to_coverage_50"] == -1  # not reached before the end
+
+
+def test_full_env_budget_is_steps_per_square_metre_of_the_plan():
+    env = gym.make("SfW-ExploreFull-v0")
+    _, info = env.reset(seed=3)
+    area = env.unwrapped.scene.floorplan.area_m2
+    assert info["max_steps"] == min(30_000, math.ceil(60.0 * area))
+    small = gym.make("SfW-ExploreFull-v0", max_steps=100)
+    _, info = small.reset(seed=3)
+    assert info["max_steps"] == 100  # capped by max_steps
