@@ -78,10 +78,17 @@ def test_sampled_waypoints_are_reproducible_from_the_agent_seed(waypoint_model):
     assert goals(1) == goals(1) and len(goals(1)) >= 2
 
 
-def test_a_policy_on_raw_continuous_actions_drives_directly(tmp_path):
-    train_ppo(SMALL, 32, tmp_path, n_envs=1, env_kwargs={"max_steps": 40}, eval_every=10**9,
+@pytest.fixture(scope="module")
+def continuous_model(tmp_path_factory):
+    """A tiny policy on the env's own continuous actions."""
+    out = tmp_path_factory.mktemp("ppo_continuous")
+    train_ppo(SMALL, 32, out, n_envs=1, env_kwargs={"max_steps": 40}, eval_every=10**9,
               progress_bar=False)  # fmt: skip
-    agent = PPOAgent(model_dir=tmp_path)
+    return out
+
+
+def test_a_policy_on_raw_continuous_actions_drives_directly(continuous_model):
+    agent = PPOAgent(model_dir=continuous_model)
     assert agent.waypoints is None
     env = gym.make(SMALL, max_steps=40)
     obs, _ = env.reset(seed=0)
@@ -94,6 +101,59 @@ def test_a_policy_on_raw_continuous_actions_drives_directly(tmp_path):
     discrete.reset(seed=0)
     with pytest.raises(ConfigError, match="action types"):
         agent.reset(discrete)
+
+
+def run_ppo(agent: PPOAgent, env_id: str, steps: int, agent_seed: int) -> list:
+    """The agent's actions over ``steps`` steps of ``env_id`` (env seed 3)."""
+    env = gym.make(env_id)
+    obs, _ = env.reset(seed=3)
+    agent.reset(env, seed=agent_seed)
+    actions = []
+    for _ in range(steps):
+        actions.append(np.asarray(agent.act(obs)).tolist())
+        obs, *_ = env.step(actions[-1])
+    return actions
+
+
+def test_deterministic_shipped_policy_takes_the_most_likely_waypoint_whatever_the_agent_seed():
+    import torch
+
+    from sfw_gym.envs.waypoint import block_features, waypoint_goal_xy
+
+    agent = PPOAgent(deterministic=True)  # the shipped waypoint policy
+    env = gym.make("SfW-Explore-v0")
+    obs, _ = env.reset(seed=3)
+    agent.reset(env, seed=0)
+    agent.act(obs)
+    view = env.unwrapped.robot_view()
+    blocks = block_features(view["belief_u8"], view["grid"], view["odometry_pose"], 8)
+    policy = agent.model.policy
+    with torch.no_grad():
+        tensor, _ = policy.obs_to_tensor({**obs, "blocks": blocks})
+        probs = policy.get_distribution(tensor).distribution.probs[0].numpy()
+    assert probs.max() < 0.5  # far from one-hot: a sampled waypoint would differ from the mode
+    np.testing.assert_allclose(agent.goals[0], waypoint_goal_xy(view["grid"], 8, probs.argmax()))
+    assert run_ppo(agent, "SfW-Explore-v0", 150, 0) == run_ppo(agent, "SfW-Explore-v0", 150, 1)
+
+
+def test_sampling_shipped_policy_repeats_itself_for_one_agent_seed_only():
+    agent = PPOAgent()
+    first = run_ppo(agent, "SfW-Explore-v0", 150, 0)
+    assert run_ppo(agent, "SfW-Explore-v0", 150, 0) == first
+    assert run_ppo(agent, "SfW-Explore-v0", 150, 1) != first
+
+
+def test_deterministic_continuous_policy_acts_with_its_mean_action(continuous_model):
+    agent = PPOAgent(model_dir=continuous_model, deterministic=True)
+    env = gym.make(SMALL)
+    obs, _ = env.reset(seed=0)
+    agent.reset(env, seed=0)
+    for _ in range(10):
+        action = agent.act(obs)
+        expected, _ = agent.model.predict(obs, deterministic=True)
+        np.testing.assert_allclose(action, np.clip(expected, -1, 1), atol=1e-6)
+        obs, *_ = env.step(action)
+    assert run_ppo(agent, SMALL, 20, 0) == run_ppo(agent, SMALL, 20, 1)
 
 
 def test_an_env_with_other_observations_is_refused(waypoint_model):
