@@ -199,6 +199,21 @@ class TestBadInput:
         with pytest.raises(ConfigError, match="router"):
             env.reset(options={"routers": 5})
 
+    @pytest.mark.parametrize(
+        "options, match",
+        [
+            ({"routers": [[1.0, 1.0]] * 5}, "5 positions given"),
+            ({"routers": 0}, r"a count must be in \[1, 2\]"),
+            ({"start_pose": (1.0, float("nan"), 0.0)}, "three finite numbers"),
+            ({"start_pose": (1.0, 2.0)}, "three finite numbers"),
+            ({"start_pose": (-40.0, -40.0, 0.0)}, "not in the free space"),
+            ({"floorplan": 2.5}, "floorplan must be a Floorplan"),
+        ],
+    )
+    def test_bad_reset_options_name_the_option(self, env, options, match):
+        with pytest.raises(ConfigError, match=match):
+            env.reset(options=options)
+
     def test_bad_kwargs(self):
         with pytest.raises(ConfigError, match="action_type"):
             gym.make("SfW-Explore-v0", action_type="teleport")
@@ -231,3 +246,13 @@ def test_pickled_env_continues_identically_through_a_first_contact():
     for action in [env.action_space.sample() for _ in range(20)]:
         a, b = env.step(action), clone.step(action)
         np.testing.assert_array_equal(a[4]["true_pose"], b[4]["true_pose"])
+
+
+def test_env_classes_are_reachable_lazily_from_the_envs_package():
+    import sfw_gym.envs as envs
+    from sfw_gym.envs.explore import SfWExploreEnv
+    from sfw_gym.envs.waypoint import WaypointWrapper
+
+    assert envs.SfWExploreEnv is SfWExploreEnv and envs.WaypointWrapper is WaypointWrapper
+    with pytest.raises(AttributeError):
+        envs.NoSuchEnv  # noqa: B018
