@@ -3,27 +3,54 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from pathlib import Path
 
 import numpy as np
 
 from sfw_gym.errors import ConfigError, FloorplanError
 
 
+def checked(convert: Callable, ok: Callable, what: str) -> Callable:
+    """An argparse ``type=``: ``convert(text)``, which must satisfy ``ok``; anything else is
+    argparse's usage error, exit 2, its last line naming the option ("argument --steps: ...")."""
+
+    def parse(text: str):
+        try:
+            value = convert(text)
+            good = ok(value)
+        except ValueError:
+            good = False
+        if not good:
+            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}")
+        return value
+
+    return parse
+
+
+positive_int = checked(int, lambda v: v >= 1, "an integer >= 1")
+non_negative_int = checked(int, lambda v: v >= 0, "an integer >= 0")
+seed_int = checked(int, lambda v: 0 <= v < 2**32, "a seed in [0, 2**32)")
+positive_float = checked(float, lambda v: math.isfinite(v) and v > 0, "a finite number > 0")
+non_negative_float = checked(float, lambda v: math.isfinite(v) and v >= 0, "a finite number >= 0")
+folder = checked(str, lambda v: not Path(v).exists() or Path(v).is_dir(), "a folder, not a file")
+
+
 def parse_routers(text: str) -> np.ndarray | int:
-    """``"x1,y1;x2,y2"`` → (R, 2) array of positions; ``"3"`` → a router count."""
+    """``"x1,y1;x2,y2"`` → (R, 2) array of positions; ``"3"`` → a router count (≥ 1)."""
     text = text.strip()
-    if text.isdigit():
+    if text.isdigit() and int(text) >= 1:
         return int(text)
     try:
         pts = [[float(v) for v in pair.split(",")] for pair in text.split(";") if pair.strip()]
         arr = np.array(pts, dtype=np.float64)
     except ValueError:
         arr = np.empty((0,))
-    if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) == 0:
-        raise ConfigError(f"--routers: expected a count or 'x1,y1;x2,y2;…', got {text!r}")
+    if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) == 0 or not np.isfinite(arr).all():
+        raise ConfigError(f"--routers: expected a count >= 1 or 'x1,y1;x2,y2;…', got {text!r}")
     return arr
 
 
@@ -99,8 +126,12 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
+    import gymnasium as gym
+
     from sfw_gym.training import train_ppo
 
+    if ":" not in args.env:  # ("module:Env-v0" registers on import, in the workers)
+        gym.spec(args.env)  # an unknown id: an --env error, not a missing YAML block
     summary = train_ppo(
         args.env,
         args.timesteps,
@@ -173,27 +204,36 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     from sfw_gym.demo import DEMO_SEED
+    from sfw_gym.world.radio import BANDS, PRESETS
 
     demo = sub.add_parser(
         "demo", help="frontier, cross-pass and the pretrained PPO on fresh plans → sfw-report/"
     )
-    demo.add_argument("--out", default="sfw-report", help="report folder (default sfw-report)")
-    demo.add_argument("--episodes", type=int, default=3, help="floorplans (default 3)")
-    demo.add_argument("--seed", type=int, default=DEMO_SEED, help="seed of the first floorplan")
-    demo.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    demo.add_argument(
+        "--out", type=folder, default="sfw-report", help="report folder (default sfw-report)"
+    )
+    demo.add_argument("--episodes", type=positive_int, default=3, help="floorplans (default 3)")
+    demo.add_argument(
+        "--seed", type=seed_int, default=DEMO_SEED, help="seed of the first floorplan"
+    )
+    demo.add_argument(
+        "--workers", type=positive_int, default=2, help="worker processes (default 2)"
+    )
     demo.add_argument("--no-progress", action="store_true", help="no progress bar")
     demo.set_defaults(func=_cmd_demo)
 
     world = sub.add_parser("world", help="draw a floorplan, its routers, RSSI and true k-regions")
     source = world.add_mutually_exclusive_group()
-    source.add_argument("--seed", type=int, default=0, help="procedural floorplan seed (default 0)")
+    source.add_argument(
+        "--seed", type=seed_int, default=0, help="procedural floorplan seed (default 0)"
+    )
     source.add_argument("--floorplan", help="a HouseExpo or sfw_gym JSON floorplan file")
     world.add_argument("--routers", default="2", help="a count, or positions 'x1,y1;x2,y2'")
+    world.add_argument("--preset", choices=PRESETS, default="default", help="radio preset")
+    world.add_argument("--band", choices=list(BANDS), default="2.4", help="GHz (default 2.4)")
     world.add_argument(
-        "--preset", default="default", help="radio preset: default, thick, residential"
+        "--resolution", type=positive_float, default=0.1, help="heat-map cell size, metres"
     )
-    world.add_argument("--band", default="2.4", help="2.4 or 5 (GHz)")
-    world.add_argument("--resolution", type=float, default=0.1, help="heat-map cell size, metres")
     world.add_argument("--out", default="world.png", help="output PNG (default world.png)")
     world.set_defaults(func=_cmd_world)
 
@@ -203,13 +243,22 @@ def build_parser() -> argparse.ArgumentParser:
         "--routers", required=True, help="router positions 'x1,y1;x2,y2' in the CSV's units"
     )
     mp.add_argument(
-        "--scale", type=float, default=1.0, help="metres per CSV unit (default 1; pixels e.g. 0.05)"
+        "--scale",
+        type=positive_float,
+        default=1.0,
+        help="metres per CSV unit (default 1; pixels e.g. 0.05)",
     )
     mp.add_argument(
-        "--resolution", type=float, default=0.05, help="map cell size, metres (default 0.05)"
+        "--resolution",
+        type=positive_float,
+        default=0.05,
+        help="map cell size, metres (default 0.05)",
     )
     mp.add_argument(
-        "--margin", type=float, default=1.0, help="border around the data, metres (default 1)"
+        "--margin",
+        type=non_negative_float,
+        default=1.0,
+        help="border around the data, metres (default 1)",
     )
     mp.add_argument(
         "--band", choices=["2.4", "5"], default=None,
@@ -226,11 +275,11 @@ def build_parser() -> argparse.ArgumentParser:
     mp.set_defaults(func=_cmd_map)
     bench = sub.add_parser("bench", help="env steps/s and reset ms beside CartPole-v1")
     bench.add_argument("--env", default="SfW-Explore-v0", help="env id (default SfW-Explore-v0)")
-    bench.add_argument("--steps", type=int, default=5000, help="random steps to time")
-    bench.add_argument("--resets", type=int, default=50, help="resets to time")
+    bench.add_argument("--steps", type=positive_int, default=5000, help="random steps to time")
+    bench.add_argument("--resets", type=positive_int, default=50, help="resets to time")
     bench.add_argument(
         "--memory-steps",
-        type=int,
+        type=non_negative_int,
         default=0,
         help="also report RSS before/after this many steps (e.g. 100000)",
     )
@@ -241,14 +290,18 @@ def build_parser() -> argparse.ArgumentParser:
     train = sub.add_parser("train", help="train an agent (PPO, stable-baselines3)")
     train.add_argument("algo", choices=["ppo"], help="the algorithm (ppo)")
     train.add_argument("--env", default="SfW-Explore-v0", help="env id (default SfW-Explore-v0)")
-    train.add_argument("--timesteps", type=int, default=1_000_000, help="total env steps")
-    train.add_argument("--n-envs", type=int, default=None, help="parallel envs (default: YAML)")
-    train.add_argument("--seed", type=int, default=0)
-    train.add_argument("--out", default=None, help="output folder (default runs/ppo/ENV)")
+    train.add_argument("--timesteps", type=positive_int, default=1_000_000, help="total env steps")
+    train.add_argument(
+        "--n-envs", type=positive_int, default=None, help="parallel envs (default: YAML)"
+    )
+    train.add_argument("--seed", type=seed_int, default=0)
+    train.add_argument(
+        "--out", type=folder, default=None, help="output folder (default runs/ppo/ENV)"
+    )
     train.add_argument("--hyperparams", default=str(DEFAULT_HYPERPARAMS), help="rl-zoo YAML")
-    train.add_argument("--checkpoint-every", type=int, default=50_000, help="env steps")
-    train.add_argument("--eval-every", type=int, default=25_000, help="env steps")
-    train.add_argument("--eval-episodes", type=int, default=5, help="held-out episodes")
+    train.add_argument("--checkpoint-every", type=positive_int, default=50_000, help="env steps")
+    train.add_argument("--eval-every", type=positive_int, default=25_000, help="env steps")
+    train.add_argument("--eval-episodes", type=positive_int, default=5, help="held-out episodes")
     train.add_argument("--resume", action="store_true", help="continue from the last checkpoint")
     train.add_argument("--no-progress", action="store_true", help="no progress bar")
     train.set_defaults(func=_cmd_train)
@@ -260,8 +313,10 @@ def build_parser() -> argparse.ArgumentParser:
         help="comma-separated: frontier, cross-pass, greedy, random, ppo (default: "
         "frontier,cross-pass,random)",
     )  # fmt: skip
-    ev.add_argument("--episodes", type=int, default=10, help="episodes per agent (default 10)")
-    ev.add_argument("--seed", type=int, default=0, help="episode i uses reset(seed=SEED + i)")
+    ev.add_argument(
+        "--episodes", type=positive_int, default=10, help="episodes per agent (default 10)"
+    )
+    ev.add_argument("--seed", type=seed_int, default=0, help="episode i uses reset(seed=SEED + i)")
     ev.add_argument(
         "--floorplans", default=None, help="folder of plan files (cycled) or one file; "
         "default: the env's procedural plans",
@@ -271,10 +326,14 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument(
         "--agent-params", default=None, help='per-agent parameters as JSON: {"frontier": {...}}'
     )
-    ev.add_argument("--out", default="evaluation", help="output folder (resumes from it)")
-    ev.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    ev.add_argument(
+        "--out", type=folder, default="evaluation", help="output folder (resumes from it)"
+    )
+    ev.add_argument("--workers", type=positive_int, default=2, help="worker processes (default 2)")
     ev.add_argument("--gif", action="store_true", help="also write GIFs of the first episodes")
-    ev.add_argument("--gif-episodes", type=int, default=1, help="episodes per agent with a GIF")
+    ev.add_argument(
+        "--gif-episodes", type=non_negative_int, default=1, help="episodes per agent with a GIF"
+    )
     ev.add_argument("--no-progress", action="store_true", help="no progress bar")
     ev.set_defaults(func=_cmd_evaluate)
     return parser
@@ -282,12 +341,18 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``sfw-gym``; bad input ends with a one-line error and exit status 2."""
+    import gymnasium as gym
+
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
     except (ConfigError, FloorplanError) as exc:
-        print(f"sfw-gym {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        message = str(exc)
+    except gym.error.Error as exc:  # e.g. NameNotFound: an unknown env id
+        message = f"--env {getattr(args, 'env', '')}: {exc}"
+    # One line, even when the message quotes a multi-line parser error (YAML, JSON).
+    print(f"sfw-gym {args.command}: error: {' '.join(message.split())}", file=sys.stderr)
+    return 2
 
 
 if __name__ == "__main__":

@@ -518,7 +518,9 @@ def evaluate(
     Returns:
         ``{"rows": summary rows, "records": episode records, "files": written paths}``.
     """
-    from sfw_gym.agents import AGENTS
+    import gymnasium as gym
+
+    from sfw_gym.agents import AGENTS, make_agent
 
     agents = list(dict.fromkeys(agents))
     if not agents:
@@ -530,9 +532,17 @@ def evaluate(
         raise ConfigError(f"--episodes must be an int >= 1, got {episodes!r}")
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ConfigError(f"--workers must be an int >= 1, got {workers!r}")
-    for name, params in (agent_params or {}).items():
-        if name in AGENTS:
-            AGENTS[name](**params)  # fail early on bad parameters
+    for name, params in (agent_params or {}).items():  # fail early on bad parameters
+        if not isinstance(params, dict):
+            raise ConfigError(f"--agent-params: {name!r}: expected a JSON object, got {params!r}")
+        try:
+            make_agent(name, **params)
+        except ConfigError as exc:
+            raise ConfigError(f"--agent-params: {exc}") from None
+    try:  # and on bad env kwargs (an unknown env id raises gymnasium's NameNotFound)
+        gym.make(env_id, **(env_kwargs or {})).close()
+    except (TypeError, ConfigError) as exc:
+        raise ConfigError(f"--env-kwargs: {exc}") from None
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     specs = episode_specs(

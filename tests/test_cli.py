@@ -1,0 +1,219 @@
+"""Every ``sfw-gym`` command through its entry point, in one table: good input exits 0 and writes
+its outputs; bad input exits 2 with one error line that names the offending argument (argparse's
+usage lines may come first), never a traceback.
+
+``demo``'s good run (three agents on full-size plans) is too slow for this table; it is covered by
+``tests/test_demo.py``. ``train``'s good case here is a single 32-step PPO rollout.
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from sfw_gym.cli import main
+
+SMALL = "SfW-ExploreSmall-v0"
+TINY_PPO = f"""{SMALL}:
+  policy: 'MultiInputPolicy'
+  n_envs: 1
+  n_steps: 32
+  batch_size: 32
+  n_epochs: 1
+  policy_kwargs: "dict(net_arch=dict(pi=[8], vf=[8]))"
+"""
+#: Input files, written to tmp_path by the ``inputs`` fixture; "{tmp}" in argv is tmp_path.
+INPUTS = {
+    "log.csv": "x,y,r1\n0,0,-40\n1,0,-45\n1,1,-50\n0,1,-47\n",
+    "badlog.csv": "x,y,r1\n0,0,-40\n1,0,-4O\n",  # a letter O
+    "notjson.json": "{not json",
+    "badplan.json": '{"verts": [[0, 0], [1, 0]]}',  # JSON, but no polygon: a FloorplanError
+    "badplans/plan.json": '{"verts": [[0, 0], [1, 0]]}',
+    "ppo.yml": TINY_PPO,
+    "bad.yml": "a: [\n",  # PyYAML's message spans several lines
+    "afile": "",
+}
+
+WORLD = ["world", "--out", "{tmp}/w.png", "--resolution", "0.5"]
+MAP = ["map", "{tmp}/log.csv", "--routers", "0.5,0.5", "--out", "{tmp}/m.png"]
+BENCH = ["bench", "--env", SMALL, "--steps", "20", "--resets", "1"]
+EVALUATE = ["evaluate", "--agents", "random", "--episodes", "1", "--env", SMALL, "--workers", "1"]
+EVALUATE += ["--no-progress", "--out", "{tmp}/ev", "--env-kwargs", '{"max_steps": 30}']
+TRAIN = ["train", "ppo", "--env", SMALL, "--timesteps", "32", "--n-envs", "1", "--no-progress"]
+TRAIN += ["--hyperparams", "{tmp}/ppo.yml", "--out", "{tmp}/run", "--eval-every", "1000000"]
+DEMO = ["demo", "--out", "{tmp}/demo", "--episodes", "1", "--workers", "1", "--no-progress"]
+
+
+def ok(argv: list[str], *outputs: str, id: str):
+    return pytest.param(argv, 0, None, outputs, id=id)
+
+
+def bad(argv: list[str], error: str, id: str):
+    """A later option overrides the same option earlier in argv (argparse keeps the last)."""
+    return pytest.param(argv, 2, error, (), id=id)
+
+
+CASES = [
+    # -- world
+    ok(["world", "--seed", "3", "--out", "{tmp}/out/w.png", "--resolution", "0.3"], "out/w.png",
+       id="world"),
+    bad([*WORLD, "--seed", "-1"], r"argument --seed: .*'-1'", id="world-seed-negative"),
+    bad([*WORLD, "--resolution", "0"], r"argument --resolution: .*'0'", id="world-resolution-0"),
+    bad([*WORLD, "--resolution", "nan"], r"argument --resolution", id="world-resolution-nan"),
+    bad([*WORLD, "--routers", "0"], r"--routers: .*'0'", id="world-routers-0"),
+    bad([*WORLD, "--routers", "1,2;3"], r"--routers: .*'1,2;3'", id="world-routers-malformed"),
+    bad([*WORLD, "--preset", "nope"], r"argument --preset: invalid choice: 'nope'",
+        id="world-preset-unknown"),
+    bad([*WORLD, "--band", "7"], r"argument --band: invalid choice: '7'", id="world-band-unknown"),
+    bad([*WORLD, "--floorplan", "{tmp}/missing.json"], r"missing\.json: cannot read",
+        id="world-floorplan-missing"),
+    bad([*WORLD, "--floorplan", "{tmp}/notjson.json"], r"notjson\.json: not valid JSON",
+        id="world-floorplan-not-json"),
+    bad([*WORLD, "--floorplan", "{tmp}/badplan.json"], r"badplan\.json: .*at least 3",
+        id="world-floorplan-malformed"),
+    bad([*WORLD, "--seed", "1", "--floorplan", "{tmp}/badplan.json"],
+        r"argument --floorplan: not allowed with argument --seed", id="world-seed-and-floorplan"),
+    # -- map
+    ok(MAP, "m.png", "m.npy", "m.json", id="map"),
+    bad(["map", "{tmp}/missing.csv", "--routers", "1,1"], r"missing\.csv: no such file",
+        id="map-log-missing"),
+    bad(["map", "{tmp}/badlog.csv", "--routers", "1,1"], r"badlog\.csv:3: column 'r1'",
+        id="map-log-malformed"),
+    bad(["map", "{tmp}", "--routers", "1,1"], r"is a directory", id="map-log-directory"),
+    bad([*MAP, "--scale", "-1"], r"argument --scale: .*'-1'", id="map-scale-negative"),
+    bad([*MAP, "--scale", "0"], r"argument --scale: .*'0'", id="map-scale-0"),
+    bad([*MAP, "--resolution", "0"], r"argument --resolution: .*'0'", id="map-resolution-0"),
+    bad([*MAP, "--margin", "-1"], r"argument --margin: .*'-1'", id="map-margin-negative"),
+    bad([*MAP, "--routers", "2"], r"--routers: .*not a count", id="map-routers-count"),
+    bad([*MAP, "--routers", "1,nan"], r"--routers: .*'1,nan'", id="map-routers-nan"),
+    bad([*MAP, "--routers", "1,1;2,2"], r"2 router positions given", id="map-routers-too-many"),
+    bad([*MAP, "--band", "7"], r"argument --band: invalid choice", id="map-band-unknown"),
+    bad([*MAP, "--policy", "nope"], r"argument --policy: invalid choice", id="map-policy-unknown"),
+    bad([*MAP, "--out", "{tmp}/m.jpg"], r"--out must be a \.png", id="map-out-not-png"),
+    # -- bench
+    ok(BENCH, id="bench"),
+    bad([*BENCH, "--steps", "0"], r"argument --steps: .*'0'", id="bench-steps-0"),
+    bad([*BENCH, "--steps", "-5"], r"argument --steps: .*'-5'", id="bench-steps-negative"),
+    bad([*BENCH, "--steps", "ten"], r"argument --steps: .*'ten'", id="bench-steps-not-int"),
+    bad([*BENCH, "--resets", "0"], r"argument --resets: .*'0'", id="bench-resets-0"),
+    bad([*BENCH, "--memory-steps", "-1"], r"argument --memory-steps: .*'-1'",
+        id="bench-memory-steps-negative"),
+    bad([*BENCH, "--env", "Nope-v0"], r"--env Nope-v0: .*doesn't exist", id="bench-env-unknown"),
+    bad([*BENCH, "--agent-params", '{"random": 3}'], r"unrecognized arguments: --agent-params",
+        id="bench-agent-params-unknown-option"),
+    # -- evaluate
+    ok(EVALUATE, "ev/results.md", "ev/results.csv", "ev/coverage_vs_steps.png", id="evaluate"),
+    bad([*EVALUATE, "--episodes", "0"], r"argument --episodes: .*'0'", id="evaluate-episodes-0"),
+    bad([*EVALUATE, "--workers", "0"], r"argument --workers: .*'0'", id="evaluate-workers-0"),
+    bad([*EVALUATE, "--seed", "-1"], r"argument --seed: .*'-1'", id="evaluate-seed-negative"),
+    bad([*EVALUATE, "--gif-episodes", "-1"], r"argument --gif-episodes: .*'-1'",
+        id="evaluate-gif-episodes-negative"),
+    bad([*EVALUATE, "--agents", "random,nope"], r"--agents: unknown agent\(s\) \['nope'\]",
+        id="evaluate-agent-unknown"),
+    bad([*EVALUATE, "--agents", ","], r"--agents: give at least one", id="evaluate-agents-none"),
+    bad([*EVALUATE, "--env", "Nope-v0"], r"--env Nope-v0: .*doesn't exist",
+        id="evaluate-env-unknown"),
+    bad([*EVALUATE, "--env-kwargs", "{bad"], r"--env-kwargs: not valid JSON",
+        id="evaluate-env-kwargs-bad-json"),
+    bad([*EVALUATE, "--env-kwargs", "[1]"], r"--env-kwargs: expected a JSON object",
+        id="evaluate-env-kwargs-not-object"),
+    bad([*EVALUATE, "--env-kwargs", '{"nope": 1}'], r"--env-kwargs: .*'nope'",
+        id="evaluate-env-kwargs-unknown-key"),
+    bad([*EVALUATE, "--env-kwargs", '{"max_steps": -1}'], r"--env-kwargs: max_steps",
+        id="evaluate-env-kwargs-bad-value"),
+    bad([*EVALUATE, "--agent-params", "{bad"], r"--agent-params: not valid JSON",
+        id="evaluate-agent-params-bad-json"),
+    bad([*EVALUATE, "--agent-params", '{"random": 3}'], r"--agent-params: 'random': expected",
+        id="evaluate-agent-params-not-object"),
+    bad([*EVALUATE, "--agent-params", '{"random": {"nope": 1}}'], r"--agent-params: .*'nope'",
+        id="evaluate-agent-params-unknown-parameter"),
+    bad([*EVALUATE, "--agent-params", '{"nope": {}}'], r"--agent-params: unknown agent 'nope'",
+        id="evaluate-agent-params-unknown-agent"),
+    bad([*EVALUATE, "--floorplans", "{tmp}/missing"], r"--floorplans .*missing: no \.json",
+        id="evaluate-floorplans-missing"),
+    bad([*EVALUATE, "--floorplans", "{tmp}/badplans"], r"plan\.json: .*at least 3",
+        id="evaluate-floorplans-malformed"),
+    bad([*EVALUATE, "--out", "{tmp}/afile"], r"argument --out: .*afile",
+        id="evaluate-out-is-a-file"),
+    # -- train
+    ok(TRAIN, "run/model.zip", "run/config.yml", id="train"),
+    bad([*TRAIN, "--timesteps", "0"], r"argument --timesteps: .*'0'", id="train-timesteps-0"),
+    bad([*TRAIN, "--n-envs", "0"], r"argument --n-envs: .*'0'", id="train-n-envs-0"),
+    bad([*TRAIN, "--n-envs", "-1"], r"argument --n-envs: .*'-1'", id="train-n-envs-negative"),
+    bad([*TRAIN, "--seed", "-1"], r"argument --seed: .*'-1'", id="train-seed-negative"),
+    bad([*TRAIN, "--checkpoint-every", "0"], r"argument --checkpoint-every: .*'0'",
+        id="train-checkpoint-every-0"),
+    bad([*TRAIN, "--eval-every", "0"], r"argument --eval-every: .*'0'", id="train-eval-every-0"),
+    bad([*TRAIN, "--eval-episodes", "0"], r"argument --eval-episodes: .*'0'",
+        id="train-eval-episodes-0"),
+    bad([*TRAIN, "--env", "Nope-v0"], r"--env Nope-v0: .*doesn't exist", id="train-env-unknown"),
+    bad([*TRAIN, "--env", "CartPole-v1"], r"no hyperparameters for 'CartPole-v1'",
+        id="train-env-without-hyperparams"),
+    bad([*TRAIN, "--hyperparams", "{tmp}/missing.yml"], r"missing\.yml: cannot read",
+        id="train-hyperparams-missing"),
+    bad([*TRAIN, "--hyperparams", "{tmp}/bad.yml"], r"bad\.yml: cannot read",
+        id="train-hyperparams-malformed"),
+    bad([*TRAIN, "--out", "{tmp}/afile"], r"argument --out: .*afile", id="train-out-is-a-file"),
+    bad(["train", "a2c"], r"argument algo: invalid choice: 'a2c'", id="train-algo-unknown"),
+    # -- demo (its good run: tests/test_demo.py)
+    bad([*DEMO, "--episodes", "0"], r"argument --episodes: .*'0'", id="demo-episodes-0"),
+    bad([*DEMO, "--workers", "0"], r"argument --workers: .*'0'", id="demo-workers-0"),
+    bad([*DEMO, "--seed", "-1"], r"argument --seed: .*'-1'", id="demo-seed-negative"),
+    bad([*DEMO, "--out", "{tmp}/afile"], r"argument --out: .*afile", id="demo-out-is-a-file"),
+    # -- no command
+    bad(["nope"], r"argument command: invalid choice: 'nope'", id="command-unknown"),
+]  # fmt: skip
+
+
+@pytest.fixture
+def inputs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """tmp_path with the input files, and the working directory (nothing lands in the repo)."""
+    for name, text in INPUTS.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(text, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+def assert_one_error_line(stderr: str, command: str, error: str) -> None:
+    """No traceback; argparse's usage lines at most, then one error line matching ``error``."""
+    assert "Traceback" not in stderr, stderr
+    *usage, last = stderr.strip().splitlines()
+    assert all(line.startswith(("usage:", " ")) for line in usage), stderr
+    assert last.startswith((f"sfw-gym {command}: error: ", "sfw-gym: error: ")), stderr
+    assert re.search(error, last), f"{error!r} not in {last!r}"
+
+
+@pytest.mark.parametrize(("argv", "code", "error", "outputs"), CASES)
+def test_cli(argv, code, error, outputs, inputs, capsys):
+    argv = [arg.replace("{tmp}", str(inputs)) for arg in argv]
+    try:
+        got = main(argv)
+    except SystemExit as exc:  # argparse's own errors
+        got = exc.code
+    captured = capsys.readouterr()
+    assert got == code, captured.err
+    if code == 0:
+        assert captured.out and "Traceback" not in captured.err
+        for name in outputs:
+            assert (inputs / name).stat().st_size > 0, name
+    else:
+        assert_one_error_line(captured.err, argv[0], error)
+
+
+def test_console_script_reports_bad_input_in_one_line(tmp_path):
+    """The installed ``sfw-gym`` executable (catches a broken entry point)."""
+    exe = shutil.which("sfw-gym", path=str(Path(sys.executable).parent)) or shutil.which("sfw-gym")
+    if exe is None:
+        pytest.fail("no sfw-gym executable: install the package (pip install -e .)")
+    proc = subprocess.run([exe, "map", "missing.csv", "--routers", "1,1"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert proc.returncode == 2, proc.stderr
+    assert re.fullmatch(r"sfw-gym map: error: \S*missing\.csv: no such file\n", proc.stderr), (
+        proc.stderr
+    )
