@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import platform
 import resource
 import statistics
 import time
@@ -77,6 +78,7 @@ def memory_run(env_id: str, steps: int, seed: int = 0) -> tuple[float, float, in
 
 def run_bench(env_id: str, steps: int, resets: int, memory_steps: int = 0) -> list[str]:
     """Measure and return printable lines (also the BENCHMARKS.md rows)."""
+    load_before = os.getloadavg()[0]
     ours = time_env(env_id, steps, resets)
     ref = time_env("CartPole-v1", steps, resets)
     rows = [ours, ref]
@@ -91,6 +93,10 @@ def run_bench(env_id: str, steps: int, resets: int, memory_steps: int = 0) -> li
         ratio = ours.steps_per_s / r.steps_per_s
         lines.append(f"{r.env_id:<28} {r.steps_per_s:>10,.0f} {r.reset_ms:>9.2f} {ratio:>13.3f}x")
     lines.append(f"(ratio = {env_id} steps/s ÷ that env's; {steps} random steps, {resets} resets)")
+    lines.append(
+        f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} CPUs; "
+        f"1-min load average {load_before:.2f} before, {os.getloadavg()[0]:.2f} after"
+    )
     if memory_steps:
         before, after, episodes = memory_run(env_id, memory_steps)
         lines.append(
