@@ -2,15 +2,12 @@
 
 from __future__ import annotations
 
-import math
-
 import gymnasium as gym
 import numpy as np
 import pytest
 
 import sfw_gym  # noqa: F401
 from sfw_gym import metrics
-from sfw_gym.errors import ConfigError
 from sfw_gym.world import generate_floorplan
 from tests.conftest import two_rooms_polygon
 
@@ -37,57 +34,6 @@ def test_incremental_info_metrics_equal_the_full_map_metrics():
     assert info["wall_precision"] == pytest.approx(np.nan_to_num(full["wall_precision"]))
     assert info["interior_wall_recall"] == pytest.approx(full["interior_wall_recall"])
     assert 0 < info["coverage"] <= 1 and info["path_length_m"] > 0
-
-
-def test_reward_is_scaled_information_gain_minus_collision_penalty():
-    env = gym.make("SfW-Explore-v0", reward_scale=0.5, collision_penalty=3.0)
-    env.reset(seed=2)
-    env.action_space.seed(0)
-    for _ in range(200):
-        _, reward, *_, info = env.step(env.action_space.sample())
-        bumped = env.unwrapped.scene.robot.bumped
-        assert reward == pytest.approx(0.5 * info["info_gain_bits"] - 3.0 * bumped)
-
-
-def test_terminates_at_the_coverage_target_and_reports_a_summary():
-    env = gym.make("SfW-ExploreSmall-v0", coverage_target=0.01)
-    env.reset(seed=0)
-    _, _, terminated, truncated, info = drive(env, 300)
-    assert terminated and not truncated
-    assert info["coverage"] >= 0.01 and info["summary"]["steps"] >= 1
-    assert 0 <= info["summary"]["map_mse"] <= 1
-
-
-def test_truncates_at_max_steps():
-    env = gym.make("SfW-ExploreSmall-v0", max_steps=7, coverage_target=1.0)
-    env.reset(seed=0)
-    for i in range(7):
-        _, _, terminated, truncated, info = env.step(env.action_space.sample())
-        assert truncated == (i == 6) and not terminated
-    assert info["summary"]["steps"] == 7
-
-
-def test_step_budget_scales_with_the_plan_area():
-    env = gym.make("SfW-ExploreSmall-v0", steps_per_m2=0.2, coverage_target=1.0)
-    _, info = env.reset(seed=0)
-    area = env.unwrapped.scene.floorplan.area_m2
-    budget = info["max_steps"]
-    assert budget == math.ceil(0.2 * area) and 2 <= budget < 300
-    steps = 0
-    while True:
-        steps += 1
-        _, _, terminated, truncated, info = env.step(env.action_space.sample())
-        if terminated or truncated:
-            break
-    assert truncated and steps == budget == info["summary"]["steps"]
-    capped = gym.make("SfW-ExploreSmall-v0", steps_per_m2=1000.0, max_steps=50)
-    assert capped.reset(seed=0)[1]["max_steps"] == 50  # max_steps caps the scaled budget
-    full = gym.make("SfW-ExploreFull-v0")
-    _, info = full.reset(seed=1)
-    assert info["max_steps"] == math.ceil(60 * full.unwrapped.scene.floorplan.area_m2)
-    for bad in (-1.0, float("nan"), "60"):
-        with pytest.raises(ConfigError, match="steps_per_m2"):
-            gym.make("SfW-Explore-v0", steps_per_m2=bad)
 
 
 def test_reset_options(tmp_path):

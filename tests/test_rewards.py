@@ -12,6 +12,7 @@ import pytest
 import sfw_gym  # noqa: F401  (registers the envs)
 from sfw_gym.agents import FrontierAgent
 from sfw_gym.envs.waypoint import WaypointWrapper
+from sfw_gym.errors import ConfigError
 
 SMALL = "SfW-ExploreSmall-v0"
 
@@ -88,18 +89,6 @@ def test_waypoint_reward_is_the_sum_of_the_env_steps_it_covers(env_id):
     assert total == pytest.approx(sum(inner.rewards), abs=1e-6)
 
 
-def test_truncated_exactly_at_the_step_budget_with_a_summary():
-    env = gym.make(SMALL, max_steps=50, coverage_target=1.0)
-    env.reset(seed=0)
-    env.action_space.seed(0)
-    for step in range(1, 51):
-        _, _, terminated, truncated, info = env.step(env.action_space.sample())
-        assert not terminated
-        assert truncated == (step == 50)
-        assert ("summary" in info) == (step == 50)
-    assert info["summary"]["steps"] == 50
-
-
 def test_terminated_at_the_first_step_that_reaches_the_coverage_target():
     env = gym.make(SMALL, coverage_target=0.2, max_steps=2000)
     obs, info = env.reset(seed=1)
@@ -114,14 +103,37 @@ def test_terminated_at_the_first_step_that_reaches_the_coverage_target():
     assert terminated and not truncated
     assert coverage[-1] >= 0.2 and max(coverage[:-1]) < 0.2
     assert info["summary"]["coverage"] == coverage[-1]
+    assert 0 <= info["summary"]["map_mse"] <= 1
     assert info["steps_to_coverage_50"] == -1  # not reached before the end
 
 
-def test_full_env_budget_is_steps_per_square_metre_of_the_plan():
-    env = gym.make("SfW-ExploreFull-v0")
-    _, info = env.reset(seed=3)
+def test_truncates_at_max_steps():
+    env = gym.make("SfW-ExploreSmall-v0", max_steps=7, coverage_target=1.0)
+    env.reset(seed=0)
+    for i in range(7):
+        _, _, terminated, truncated, info = env.step(env.action_space.sample())
+        assert truncated == (i == 6) and not terminated
+    assert info["summary"]["steps"] == 7
+
+
+def test_step_budget_scales_with_the_plan_area():
+    env = gym.make("SfW-ExploreSmall-v0", steps_per_m2=0.2, coverage_target=1.0)
+    _, info = env.reset(seed=0)
     area = env.unwrapped.scene.floorplan.area_m2
-    assert info["max_steps"] == min(30_000, math.ceil(60.0 * area))
-    small = gym.make("SfW-ExploreFull-v0", max_steps=100)
-    _, info = small.reset(seed=3)
-    assert info["max_steps"] == 100  # capped by max_steps
+    budget = info["max_steps"]
+    assert budget == math.ceil(0.2 * area) and 2 <= budget < 300
+    steps = 0
+    while True:
+        steps += 1
+        _, _, terminated, truncated, info = env.step(env.action_space.sample())
+        if terminated or truncated:
+            break
+    assert truncated and steps == budget == info["summary"]["steps"]
+    capped = gym.make("SfW-ExploreSmall-v0", steps_per_m2=1000.0, max_steps=50)
+    assert capped.reset(seed=0)[1]["max_steps"] == 50  # max_steps caps the scaled budget
+    full = gym.make("SfW-ExploreFull-v0")
+    _, info = full.reset(seed=1)
+    assert info["max_steps"] == math.ceil(60 * full.unwrapped.scene.floorplan.area_m2)
+    for bad in (-1.0, float("nan"), "60"):
+        with pytest.raises(ConfigError, match="steps_per_m2"):
+            gym.make("SfW-Explore-v0", steps_per_m2=bad)
