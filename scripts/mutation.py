@@ -1,0 +1,281 @@
+"""Mutation testing of sfw_gym with mutmut 3, per module group, and the table in BENCHMARKS.md.
+
+Not run in CI (it takes minutes to hours). Run it from the repository root, niced on a shared box:
+
+    nice -n 10 .venv/bin/python scripts/mutation.py --modules mapper radio navigation
+    nice -n 10 .venv/bin/python scripts/mutation.py --modules agents env cli
+    .venv/bin/python scripts/mutation.py --report-only     # rewrite the table from mutants/ only
+
+How long it took (2-core machine shared with other work, load ≈ 2, ``--max-children 2``):
+mapper + radio + navigation together, 1,475 mutants: see the "runs" lines that the script writes
+into BENCHMARKS.md (section "Mutation testing"), which also hold the command and the machine.
+
+What it does
+------------
+1. Runs ``mutmut run`` on the source files of the chosen groups (``GROUPS``), with mutmut's
+   configuration from ``[tool.mutmut]`` in pyproject.toml, except two fields that it sets for the
+   run: ``only_mutate`` (the groups' files) and ``pytest_add_cli_args_test_selection`` (the
+   groups' test files). mutmut already runs, for each mutant, only the tests that called the
+   mutated function while it collected its stats; restricting the collection to the groups' unit
+   tests keeps the integration tests (whole episodes, PPO, CLI) out of every mapper mutant's run.
+   Every mutant of the chosen groups is run again (explicit mutant globs), because mutmut keeps a
+   verdict as long as the *function* is unchanged, even after tests were added.
+2. Reads the verdicts from mutmut's meta files (``mutants/<source>.py.meta``, the same files that
+   ``mutmut results`` and ``mutmut export-cicd-stats`` read; exit codes → statuses through
+   ``mutmut.stats.status_by_exit_code``).
+3. Subtracts the mutants reviewed as equivalent (``scripts/mutation_equivalent.toml``: mutant
+   name → one-line reason; a name there that is *killed* is reported, since the entry is stale),
+   writes the per-module table to stdout, stores the group's numbers in
+   ``scripts/mutation_results.json`` (so that a run of other groups keeps them) and rewrites the
+   table between ``<!-- mutation:begin -->`` and ``<!-- mutation:end -->`` in BENCHMARKS.md.
+
+score = killed / (mutants − equivalent); "timeout" and "no tests" mutants count against it.
+
+mutmut notes: it copies the package and tests into ``mutants/`` (git-ignored) and imports from
+there; decorated functions are not mutated (the numba ``@njit`` kernels: they are checked against
+the dense oracle and hand-computed cases instead); ``conftest.HOUSEEXPO_DIR`` resolves to
+``mutants/../shared`` = ``<repo>/shared``, which does not exist, so the three HouseExpo tests of
+test_floorplan.py skip under mutmut (no group here relies on them).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import re
+import subprocess
+import sys
+import time
+from datetime import date
+from pathlib import Path
+
+import tomllib
+
+ROOT = Path(__file__).resolve().parents[1]
+EQUIVALENT_FILE = ROOT / "scripts" / "mutation_equivalent.toml"
+RESULTS_FILE = ROOT / "scripts" / "mutation_results.json"
+BENCHMARKS = ROOT / "BENCHMARKS.md"
+BEGIN, END = "<!-- mutation:begin -->", "<!-- mutation:end -->"
+
+#: group -> (source files to mutate, test files whose tests may kill them)
+GROUPS: dict[str, tuple[list[str], list[str]]] = {
+    "mapper": (
+        [
+            "sfw_gym/mapping/sparse.py",
+            "sfw_gym/mapping/k_estimation.py",
+            "sfw_gym/mapping/grid.py",
+            "sfw_gym/mapping/raycast.py",
+        ],
+        [
+            "tests/test_sparse_mapper.py",
+            "tests/test_k_estimation.py",
+            "tests/test_grid.py",
+            "tests/test_dense_mapper.py",
+        ],
+    ),
+    "radio": (["sfw_gym/world/radio.py"], ["tests/test_radio.py"]),
+    "navigation": (["sfw_gym/navigation.py"], ["tests/test_navigation.py"]),
+    "agents": (
+        sorted(str(p.relative_to(ROOT)) for p in (ROOT / "sfw_gym" / "agents").glob("*.py")),
+        ["tests/test_agents.py", "tests/test_agent_behaviour.py", "tests/test_ppo_agent.py"],
+    ),
+    "env": (
+        ["sfw_gym/envs/explore.py", "sfw_gym/envs/waypoint.py"],
+        [
+            "tests/test_envs.py",
+            "tests/test_explore_env.py",
+            "tests/test_waypoint.py",
+            "tests/test_rewards.py",
+        ],
+    ),
+    "cli": (["sfw_gym/cli.py"], ["tests/test_cli.py"]),
+}
+
+COLUMNS = ["mutants", "killed", "survived", "timeout", "no tests", "other", "equivalent"]
+
+# Runs mutmut in a child interpreter with two config fields overridden. mutmut's fork server and
+# workers are os.fork()ed from it, so they inherit the patched configuration.
+_BOOTSTRAP = """
+import json, sys
+import mutmut.configuration as configuration
+only_mutate, tests, args = json.loads(sys.argv[1])
+cfg = configuration.config()
+cfg.only_mutate = only_mutate
+cfg.pytest_add_cli_args_test_selection = tests
+from mutmut.__main__ import cli
+cli(["run", *args])
+"""
+
+
+def module_name(path: str) -> str:
+    return path[: -len(".py")].replace("/", ".")
+
+
+def run_mutmut(files: list[str], tests: list[str], max_children: int) -> float:
+    globs = [module_name(f) + ".*" for f in files]
+    args = ["--max-children", str(max_children), *globs]
+    payload = json.dumps([files, tests, args])
+    start = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-c", _BOOTSTRAP, payload], cwd=ROOT, check=False)
+    wall = time.perf_counter() - start
+    if proc.returncode not in (0, None):
+        sys.exit(f"mutmut run failed with exit code {proc.returncode}")
+    return wall
+
+
+def statuses(path: str) -> dict[str, str]:
+    """Mutant name -> mutmut status, from mutmut's meta file for ``path``."""
+    from mutmut.stats import status_by_exit_code
+
+    meta = ROOT / "mutants" / (path + ".meta")
+    if not meta.exists():
+        return {}
+    codes = json.loads(meta.read_text())["exit_code_by_key"]
+    return {name: status_by_exit_code[code] for name, code in codes.items()}
+
+
+def load_equivalent() -> dict[str, str]:
+    if not EQUIVALENT_FILE.exists():
+        return {}
+    return dict(tomllib.loads(EQUIVALENT_FILE.read_text())["equivalent"])
+
+
+def tally(path: str, equivalent: dict[str, str]) -> tuple[dict[str, int], list[str], list[str]]:
+    """Counts for one source file, the surviving non-equivalent mutants, and stale entries."""
+    counts = dict.fromkeys(COLUMNS, 0)
+    open_mutants, stale = [], []
+    for name, status in sorted(statuses(path).items()):
+        counts["mutants"] += 1
+        if name in equivalent:
+            if status == "killed":
+                stale.append(name)
+            else:
+                counts["equivalent"] += 1
+                continue
+        if status in ("killed", "survived", "timeout", "no tests"):
+            counts[status] += 1
+        else:
+            counts["other"] += 1
+        if status != "killed":
+            open_mutants.append(f"{name}: {status}")
+    return counts, open_mutants, stale
+
+
+def score(c: dict[str, int]) -> float:
+    denominator = c["mutants"] - c["equivalent"]
+    return c["killed"] / denominator if denominator else float("nan")
+
+
+def table(results: dict) -> str:
+    head = ["group", "module", *COLUMNS, "score"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * 2 + "---:|" * (len(head) - 2)]
+    for group in GROUPS:
+        if group not in results["groups"]:
+            continue
+        for path, c in results["groups"][group]["modules"].items():
+            cells = [group, f"`{path}`", *(str(c[k]) for k in COLUMNS), f"{score(c):.1%}"]
+            lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def section(results: dict) -> str:
+    runs = [
+        f"- `{g}`: {r['command']} — {r['wall_s'] / 60:.1f} min wall, {r['date']}, {r['machine']}"
+        for g, r in results["groups"].items()
+    ]
+    return "\n".join(
+        [
+            BEGIN,
+            "",
+            "Made by `scripts/mutation.py` (mutmut "
+            + results.get("mutmut", "?")
+            + ", config `[tool.mutmut]` in pyproject.toml); not run in CI. score = killed /"
+            " (mutants − equivalent); timeouts and mutants without tests count as not killed."
+            " Equivalent mutants and why: `scripts/mutation_equivalent.toml`. mutmut does not"
+            " mutate decorated functions, so the numba `@njit` kernels (the sparse mapper's ray"
+            " update, the k-threshold kernel, grid traversal, the RSSI kernels) are not in these"
+            " numbers: they are checked against the dense oracle (`tests/test_dense_mapper.py`)"
+            " and hand-computed cases instead.",
+            "",
+            table(results),
+            "",
+            "Runs:",
+            "",
+            *runs,
+            "",
+            END,
+        ]
+    )
+
+
+def write_benchmarks(text: str) -> None:
+    doc = BENCHMARKS.read_text()
+    if BEGIN in doc and END in doc:
+        doc = re.sub(re.escape(BEGIN) + r".*?" + re.escape(END), lambda _: text, doc, flags=re.S)
+    else:
+        doc = doc.rstrip("\n") + "\n\n## Mutation testing\n\n" + text + "\n"
+    BENCHMARKS.write_text(doc)
+
+
+def machine() -> str:
+    load = os.getloadavg()[0]
+    return f"{platform.machine()}, {os.cpu_count()} cores, load {load:.1f} at the end"
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--modules", nargs="+", choices=list(GROUPS), default=list(GROUPS))
+    ap.add_argument("--max-children", type=int, default=os.cpu_count() or 1)
+    ap.add_argument("--report-only", action="store_true", help="do not run mutmut, only report")
+    ap.add_argument("--list-survivors", action="store_true", help="print surviving mutants")
+    args = ap.parse_args(argv)
+
+    import mutmut
+
+    results = json.loads(RESULTS_FILE.read_text()) if RESULTS_FILE.exists() else {"groups": {}}
+    results["mutmut"] = mutmut.__version__
+    equivalent = load_equivalent()
+
+    wall = None
+    if not args.report_only:
+        files = [f for g in args.modules for f in GROUPS[g][0]]
+        tests = [t for g in args.modules for t in GROUPS[g][1]]
+        wall = run_mutmut(files, tests, args.max_children)
+
+    command = (
+        f"`nice -n 10 .venv/bin/python scripts/mutation.py --modules {' '.join(args.modules)}`"
+    )
+    for group in args.modules:
+        modules, survivors = {}, []
+        for path in GROUPS[group][0]:
+            counts, open_mutants, stale = tally(path, equivalent)
+            if counts["mutants"]:
+                modules[path] = counts
+            survivors += open_mutants
+            for name in stale:
+                print(f"warning: {name} is listed as equivalent but was killed", file=sys.stderr)
+        checked = any(c["mutants"] > c["other"] for c in modules.values())
+        if not modules or (wall is None and not checked):
+            continue  # nothing measured (or verdicts reset by a later run of other groups)
+        previous = results["groups"].get(group, {})
+        results["groups"][group] = {
+            "modules": modules,
+            "command": command if wall is not None else previous.get("command", command),
+            "wall_s": round(wall, 1) if wall is not None else previous.get("wall_s", 0.0),
+            "date": str(date.today()) if wall is not None else previous.get("date", "?"),
+            "machine": machine() if wall is not None else previous.get("machine", "?"),
+        }
+        if args.list_survivors:
+            print(f"# {group}: not killed, not equivalent")
+            print("\n".join(survivors) or "(none)")
+
+    print(table(results))
+    RESULTS_FILE.write_text(json.dumps(results, indent=2, sort_keys=True) + "\n")
+    write_benchmarks(section(results))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
