@@ -125,3 +125,64 @@ def test_ray_bad_input():
         ray_cells(UNIT, (np.nan, 0.0), (1.0, 1.0))
     with pytest.raises(ConfigError):
         ray_cells(UNIT, (0.0, 0.0, 0.0), (1.0, 1.0))
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"origin_xy": ("a", 0.0)}, r"origin_xy must be two numbers, got \('a', 0.0\)"),
+        ({"origin_xy": (np.inf, 0.0)}, r"origin_xy must be finite, got \(inf, 0.0\)"),
+        ({"resolution_m": "0.1"}, r"resolution_m must be a number, got '0.1'"),
+        ({"resolution_m": True}, r"resolution_m must be a number, got True"),
+        ({"resolution_m": np.nan}, r"resolution_m must be finite and > 0, got nan"),
+        ({"shape": 4}, r"shape must be \(n_rows, n_cols\), got 4"),
+        ({"shape": (0, 2)}, r"shape n_rows must be an int >= 1, got 0"),
+        ({"shape": (2, -1)}, r"shape n_cols must be an int >= 1, got -1"),
+    ],
+)
+def test_bad_grid_message_names_the_field_and_value(kwargs, message):
+    """The error a user sees (the CLI prints it on one line) says which field is wrong."""
+    args = {"origin_xy": (0.0, 0.0), "resolution_m": 0.1, "shape": (2, 2)} | kwargs
+    with pytest.raises(ConfigError, match=message):
+        GridSpec(**args)
+
+
+def test_grid_fields_are_normalised_so_equal_grids_compare_and_hash_equal():
+    g = GridSpec([1, 2], 1, [np.int64(3), 4])  # lists, ints, numpy ints
+    assert g.origin_xy == (1.0, 2.0) and type(g.origin_xy[0]) is float
+    assert g.resolution_m == 1.0 and type(g.resolution_m) is float
+    assert g.shape == (3, 4) and type(g.shape) is tuple and type(g.shape[0]) is int
+    assert g == GridSpec((1.0, 2.0), 1.0, (3, 4))
+    assert hash(g) == hash(GridSpec((1.0, 2.0), 1.0, (3, 4)))
+    assert GridSpec((0.0, 0.0), 0.1, (1, 1)).shape == (1, 1)  # a single cell is a grid
+
+
+@pytest.mark.parametrize(
+    ("bounds", "resolution", "message"),
+    [
+        ((0.0, 0.0, 1.0), 0.1, r"bounds must be \(xmin, ymin, xmax, ymax\)"),
+        ((0.0, 0.0, np.inf, 1.0), 0.1, r"bounds must be finite"),
+        ((0.0, 0.0, 0.0, 1.0), 0.1, r"bounds need xmax > xmin and ymax > ymin"),  # zero width
+        ((0.0, 1.0, 1.0, 1.0), 0.1, r"bounds need xmax > xmin and ymax > ymin"),  # zero height
+        ((0.0, 0.0, 1.0, 1.0), 0.0, r"resolution_m must be > 0, got 0.0"),
+        ((0.0, 0.0, 1.0, 1.0), "0.1", r"resolution_m must be > 0, got '0.1'"),
+    ],
+)
+def test_bad_covering_message(bounds, resolution, message):
+    with pytest.raises(ConfigError, match=message):
+        GridSpec.covering(bounds, resolution)
+
+
+def test_covering_a_bound_smaller_than_a_cell_is_one_cell():
+    g = GridSpec.covering((2.0, 3.0, 2.04, 3.01), 0.1)
+    assert g.shape == (1, 1) and g.origin_xy == (2.0, 3.0)
+
+
+def test_ray_bad_input_messages_and_point_shapes():
+    with pytest.raises(ConfigError, match=r"start_xy and end_xy must be \(x, y\) pairs"):
+        ray_cells(UNIT, (0.0, 0.0, 0.0), (1.0, 1.0))
+    with pytest.raises(ConfigError, match="start_xy and end_xy must be finite"):
+        ray_cells(UNIT, (0.5, 0.5), (np.inf, 1.0))
+    # a point given as a (1, 2) row (e.g. one row of cell_to_world's output) is a point
+    row = ray_cells(UNIT, np.array([[0.5, 0.5]]), np.array([[3.5, 0.5]]))
+    assert row.tolist() == [[0, 0], [0, 1], [0, 2], [0, 3]]

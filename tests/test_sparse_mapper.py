@@ -316,6 +316,7 @@ def test_pickle_round_trip_continues_identically():
         assert m.update(p, rssi_k(p, k)) == clone.update(p, rssi_k(p, k))
     assert np.array_equal(m.occupancy_u8, clone.occupancy_u8)
     assert np.array_equal(m.classified, clone.classified)
+    assert np.array_equal(m.log_odds, clone.log_odds)
     assert m.entropy_bits == clone.entropy_bits
     assert clone.occupancy_u8.base is not None and not clone.occupancy_u8.flags.writeable
 
@@ -343,8 +344,11 @@ def test_router_policy_all_uses_every_heard_router():
 @pytest.mark.parametrize(
     ("position", "rssi", "kwargs", "match"),
     [
-        ((np.nan, 1.0), [-40.0], {}, "position_xy"),
+        ((np.nan, 1.0), [-40.0], {}, "position_xy must be two finite numbers"),
+        ((1.0, 1.0, 1.0), [-40.0], {}, "position_xy must be two finite numbers"),
         ((1.0,), [-40.0], {}, "position_xy"),
+        ((6.0, 1.0), [-40.0], {}, "outside"),  # the upper edges are outside
+        ((1.0, 2.0), [-40.0], {}, "outside"),
         ((7.0, 1.0), [-40.0], {}, "outside"),
         ((-0.01, 1.0), [-40.0], {}, "outside"),
         ((1.0, 1.0), [np.nan], {}, "rssi_dbm"),
@@ -373,3 +377,76 @@ def test_bad_construction_raises():
         SparseInverseKVisibility((0, 0, 1, 1), [[1.0, 2.0]])
     with pytest.raises(ConfigError, match="config"):
         SparseInverseKVisibility(GRID, [[1.0, 2.0]], {"max_k": 3})
+
+
+def test_bad_construction_messages_name_the_problem():
+    with pytest.raises(ConfigError, match="grid must be a GridSpec, got tuple"):
+        SparseInverseKVisibility((0, 0, 1, 1), [[1.0, 2.0]])
+    with pytest.raises(ConfigError, match="config must be a MapperConfig, got dict"):
+        SparseInverseKVisibility(GRID, [[1.0, 2.0]], {"max_k": 3})
+    for bad in (np.zeros((1, 3)), np.zeros((0, 2))):  # three coordinates; no router
+        with pytest.raises(ConfigError, match=r"routers_xy must have shape \(R, 2\) with R >= 1"):
+            SparseInverseKVisibility(GRID, bad)
+
+
+def test_routers_are_stored_as_read_only_float_metres():
+    routers = [[1, 2], [3, 0]]
+    m = SparseInverseKVisibility(GRID, routers, EXACT)
+    assert m.routers_xy.dtype == np.float64 and m.routers_xy.tolist() == [[1.0, 2.0], [3.0, 0.0]]
+    with pytest.raises(ValueError):  # the mapper's router geometry cannot drift from the array
+        m.routers_xy[0, 0] = 5.0
+
+
+def test_origin_corner_is_inside_and_x_y_use_their_own_origin():
+    # origin x != y: a swapped origin coordinate would put the robot in another cell
+    grid = GridSpec((-1.0, 2.0), 0.5, (4, 6))
+    m = SparseInverseKVisibility(grid, [(0.0, 0.0)], replace(EXACT, robot_radius_m=0.0))
+    m.update((-1.0, 2.0), [-100.0])  # the lower-left corner is inside the grid
+    assert m.log_odds[0, 0] == pytest.approx(-1.0)  # the footprint of a not-heard reading
+    m.reset()
+    m.update((0.3, 2.6), [-100.0])  # cell (row 1, col 2)
+    assert m.log_odds[1, 2] == pytest.approx(-1.0) and (m.log_odds != 0).sum() == 1
+
+
+def test_outer_bounds_include_cell_centres_on_the_bound():
+    grid = GridSpec((0.0, 0.0), 0.5, (4, 6))  # centres at 0.25, 0.75, 1.25, ...
+    cfg = replace(EXACT, outer_bounds_m=(0.25, 0.25, 1.25, 0.75))
+    m = SparseInverseKVisibility(grid, [(0.0, 0.0)], cfg)
+    assert m.entropy_bits == 3 * 2  # columns 0-2, rows 0-1: 1 bit each
+    assert m.recompute_entropy_bits() == pytest.approx(6.0)
+
+
+def test_policy_all_frees_the_ray_of_every_heard_router_and_strongest_only_one():
+    near = (3.0, 1.9)  # 0.85 m from the robot: the strongest
+    p = (3.05, 1.05)
+    rssi = rssi_k(p, 0) + rssi_k(p, 0, router=near)
+    on_far_ray = tuple(GRID.world_to_cell((1.55, 1.05)))  # on the ray to ROUTER only
+    on_near_ray = tuple(GRID.world_to_cell((3.0, 1.75)))
+    for policy, far_freed in (("strongest", False), ("all", True)):
+        m = SparseInverseKVisibility(GRID, [ROUTER, near], replace(EXACT, router_policy=policy))
+        m.update(p, rssi)
+        assert m.log_odds[on_near_ray] == pytest.approx(-0.4)
+        assert m.log_odds[on_far_ray] == pytest.approx(-0.4 if far_freed else 0.0)
+
+
+def test_update_counts_and_reset_gives_a_fresh_mapper():
+    path = [(x, 0.25) for x in np.arange(0.15, 2.0, 0.05)]
+    readings = [rssi_k(q, 0 if q[0] < 1.0 else 1) for q in path]
+    fresh = SparseInverseKVisibility(GRID, [ROUTER], EXACT)
+    used = SparseInverseKVisibility(GRID, [ROUTER], EXACT)
+    for x in np.arange(3.0, 5.0, 0.1):  # another history, far away
+        used.update((x, 1.55), rssi_k((x, 1.55), 1))
+    assert used.n_updates == 20
+    used.reset()
+    assert used.n_updates == 0 and used.last_changed_cells.size == 0
+    for q, r in zip(path, readings, strict=True):
+        assert used.update(q, r) == fresh.update(q, r)
+    assert used.n_updates == fresh.n_updates == len(path)
+    assert np.array_equal(used.log_odds, fresh.log_odds)
+    assert used.entropy_bits == fresh.entropy_bits
+
+
+def test_a_heading_without_bumped_marks_no_wall():
+    m = SparseInverseKVisibility(GRID, [ROUTER], replace(EXACT, robot_radius_m=0.17))
+    m.update((3.05, 1.05), [-100.0], heading_rad=0.0)  # bumped defaults to False
+    assert (m.log_odds <= 0).all()
