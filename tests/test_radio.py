@@ -139,3 +139,139 @@ def test_config_validation_and_presets():
     with pytest.raises(ConfigError, match="tx_power_dbm"):
         RadioConfig(tx_power_dbm=float("nan"))
     assert RadioConfig().to_dict()["wall_loss_db"]["generic"] == 10.0
+
+
+# -- from the mutation review: formulas at hand-computed points, boundaries, messages ------------
+def test_free_space_path_loss_follows_friis():
+    from sfw_gym.world.radio import free_space_path_loss_db
+
+    # 20 log10(4π d f / c): 2.4 GHz at 1 m is 40.05 dB; doubling the distance adds 6.02 dB
+    assert free_space_path_loss_db(1.0, 2.4) == pytest.approx(40.05, abs=0.01)
+    assert free_space_path_loss_db(2.0, 2.4) == pytest.approx(40.05 + 6.02, abs=0.01)
+    assert free_space_path_loss_db(1.0, 4.8) == pytest.approx(40.05 + 6.02, abs=0.01)
+
+
+def test_path_loss_is_log_distance_from_the_reference_distance(open_hall):
+    cfg = RadioConfig(path_loss_d0_db=40.0, path_loss_exponent=3.0, reference_distance_m=2.0)
+    model = RadioModel(open_hall, [[1.0, 5.0]], cfg.noiseless(), np.random.default_rng(0))
+    # 8 m = 4 d0: 40 + 30 log10(4) = 58.06 dB; closer than d0 the loss stays PL(d0)
+    pl = model.path_loss_db(np.array([[9.0, 5.0], [2.0, 5.0]]))
+    assert pl[:, 0] == pytest.approx([40.0 + 30.0 * math.log10(4.0), 40.0])
+
+
+def test_a_reading_at_the_sensitivity_is_heard(open_hall):
+    base = RadioConfig(shadowing_sigma_db=0.0, noise_sigma_db=0.0)
+    probe = RadioModel(open_hall, [[1.0, 5.0]], base, np.random.default_rng(0))
+    p = np.array([15.0, 5.0])
+    mean = probe.mean_rssi(p)[0, 0]
+    # shift the transmit power so that the mean at p is -90.2 dBm: the reading rounds to -90
+    cfg = RadioConfig(tx_power_dbm=base.tx_power_dbm - (mean + 90.2), shadowing_sigma_db=0.0,
+                      noise_sigma_db=0.0, sensitivity_dbm=-90.0)  # fmt: skip
+    model = RadioModel(open_hall, [[1.0, 5.0]], cfg, np.random.default_rng(0))
+    assert model.measure(p).tolist() == [-90]
+
+
+def test_noise_is_drawn_per_router_and_even_below_one_db(open_hall):
+    cfg = RadioConfig(shadowing_sigma_db=0.0, noise_sigma_db=0.8)
+    model = RadioModel(open_hall, [[1.0, 4.0], [1.0, 6.0]], cfg, np.random.default_rng(1))
+    p = np.array([6.0, 5.0])  # equidistant: both routers have the same mean
+    mean = model.mean_rssi(p)[0]
+    assert mean[0] == pytest.approx(mean[1])
+    readings = np.array([model.measure(p) for _ in range(200)])
+    assert len(np.unique(readings[:, 0])) > 1  # 0.8 dB of noise changes the rounded reading
+    assert (readings[:, 0] != readings[:, 1]).any()  # independent draws per router
+
+
+def test_a_model_without_an_rng_makes_its_own(open_hall):
+    model = RadioModel(open_hall, [[1.0, 5.0]])
+    assert model.measure(np.array([3.0, 5.0])).dtype.kind == "i"
+
+
+def test_shadowing_below_one_db_is_applied(open_hall):
+    cfg = RadioConfig(shadowing_sigma_db=0.5, noise_sigma_db=0.0)
+    model = RadioModel(open_hall, [[1.0, 5.0]], cfg, np.random.default_rng(2))
+    flat = RadioModel(open_hall, [[1.0, 5.0]], cfg.noiseless(), np.random.default_rng(2))
+    pts = np.array([[x, 5.0] for x in range(3, 19)], np.float64)
+    assert not np.allclose(model.mean_rssi(pts), flat.mean_rssi(pts))
+
+
+def test_router_and_point_input_checks(open_hall):
+    model = RadioModel(open_hall, [[1, 5]])  # integer positions are metres too
+    assert model.routers.dtype == np.float64 and model.routers.tolist() == [[1.0, 5.0]]
+    for bad in (np.zeros((1, 3)), np.zeros((0, 2))):
+        with pytest.raises(ConfigError, match=r"routers must have shape \(R, 2\) with R ≥ 1"):
+            RadioModel(open_hall, bad)
+    with pytest.raises(ConfigError, match=r"points must be finite \(got NaN or inf\)"):
+        model.mean_rssi(np.array([np.inf, 1.0]))
+
+
+def test_router_outside_message(two_rooms):
+    with pytest.raises(ConfigError, match=r"\(50\.000, 2\.000\) is outside the building of"):
+        RadioModel(two_rooms, [[50.0, 2.0]])
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"frequency_ghz": 0.0}, r"^RadioConfig\.frequency_ghz must be > 0, got 0\.0$"),
+        ({"frequency_ghz": True}, r"^RadioConfig\.frequency_ghz must be a finite number"),
+        ({"path_loss_d0_db": math.inf}, r"^RadioConfig\.path_loss_d0_db must be finite, got inf"),
+        ({"wall_loss_db": [10.0]}, r"^RadioConfig\.wall_loss_db must map material names to"),
+        ({"wall_loss_db": "generic"}, r"^RadioConfig\.wall_loss_db must map material names to"),
+    ],
+)
+def test_config_messages_name_the_field(kwargs, message):
+    with pytest.raises(ConfigError, match=message):
+        RadioConfig(**kwargs)
+
+
+def test_wall_losses_need_every_material_once_and_non_negative_numbers():
+    losses = dict(RadioConfig().wall_loss_db)
+    with pytest.raises(ConfigError, match=r"missing \[\], unknown \['steel'\]"):
+        RadioConfig(wall_loss_db=losses | {"steel": 20.0})
+    for bad in (-1.0, math.nan, "10"):
+        with pytest.raises(ConfigError, match=r"^RadioConfig\.wall_loss_db\['glass'\] must be ≥ 0"):
+            RadioConfig(wall_loss_db=losses | {"glass": bad})
+    ok = RadioConfig(wall_loss_db=losses | {"glass": 0, "wood": 0.5})  # zero and small are fine
+    assert ok.wall_loss_db["glass"] == 0.0 and ok.wall_loss_db["wood"] == 0.5
+
+
+def test_config_keeps_a_private_float_copy_of_the_losses():
+    losses = dict.fromkeys(RadioConfig().wall_loss_db, 7)
+    cfg = RadioConfig(wall_loss_db=losses)
+    losses["glass"] = 99
+    assert cfg.wall_loss_db["glass"] == 7.0 and type(cfg.wall_loss_db["glass"]) is float
+    assert type(cfg.wall_loss_db) is dict
+
+
+def test_d0_loss_uses_a_configured_value():
+    assert RadioConfig(path_loss_d0_db=35.5).d0_loss_db == 35.5
+
+
+def test_presets_defaults_overrides_and_messages():
+    default = RadioConfig.preset()
+    assert default.frequency_ghz == 2.437 and set(default.wall_loss_db.values()) == {10.0}
+    assert RadioConfig.preset("thick", noise_sigma_db=0.5).noise_sigma_db == 0.5
+    with pytest.raises(ConfigError, match=r"unknown radio band '6'; choose one of \['2\.4', '5'\]"):
+        RadioConfig.preset(band="6")
+    with pytest.raises(ConfigError, match=r"^RadioConfig\.preset: .*colour"):
+        RadioConfig.preset(colour="blue")
+
+
+def test_noiseless_removes_shadowing_and_noise():
+    cfg = RadioConfig().noiseless()
+    assert cfg.shadowing_sigma_db == 0.0 and cfg.noise_sigma_db == 0.0
+
+
+def test_shadowing_table_covers_the_bounds_and_interpolates_between_nodes():
+    from sfw_gym.world.radio import ShadowingField
+
+    f = ShadowingField((2.0, 3.0, 7.2, 5.0), 2, 4.0, 5.0, np.random.default_rng(0))
+    assert f.origin.tolist() == [1.5, 2.5]  # one node spacing (0.5 m) below-left of the bounds
+    n_r, ny, nx = f.table_db.shape
+    assert n_r == 2
+    assert f.origin[0] + 0.5 * (nx - 1) >= 7.2 + 0.5 and f.origin[1] + 0.5 * (ny - 1) >= 5.0 + 0.5
+    node = f.origin + 0.5 * np.array([3.0, 2.0])  # node (row 2, column 3)
+    np.testing.assert_allclose(f(node[None]), f.table_db[None, :, 2, 3])
+    halfway = (f.table_db[:, 2, 3] + f.table_db[:, 2, 4]) / 2
+    np.testing.assert_allclose(f((node + [0.25, 0.0])[None])[0], halfway)
