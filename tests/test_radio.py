@@ -274,4 +274,4 @@ def test_shadowing_table_covers_the_bounds_and_interpolates_between_nodes():
     node = f.origin + 0.5 * np.array([3.0, 2.0])  # node (row 2, column 3)
     np.testing.assert_allclose(f(node[None]), f.table_db[None, :, 2, 3])
     halfway = (f.table_db[:, 2, 3] + f.table_db[:, 2, 4]) / 2
-    np.testing.assert_allclose(f((node + [0.25, 0.0])[None])[0], halfway)
+    np.testing.assert_allclose(f((node + np.array([0.25, 0.0]))[None])[0], halfway)
