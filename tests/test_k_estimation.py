@@ -194,3 +194,120 @@ def test_calibration_needs_distance_aware():
 def test_config_round_trips_through_dict():
     cfg = MapperConfig(outer_bounds_m=(0.0, 0.0, 5.0, 5.0), router_policy="all")
     assert MapperConfig(**cfg.to_dict()) == cfg
+
+
+# -- from the mutation review: merging rules worked by hand, reset, refit, messages, dtypes ------
+def test_merge_levels_gap_then_size_worked_example():
+    # sorted: -40 (10), -45 (30), -52 (10), -70 (5). Gap step (6 dB): -40/-45 merge to
+    # (-400 - 1350) / 40 = -43.75. Size step (15 % of 55 = 8.25): -70 (5 samples) joins its
+    # only neighbour -52: (-520 - 350) / 15 = -58.
+    out = merge_levels(np.array([-40.0, -52.0, -45.0, -70.0]), np.array([10, 10, 30, 5]), 6.0, 0.15)
+    assert out == pytest.approx([-43.75, -58.0])
+
+
+def test_merge_levels_boundaries_are_kept():
+    assert merge_levels([-40.0, -46.0], [1, 1], 6.0).tolist() == [-40.0, -46.0]  # gap == min
+    assert merge_levels([-40.0, -60.0], [3, 1], 6.0, 0.25).tolist() == [-40.0, -60.0]  # 1/4
+    assert merge_levels([-50.0], [3], 6.0).tolist() == [-50.0]  # one level: nothing to merge
+    assert merge_levels([-40.0, -42.0], [1, 1], 6.0).tolist() == [-41.0]  # two close levels
+    assert merge_levels([-40, -60], [1, 1], 6.0).dtype == np.float64  # levels are float dB
+
+
+def test_merge_levels_empty_cluster_has_no_weight():
+    assert merge_levels([-40.0, -42.0], [5, 0], 6.0) == pytest.approx([-40.0])
+
+
+@pytest.mark.parametrize(
+    ("levels", "expected"),
+    [
+        # a small middle level joins the nearer neighbour: -50 is 10 dB from -40, 30 from -80
+        ([-40.0, -50.0, -80.0], [(-400.0 - 50.0) / 11, -80.0]),
+        ([-40.0, -70.0, -80.0], [-40.0, (-70.0 - 800.0) / 11]),
+        # equidistant: the stronger neighbour
+        ([-40.0, -60.0, -80.0], [(-400.0 - 60.0) / 11, -80.0]),
+    ],
+)
+def test_merge_levels_small_cluster_joins_its_nearer_neighbour(levels, expected):
+    assert merge_levels(levels, [10, 1, 10], 6.0, 0.1) == pytest.approx(expected)
+
+
+def test_fit_levels_two_values_and_a_single_reading_level():
+    levels, (lo, hi) = fit_levels([-40.0] * 5 + [-60.0] * 5, 3, 5.0)
+    assert levels == pytest.approx([-40.0, -60.0]) and (lo, hi) == (-60.0, -40.0)
+    # one reading of a level is a level (no size filter) ...
+    levels, _ = fit_levels([-40.0] * 10 + [-70.0], 3, 5.0)
+    assert levels == pytest.approx([-40.0, -70.0])
+    # ... unless it holds less than min_fraction of the samples: then it joins its neighbour
+    levels, extremes = fit_levels([-40.0] * 10 + [-70.0], 3, 5.0, 0.2)
+    assert levels == pytest.approx([(-400.0 - 70.0) / 11]) and extremes == (-70.0, -40.0)
+    assert fit_levels([-50.0] * 4, 3, 5.0) is None
+
+
+def test_estimator_input_messages_and_default_config():
+    with pytest.raises(ConfigError, match=r"^n_routers must be an int >= 1, got '3'$"):
+        KEstimator("3")
+    with pytest.raises(ConfigError, match=r"^config must be a MapperConfig, got dict$"):
+        KEstimator(2, {"max_k": 3})
+    est = KEstimator(2)  # the default configuration
+    assert est.config == MapperConfig()
+    with pytest.raises(ConfigError, match=r"^rssi_dbm must have shape \(2,\)"):
+        est.add([-40.0], [1.0, 1.0])
+    with pytest.raises(ConfigError, match=r"^distances_m must have shape \(2,\)"):
+        est.add([-40.0, -50.0], [1.0])
+    with pytest.raises(ConfigError, match=r"^features must have shape \(2,\), got \(3,\)"):
+        est.estimate([-40.0, -50.0, -60.0])
+
+
+def test_k_values_are_integers_and_minus_one_before_any_reading():
+    est = KEstimator(2, MapperConfig(k0_level_dbm=-40.0))
+    assert est.last_k.tolist() == [-1, -1]
+    k = est.update([-40.0, -100.0], [1.0, 1.0])
+    assert k.dtype.kind == "i" and k.tolist() == [0, -1]
+    assert est.estimate([-40.0, -65.0]).dtype.kind == "i"
+
+
+def test_reset_gives_a_fresh_estimator():
+    cfg = MapperConfig(refit_min_samples=8)
+    readings = [([-40.0 - 20.0 * (i // 10 % 2), -55.0], [2.0, 3.0]) for i in range(40)]
+    fresh, used = KEstimator(2, cfg), KEstimator(2, cfg)
+    for i in range(50):
+        used.update([-30.0 - (i % 3) * 25.0, -70.0], [1.5, 4.0])
+    used.reset()
+    assert used.last_k.tolist() == [-1, -1] and used.n_samples.tolist() == [0, 0]
+    for rssi, dist in readings:
+        np.testing.assert_array_equal(used.update(rssi, dist), fresh.update(rssi, dist))
+        np.testing.assert_array_equal(used.add(rssi, dist), fresh.add(rssi, dist))
+    assert used.n_refits == fresh.n_refits
+    for r in range(2):
+        np.testing.assert_array_equal(used.thresholds(r), fresh.thresholds(r))
+
+
+def two_levels(est, r_heard, other):
+    """20 readings at -40 dBm then 20 at -60 dBm at 1 m from router r_heard."""
+    for level in (-40.0, -60.0):
+        for _ in range(20):
+            rssi = np.full(est.n_routers, other)
+            rssi[r_heard] = level
+            est.add(rssi, np.ones(est.n_routers))
+
+
+def test_forced_refit_fits_every_router_with_two_levels_and_skips_the_others():
+    # router 0 never heard, router 1 heard at one level only (no fit), router 2 at two levels
+    est = KEstimator(3, MapperConfig(refit_min_samples=1000))
+    for level in (-40.0, -60.0):
+        for _ in range(20):
+            est.add([-100.0, -50.0, level], [1.0, 1.0, 1.0])
+    est.refit()  # not due yet (1000 samples)
+    assert est.n_refits == 0
+    est.refit(force=True)
+    assert est.n_refits == 1
+    # levels -40 / -60, k_top 0: thresholds at the midpoint, then 10 dB walls below the lowest
+    assert est.thresholds(2) == pytest.approx([-50.0, -65.0, -75.0])
+
+
+def test_a_level_stronger_than_the_calibrated_k0_is_k_zero():
+    # k0 = -50 dBm but a level at -40 dBm is seen: round((-50 + 40) / 10) = -1 → clamped to 0
+    est = KEstimator(1, MapperConfig(k0_level_dbm=-50.0, refit_min_samples=1000))
+    two_levels(est, 0, -100.0)
+    est.refit(force=True)
+    assert est.thresholds(0) == pytest.approx([-50.0, -65.0, -75.0])
