@@ -450,3 +450,14 @@ def test_a_heading_without_bumped_marks_no_wall():
     m = SparseInverseKVisibility(GRID, [ROUTER], replace(EXACT, robot_radius_m=0.17))
     m.update((3.05, 1.05), [-100.0], heading_rad=0.0)  # bumped defaults to False
     assert (m.log_odds <= 0).all()
+
+
+def test_public_views_have_the_documented_dtypes():
+    m = SparseInverseKVisibility(GRID, [ROUTER], EXACT)
+    m.update((3.05, 1.05), rssi_k((3.05, 1.05), 0))
+    assert m.log_odds.dtype == np.float32 and m.log_odds.shape == GRID.shape
+    assert m.occupancy_u8.dtype == np.uint8 and m.classified.dtype == np.bool_
+    assert m.probability.dtype == np.float32
+    changed = m.last_changed_cells
+    assert changed.dtype == np.int64 and changed.size > 0
+    assert m.classified.ravel()[changed].all()  # unknown -> free: every change is a new class
