@@ -274,6 +274,7 @@ def test_reset_gives_a_fresh_estimator():
         used.update([-30.0 - (i % 3) * 25.0, -70.0], [1.5, 4.0])
     used.reset()
     assert used.last_k.tolist() == [-1, -1] and used.n_samples.tolist() == [0, 0]
+    assert used.n_samples.dtype.kind == "i"  # a count of readings
     for rssi, dist in readings:
         np.testing.assert_array_equal(used.update(rssi, dist), fresh.update(rssi, dist))
         np.testing.assert_array_equal(used.add(rssi, dist), fresh.add(rssi, dist))

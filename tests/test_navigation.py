@@ -296,3 +296,73 @@ def test_mark_contact_marks_the_cell_just_ahead_of_the_bumper():
     mask[:] = False
     mark_contact(mask, grid, (1.05, 1.07, math.pi / 2), 0.2)
     assert mask.sum() == 5 and mask[13, 10] and mask[12, 10] and mask[14, 10]
+
+
+# ---------------------------------------------------------------- from the mutation review
+
+
+def test_default_unknown_cost_is_one_and_a_half():
+    assert traversal_costs(np.array([[127, 255]], np.uint8), 0.1, 0.2).tolist() == [[1.5, 1.0]]
+
+
+def test_free_start_default_radius_edges_and_the_robots_own_finite_cell():
+    cost = np.full((5, 5), np.inf)
+    out = free_start(cost, (2, 2))  # default: one cell around the robot
+    assert np.isfinite(out).sum() == 9
+    top = free_start(cost, (0, 2), radius_cells=1)  # on the top edge: rows 0-1, columns 1-3
+    assert np.isfinite(top).sum() == 6 and np.isfinite(top[0, 1:4]).all()
+    ones = free_start(np.ones((3, 3)), (1, 1))
+    assert (ones == 1.0).all()  # passable cells, the robot's included, keep their cost
+    # a start just outside the grid frees the border cells beside it, nothing else
+    below = free_start(cost, (5, 2), radius_cells=1)
+    assert np.isfinite(below).sum() == 3 and np.isfinite(below[4, 1:4]).all()
+    right = free_start(cost, (2, 5), radius_cells=1)
+    assert np.isfinite(right).sum() == 3 and np.isfinite(right[1:4, 4]).all()
+
+
+def test_cost_field_clamps_a_start_below_and_right_of_the_grid_and_keeps_the_resolution():
+    field = cost_field(np.ones((4, 6)), (10, -2), 0.25)
+    assert field.start_rc == (3, 0) and field.resolution_m == 0.25
+    assert field.cumulative[3, 5] == pytest.approx(5 * 0.25)
+
+
+def test_unreachable_path_is_an_empty_int_array():
+    cost = np.ones((3, 3))
+    cost[:, 1] = np.inf
+    path = cost_field(cost, (0, 0), 1.0).path((0, 2))
+    assert path.shape == (0, 2) and path.dtype == np.int64
+
+
+def test_simplify_thins_three_points_and_considers_the_second_point():
+    three = np.array([[0.0, 0.0], [0.1, 0.0], [1.0, 0.0]])
+    assert simplify_path(three, 0.5)[:, 0].tolist() == [0.0, 1.0]
+    four = np.array([[0.0, 0.0], [0.625, 0.0], [0.75, 0.0], [1.5, 0.0]])
+    assert simplify_path(four, 0.5)[:, 0].tolist() == [0.0, 0.625, 1.5]
+
+
+def test_remaining_m_counts_the_last_leg():
+    pp = PurePursuit()
+    pp.set_path(np.array([[0.0, 0.0], [0.05, 0.0]]))  # two points after resampling
+    assert len(pp.path) == 2
+    assert pp.remaining_m(np.array([0.0, 0.1])) == pytest.approx(0.15)
+
+
+def test_carrot_is_the_path_end_when_every_point_is_within_the_lookahead():
+    pp = PurePursuit()
+    pp.set_path(np.array([[0.0, 0.0], [0.4, 0.0]]))
+    linear, angular = pp.command((0.0, 0.1, 0.0))  # end (0.4, 0) is 0.41 m away
+    bearing = math.atan2(-0.1, 0.4)
+    assert angular == pytest.approx(1.5 * bearing) and linear == pytest.approx(math.cos(bearing))
+
+
+def test_a_point_exactly_at_the_lookahead_is_the_carrot():
+    pp = PurePursuit()  # lookahead 0.5 m
+    pp.set_path(np.array([[0.0, 0.0], [0.5, 0.0], [0.5, 1.0]]))  # corner exactly 0.5 m ahead
+    assert pp.command((0.0, 0.0, 0.0)) == pytest.approx((1.0, 0.0))
+
+
+def test_a_bearing_equal_to_the_turn_threshold_still_drives():
+    pp = PurePursuit(turn_in_place_rad=wrap_angle(1.0))
+    pp.set_path(np.array([[0.0, 0.0], [2.0, 0.0]]))
+    linear, angular = pp.command((0.0, 0.0, -1.0))  # bearing to the carrot: +1 rad
+    assert linear == pytest.approx(math.cos(1.0)) and angular == 1.0
