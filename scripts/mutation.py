@@ -113,8 +113,29 @@ def module_name(path: str) -> str:
     return path[: -len(".py")].replace("/", ".")
 
 
-def run_mutmut(files: list[str], tests: list[str], max_children: int) -> float:
-    globs = [module_name(f) + ".*" for f in files]
+def forget_unmutated_copies(files: list[str]) -> None:
+    """Delete ``mutants/<file>`` where mutmut has no meta file for it.
+
+    A run of other groups copies this file into mutants/ unmutated (it is not in only_mutate),
+    and the copy is newer than the source, so mutmut would take it for an up-to-date mutated
+    file and generate no mutants for it (mutmut 3.8 compares mtimes only).
+    """
+    for f in files:
+        copy = ROOT / "mutants" / f
+        if copy.exists() and not (ROOT / "mutants" / (f + ".meta")).exists():
+            copy.unlink()
+
+
+def run_mutmut(
+    files: list[str], tests: list[str], max_children: int, names: list[str] | None = None
+) -> float:
+    """Run mutmut on ``files`` (every mutant, or only ``names``); return the wall time."""
+    forget_unmutated_copies(files)
+    # Fresh stats: mutmut reuses its stats file when the test selection is unchanged, and then
+    # knows no tests for functions of a file that was not mutated when the stats were taken
+    # (every mutant of it would be "no tests"). Collecting them again costs one test run.
+    (ROOT / "mutants" / "mutmut-stats.json").unlink(missing_ok=True)
+    globs = names if names else [module_name(f) + ".*" for f in files]
     args = ["--max-children", str(max_children), *globs]
     payload = json.dumps([files, tests, args])
     start = time.perf_counter()
@@ -181,10 +202,13 @@ def table(results: dict) -> str:
 
 
 def section(results: dict) -> str:
-    runs = [
-        f"- `{g}`: {r['command']} — {r['wall_s'] / 60:.1f} min wall, {r['date']}, {r['machine']}"
-        for g, r in results["groups"].items()
-    ]
+    runs = []
+    for g, r in results["groups"].items():
+        line = f"- `{g}`: {r.get('command', '?')} — {r.get('wall_s', 0.0) / 60:.1f} min wall"
+        line += f", {r.get('date', '?')}, {r.get('machine', '?')}"
+        if "rerun" in r:
+            line += f"; then {r['rerun']}"
+        runs.append(line)
     return "\n".join(
         [
             BEGIN,
@@ -230,6 +254,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--max-children", type=int, default=os.cpu_count() or 1)
     ap.add_argument("--report-only", action="store_true", help="do not run mutmut, only report")
     ap.add_argument("--list-survivors", action="store_true", help="print surviving mutants")
+    ap.add_argument(
+        "--survivors",
+        action="store_true",
+        help="re-run only the mutants not killed (and not equivalent) in the last run of the "
+        "same groups, e.g. after adding tests; the other verdicts are kept",
+    )
     args = ap.parse_args(argv)
 
     import mutmut
@@ -242,7 +272,17 @@ def main(argv: list[str] | None = None) -> int:
     if not args.report_only:
         files = [f for g in args.modules for f in GROUPS[g][0]]
         tests = [t for g in args.modules for t in GROUPS[g][1]]
-        wall = run_mutmut(files, tests, args.max_children)
+        names = None
+        if args.survivors:
+            names = [
+                name
+                for f in files
+                for name, status in statuses(f).items()
+                if status != "killed" and name not in equivalent
+            ]
+            print(f"re-running {len(names)} mutants that were not killed")
+        if names is None or names:
+            wall = run_mutmut(files, tests, args.max_children, names)
 
     command = (
         f"`nice -n 10 .venv/bin/python scripts/mutation.py --modules {' '.join(args.modules)}`"
@@ -259,14 +299,17 @@ def main(argv: list[str] | None = None) -> int:
         checked = any(c["mutants"] > c["other"] for c in modules.values())
         if not modules or (wall is None and not checked):
             continue  # nothing measured (or verdicts reset by a later run of other groups)
-        previous = results["groups"].get(group, {})
-        results["groups"][group] = {
-            "modules": modules,
-            "command": command if wall is not None else previous.get("command", command),
-            "wall_s": round(wall, 1) if wall is not None else previous.get("wall_s", 0.0),
-            "date": str(date.today()) if wall is not None else previous.get("date", "?"),
-            "machine": machine() if wall is not None else previous.get("machine", "?"),
-        }
+        run = dict(results["groups"].get(group, {}))
+        if wall is not None and args.survivors:
+            run["rerun"] = (
+                f"{command[:-1]} --survivors`: {len(names or [])} mutants not killed before,"
+                f" {wall / 60:.1f} min, {date.today()}"
+            )
+        elif wall is not None:
+            run = {"command": command, "wall_s": round(wall, 1), "date": str(date.today())}
+            run["machine"] = machine()
+        run["modules"] = modules
+        results["groups"][group] = run
         if args.list_survivors:
             print(f"# {group}: not killed, not equivalent")
             print("\n".join(survivors) or "(none)")
