@@ -186,3 +186,12 @@ def test_ray_bad_input_messages_and_point_shapes():
     # a point given as a (1, 2) row (e.g. one row of cell_to_world's output) is a point
     row = ray_cells(UNIT, np.array([[0.5, 0.5]]), np.array([[3.5, 0.5]]))
     assert row.tolist() == [[0, 0], [0, 1], [0, 2], [0, 3]]
+
+
+def test_ray_buffer_holds_the_longest_traversal_of_a_tall_grid():
+    from sfw_gym.mapping.raycast import ray_buffer_size
+
+    tall = GridSpec((0.0, 0.0), 1.0, (50, 3))
+    c = ray_cells(tall, (0.01, 0.01), (2.99, 49.99))  # corner to corner: rows + cols - 1 cells
+    assert len(c) == 52 and len(c) <= ray_buffer_size(tall.shape)
+    assert len(ray_cells(GridSpec((0.0, 0.0), 1.0, (3, 50)), (0.01, 0.01), (49.99, 2.99))) == 52

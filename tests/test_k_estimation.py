@@ -312,3 +312,29 @@ def test_a_level_stronger_than_the_calibrated_k0_is_k_zero():
     two_levels(est, 0, -100.0)
     est.refit(force=True)
     assert est.thresholds(0) == pytest.approx([-50.0, -65.0, -75.0])
+
+
+def test_reset_restores_the_every_sample_reservoir():
+    # readings alternate between two levels: a reservoir that kept every other sample would
+    # see one level only and fit nothing
+    cfg = MapperConfig(filter_window=1, refit_min_samples=1000)
+    est = KEstimator(1, cfg)
+    for i in range(3000):  # long enough to fill and thin the fit buffer
+        est.add([-45.0 - (i % 5)], [1.0])
+    est.reset()
+    for i in range(20):
+        est.add([-40.0 if i % 2 == 0 else -60.0], [1.0])
+    est.refit(force=True)
+    assert est.n_refits == 1
+    assert est.thresholds(0) == pytest.approx([-50.0, -65.0, -75.0])
+
+
+def test_refit_merges_levels_below_the_minimum_fraction():
+    # 20 readings at -40 dBm, 2 at -70 dBm (9 % < 20 %): one level at (-800 - 140) / 22
+    cfg = MapperConfig(filter_window=1, refit_min_samples=1000, min_level_fraction=0.2)
+    est = KEstimator(1, cfg)
+    for rssi in [-40.0] * 20 + [-70.0] * 2:
+        est.add([rssi], [1.0])
+    est.refit(force=True)
+    top = (-800.0 - 140.0) / 22
+    assert est.thresholds(0) == pytest.approx([top - 5.0, top - 15.0, top - 25.0])

@@ -201,7 +201,7 @@ def test_router_and_point_input_checks(open_hall):
     for bad in (np.zeros((1, 3)), np.zeros((0, 2))):
         with pytest.raises(ConfigError, match=r"routers must have shape \(R, 2\) with R ≥ 1"):
             RadioModel(open_hall, bad)
-    with pytest.raises(ConfigError, match=r"points must be finite \(got NaN or inf\)"):
+    with pytest.raises(ConfigError, match=r"^points must be finite \(got NaN or inf\)$"):
         model.mean_rssi(np.array([np.inf, 1.0]))
 
 
@@ -275,3 +275,12 @@ def test_shadowing_table_covers_the_bounds_and_interpolates_between_nodes():
     np.testing.assert_allclose(f(node[None]), f.table_db[None, :, 2, 3])
     halfway = (f.table_db[:, 2, 3] + f.table_db[:, 2, 4]) / 2
     np.testing.assert_allclose(f((node + np.array([0.25, 0.0]))[None])[0], halfway)
+
+
+def test_shadowing_table_covers_bounds_left_of_and_below_the_origin():
+    from sfw_gym.world.radio import ShadowingField
+
+    f = ShadowingField((-4.0, -3.0, 1.2, -1.0), 1, 4.0, 5.0, np.random.default_rng(0))
+    _, ny, nx = f.table_db.shape
+    assert f.origin.tolist() == [-4.5, -3.5]
+    assert f.origin[0] + 0.5 * (nx - 1) >= 1.7 and f.origin[1] + 0.5 * (ny - 1) >= -0.5
