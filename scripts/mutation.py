@@ -51,8 +51,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import platform
+import random
 import re
 import subprocess
 import sys
@@ -156,6 +158,26 @@ def run_mutmut(
     return wall
 
 
+def sample_mutants(files: list[str], n: int, tests: list[str], max_children: int) -> list[str]:
+    """``n`` mutant names per file, drawn with seed 0 (mutmut generates them first if needed)."""
+    if not all(statuses(f) for f in files):
+        run_mutmut(files, tests, max_children, names=["none.such.mutant"])  # generate only
+    rng = random.Random(0)
+    names: list[str] = []
+    for f in files:
+        population = sorted(statuses(f))
+        chosen = set(rng.sample(population, min(n, len(population))))
+        names += sorted(chosen)
+        # forget earlier verdicts outside the sample, so that the table counts the sample only
+        meta = ROOT / "mutants" / (f + ".meta")
+        data = json.loads(meta.read_text())
+        for name in population:
+            if name not in chosen:
+                data["exit_code_by_key"][name] = None
+        meta.write_text(json.dumps(data))
+    return names
+
+
 def statuses(path: str) -> dict[str, str]:
     """Mutant name -> mutmut status, from mutmut's meta file for ``path``."""
     from mutmut.stats import status_by_exit_code
@@ -178,6 +200,8 @@ def tally(path: str, equivalent: dict[str, str]) -> tuple[dict[str, int], list[s
     counts = dict.fromkeys(COLUMNS, 0)
     open_mutants, stale = [], []
     for name, status in sorted(statuses(path).items()):
+        if status == "not checked":  # outside a sampled run's sample
+            continue
         counts["mutants"] += 1
         if name in equivalent:
             if status == "killed":
@@ -199,14 +223,31 @@ def score(c: dict[str, int]) -> float:
     return c["killed"] / denominator if denominator else float("nan")
 
 
+def wilson(c: dict[str, int]) -> tuple[float, float]:
+    """95 % Wilson interval of the score (for a random sample of a module's mutants)."""
+    n = c["mutants"] - c["equivalent"]
+    if not n:
+        return float("nan"), float("nan")
+    p, z = c["killed"] / n, 1.96
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return centre - half, centre + half
+
+
 def table(results: dict) -> str:
     head = ["group", "module", *COLUMNS, "score"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * 2 + "---:|" * (len(head) - 2)]
     for group in GROUPS:
         if group not in results["groups"]:
             continue
-        for path, c in results["groups"][group]["modules"].items():
-            cells = [group, f"`{path}`", *(str(c[k]) for k in COLUMNS), f"{score(c):.1%}"]
+        run = results["groups"][group]
+        for path, c in run["modules"].items():
+            cell = f"{score(c):.1%}"
+            if run.get("sample"):
+                low, high = wilson(c)
+                of = run.get("population", {}).get(path, "?")
+                cell += f" (95 % CI {low:.0%}–{high:.0%}; sample of {of})"
+            cells = [group, f"`{path}`", *(str(c[k]) for k in COLUMNS), cell]
             lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
@@ -276,6 +317,15 @@ def main(argv: list[str] | None = None) -> int:
         help="re-run only the mutants not killed (and not equivalent) in the last run of the "
         "same groups, e.g. after adding tests; the other verdicts are kept",
     )
+    ap.add_argument(
+        "--sample",
+        type=int,
+        default=0,
+        metavar="N",
+        help="run a random sample (seed 0) of N mutants per module instead of all of them; the "
+        "table then gives the score's 95 %% Wilson interval (for groups whose tests run whole "
+        "episodes: all of their mutants take hours on 2 cores)",
+    )
     args = ap.parse_args(argv)
 
     import mutmut
@@ -297,12 +347,14 @@ def main(argv: list[str] | None = None) -> int:
                 if status != "killed" and name not in equivalent
             ]
             print(f"re-running {len(names)} mutants that were not killed")
+        elif args.sample:
+            names = sample_mutants(files, args.sample, tests, args.max_children)
+            print(f"running a sample of {len(names)} mutants")
         if names is None or names:
             wall = run_mutmut(files, tests, args.max_children, names)
 
-    command = (
-        f"`nice -n 10 .venv/bin/python scripts/mutation.py --modules {' '.join(args.modules)}`"
-    )
+    command = f"`nice -n 10 .venv/bin/python scripts/mutation.py --modules {' '.join(args.modules)}"
+    command += f" --sample {args.sample}`" if args.sample else "`"
     for group in args.modules:
         modules, survivors = {}, []
         for path in GROUPS[group][0]:
@@ -323,8 +375,11 @@ def main(argv: list[str] | None = None) -> int:
             )
         elif wall is not None:
             run = {"command": command, "wall_s": round(wall, 1), "date": str(date.today())}
-            run["n_mutants"] = sum(len(statuses(f)) for g in args.modules for f in GROUPS[g][0])
+            run["n_mutants"] = len(names) if names else sum(len(statuses(f)) for f in files)
             run["machine"] = machine()
+            if args.sample:
+                run["sample"] = args.sample
+                run["population"] = {f: len(statuses(f)) for f in GROUPS[group][0]}
         run["modules"] = modules
         results["groups"][group] = run
         if args.list_survivors:

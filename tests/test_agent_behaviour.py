@@ -21,6 +21,8 @@ tests do not flake; the margins leave room for numerical differences across plat
 
 from __future__ import annotations
 
+import functools
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -72,40 +74,42 @@ def run_random_goals(seed: int) -> float:
     return info["coverage"]
 
 
-@pytest.fixture(scope="module")
-def episodes() -> dict[str, np.ndarray]:
-    """Coverage per agent and seed; the goal choices of the goal-choosing agents."""
-    choices: dict[str, list] = {name: [] for name in GOAL_CHOOSERS}
-    cov = {
-        name: np.array([run_agent(name, s, choices.get(name)) for s in SEEDS])
-        for name in (*GOAL_CHOOSERS, "random")
-    }
-    cov["random goals"] = np.array([run_random_goals(s) for s in SEEDS])
-    return {"coverage": cov, "choices": choices}
+@functools.cache
+def episodes(name: str) -> tuple[np.ndarray, list]:
+    """Coverage per seed and the recorded goal choices of one agent (computed once per run,
+    per agent: a test needs only the agents it compares)."""
+    if name == "random goals":
+        return np.array([run_random_goals(s) for s in SEEDS]), []
+    choices: list | None = [] if name in GOAL_CHOOSERS else None
+    return np.array([run_agent(name, s, choices) for s in SEEDS]), choices or []
+
+
+def coverage(name: str) -> np.ndarray:
+    return episodes(name)[0]
 
 
 @pytest.mark.parametrize("name", GOAL_CHOOSERS)
-def test_goal_choosing_agents_reach_a_coverage_floor(episodes, name):
-    cov = episodes["coverage"][name]
+def test_goal_choosing_agents_reach_a_coverage_floor(name):
+    cov = coverage(name)
     assert cov.mean() >= 0.50, cov  # measured 0.63-0.64
     assert cov.min() >= 0.35, cov  # measured >= 0.51
 
 
 @pytest.mark.parametrize("name", GOAL_CHOOSERS)
-def test_goal_choosing_agents_beat_random_actions_on_every_seed(episodes, name):
-    margin = episodes["coverage"][name] - episodes["coverage"]["random"]
+def test_goal_choosing_agents_beat_random_actions_on_every_seed(name):
+    margin = coverage(name) - coverage("random")
     assert margin.min() >= 0.15, margin  # measured >= 0.35
 
 
-def test_frontier_beats_random_goals_paired(episodes):
-    margin = episodes["coverage"]["frontier"] - episodes["coverage"]["random goals"]
+def test_frontier_beats_random_goals_paired():
+    margin = coverage("frontier") - coverage("random goals")
     assert margin.mean() >= 0.08, margin  # measured +0.18 (two seeds within ±0.04)
     assert (margin > 0).sum() >= 5, margin  # measured 7 of 8
 
 
 @pytest.mark.parametrize("name", GOAL_CHOOSERS)
-def test_the_chosen_goal_is_the_best_of_the_menu_by_the_agents_own_score(episodes, name):
-    choices = episodes["choices"][name]
+def test_the_chosen_goal_is_the_best_of_the_menu_by_the_agents_own_score(name):
+    choices = episodes(name)[1]
     assert len(choices) >= 20, "too few frontier choices to judge"
     for target, menu in choices:
         scores = dict(menu)
