@@ -102,7 +102,7 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
             "tests/test_rewards.py",
         ],
     ),
-    "cli": (["sfw_gym/cli.py"], ["tests/test_cli.py"]),
+    "cli": (["sfw_gym/cli.py"], ["tests/test_cli.py", "tests/test_demo.py"]),
 }
 
 COLUMNS = ["mutants", "killed", "survived", "timeout", "no tests", "other", "equivalent"]

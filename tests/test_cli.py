@@ -217,3 +217,28 @@ def test_console_script_reports_bad_input_in_one_line(tmp_path):
     assert re.fullmatch(r"sfw-gym map: error: \S*missing\.csv: no such file\n", proc.stderr), (
         proc.stderr
     )
+
+
+def run_cli(argv: list[str], capsys: pytest.CaptureFixture) -> str:
+    assert main(argv) == 0
+    return capsys.readouterr().out
+
+
+def test_world_is_reproducible_from_its_seed(inputs, capsys):
+    """The same --seed draws the same plan and routers (printed with their positions)."""
+    argv = ["world", "--seed", "5", "--out", "w.png", "--resolution", "0.5", "--routers", "3"]
+    first = run_cli(argv, capsys).splitlines()[0]
+    assert first == run_cli(argv, capsys).splitlines()[0]
+    assert first != run_cli([*argv[:2], "6", *argv[3:]], capsys).splitlines()[0]
+    assert first.count("[") == 4  # three router positions in a list
+
+
+def test_map_reports_which_columns_feed_which_router(inputs, capsys):
+    out = run_cli([arg.replace("{tmp}", str(inputs)) for arg in MAP], capsys)
+    assert "4 samples, 0 rows skipped" in out and "routers <- columns r1" in out
+
+
+def test_bench_memory_option_reports_rss(inputs, capsys):
+    out = run_cli([*BENCH, "--memory-steps", "30"], capsys)
+    assert re.search(r"memory: RSS .* MiB before, .* MiB after 30 steps", out)
+    assert "SfW-ExploreSmall-v0" in out and "CartPole-v1" in out and "load average" in out

@@ -88,9 +88,10 @@ class GreedyInfoGainAgent(FrontierAgent):
         first[:, 1:] = flat[:, 1:] != flat[:, :-1]
         gain = (unknown.ravel()[flat] & first).sum(axis=1).astype(np.float64)
         foot = np.asarray(self._reach_offsets)
-        fr = np.clip(cells[:, None, 0] + foot[None, :, 0], 0, h - 1)
-        fc = np.clip(cells[:, None, 1] + foot[None, :, 1], 0, w - 1)
-        return gain + unknown[fr, fc].sum(axis=1)
+        fr = cells[:, None, 0] + foot[None, :, 0]
+        fc = cells[:, None, 1] + foot[None, :, 1]
+        inside = (fr >= 0) & (fr < h) & (fc >= 0) & (fc < w)  # footprint cells off the grid
+        return gain + (unknown[fr.clip(0, h - 1), fc.clip(0, w - 1)] & inside).sum(axis=1)
 
     def _choose_goal(self, view: RobotView, paths: CostField) -> Goal | None:
         self.candidates = []

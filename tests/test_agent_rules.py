@@ -1,0 +1,209 @@
+"""The agents' documented rules, worked on hand-made inputs (found missing by mutation review)."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import sfw_gym  # noqa: F401  (registers the envs)
+from sfw_gym.agents import CrossPassAgent, FrontierAgent, GreedyInfoGainAgent, RandomAgent
+from sfw_gym.agents.base import RobotView
+from sfw_gym.agents.ppo import waypoint_settings
+from sfw_gym.errors import ConfigError
+from sfw_gym.navigation import cost_field, disk_offsets
+from tests.test_agents import F, FakeEnv, U, W, _walled_room_with_unreachable_frontier
+
+SMALL = "SfW-ExploreSmall-v0"
+
+
+# ------------------------------------------------------------------------------ random agent
+def random_actions(action_type: str, hold_steps: int, n: int = 40) -> list:
+    env = gym.make(SMALL, action_type=action_type)
+    obs, _ = env.reset(seed=0)
+    agent = RandomAgent(hold_steps=hold_steps)
+    agent.reset(env, seed=0)
+    actions, bumps = [], []
+    for _ in range(n):
+        actions.append(np.asarray(agent.act(obs)).tolist())
+        obs, *_ = env.step(actions[-1])
+        bumps.append(env.unwrapped.scene.robot.bumped)
+    return actions, bumps
+
+
+def test_random_agent_holds_each_draw_for_hold_steps_and_draws_anew_after_a_bump():
+    actions, bumps = random_actions("continuous", hold_steps=3, n=300)
+    assert actions[0] != [0.0, 0.0]  # the first action is a draw
+    values = np.array(actions)
+    assert values.min() < -0.5 and values.max() > 0.5  # uniform on [-1, 1]
+    start = 0  # the current draw was made at this step
+    for t in range(1, len(actions)):
+        if bumps[t - 1] or t - start == 3:
+            start = t  # a new draw: after a bump, or after hold_steps steps
+        else:
+            assert actions[t] == actions[start], t
+    assert any(bumps)
+
+
+def test_random_agent_discrete_actions_cover_all_three():
+    actions, _ = random_actions("discrete", hold_steps=1, n=60)
+    assert set(np.ravel(actions).tolist()) == {0, 1, 2}
+
+
+def test_random_agent_parameters():
+    RandomAgent(hold_steps=1)  # the i.i.d. random policy
+    for bad in (0, 1.5, True):
+        with pytest.raises(ConfigError, match="hold_steps"):
+            RandomAgent(hold_steps=bad)
+    env = gym.make(SMALL)
+    obs, _ = env.reset(seed=0)
+    agent = RandomAgent(max_steps=3)
+    agent.reset(env, seed=0)
+    for _ in range(3):
+        agent.act(obs)
+    assert agent.act(obs).tolist() == [0.0, 0.0] and agent.stop_reason == "max_steps"
+
+
+# ------------------------------------------------------------------------------ base
+def test_params_are_every_constructor_parameter_of_the_class_chain():
+    agent = CrossPassAgent(band_m=0.5, potential_scale=2.0)
+    params = agent.params()
+    assert params["band_m"] == 0.5 and params["potential_scale"] == 2.0
+    assert {"band_bonus", "gain_scale", "stall_steps", "max_steps"} <= set(params)
+    assert "self" not in params and "frontier_params" not in params
+
+
+# ------------------------------------------------------------------------------ PPO agent config
+def test_waypoint_settings_of_a_config_without_wrapper_or_hyperparameters():
+    assert waypoint_settings({}) is None
+    assert waypoint_settings({"hyperparameters": {}}) is None
+    name = "sfw_gym.envs.waypoint.WaypointWrapper"
+    config = {"hyperparameters": {"env_wrapper": [{name: {"grid_cells": 4}}]}}
+    assert waypoint_settings(config) == {"grid_cells": 4}
+
+
+# ------------------------------------------------------------------------------ greedy
+def greedy_on(belief: np.ndarray, routers, pose=(0.05, 0.05, 0.0)):
+    """A greedy agent bound to a fake env showing ``belief``, zones fixed to router 0."""
+    env = FakeEnv(belief, pose=pose, routers=routers)
+    agent = GreedyInfoGainAgent()
+    agent.reset(env, seed=0)
+    agent._zone = np.zeros(belief.shape, np.int64)
+    agent._zones_at = agent.steps
+    view = RobotView(**env.robot_view())
+    return agent, view
+
+
+def test_expected_gain_counts_each_unknown_ray_cell_once_plus_the_footprint():
+    b = np.full((10, 10), F, np.uint8)
+    b[4, :] = U  # one unknown row; the router at its left end, the candidate at its right end
+    agent, view = greedy_on(b, routers=((0.05, 0.45),))
+    assert len(agent._reach_offsets) == len(disk_offsets(1.1)) == 5
+    # ray: the 10 cells of row 4; footprint (a 5-cell cross): the unknown (4, 9), (4, 8), the
+    # free (3, 9), (5, 9); (4, 10) lies outside the grid and counts for nothing
+    assert agent.expected_gain(view, np.array([[4, 9]])).tolist() == [10 + 2]
+    # the same along the top and the bottom row (two footprint cells outside the grid)
+    for row in (0, 9):
+        b = np.full((10, 10), F, np.uint8)
+        b[row, :] = U
+        agent, view = greedy_on(b, routers=((0.05, row * 0.1 + 0.05),))
+        assert agent.expected_gain(view, np.array([[row, 9]])).tolist() == [10 + 2]
+    # and up the first column
+    b = np.full((10, 10), F, np.uint8)
+    b[:, 0] = U
+    agent, view = greedy_on(b, routers=((0.05, 0.05),))
+    assert agent.expected_gain(view, np.array([[9, 0]])).tolist() == [10 + 2]
+
+
+def test_greedy_subsamples_its_candidates_evenly():
+    b = np.full((30, 30), F, np.uint8)
+    b[:, 15:] = U
+    env = FakeEnv(b, pose=(0.5, 0.5, 0.0))
+    agent = GreedyInfoGainAgent(max_candidates=7)
+    agent.reset(env, seed=0)
+    agent.act(None)
+    assert len(agent.candidates) == 7
+    rows = [cell[0] for cell, _ in agent.candidates]
+    assert rows == sorted(rows) and rows[0] == 0 and rows[-1] == 29  # first to last, in order
+    with pytest.raises(ConfigError, match="max_candidates"):
+        GreedyInfoGainAgent(max_candidates=0)
+
+
+def test_greedy_zone_model_uses_the_readings_and_refits_every_zones_every_steps(monkeypatch):
+    import sfw_gym.agents.greedy as greedy
+
+    calls = []
+
+    def spy(grid, routers, xy, rssi, **kwargs):
+        calls.append((len(xy), None if rssi is None else len(rssi)))
+        return real(grid, routers, xy, rssi, **kwargs)
+
+    real = greedy.router_scores
+    monkeypatch.setattr(greedy, "router_scores", spy)
+    b = np.full((30, 30), F, np.uint8)
+    b[:, 15:] = U
+    env = FakeEnv(b, pose=(0.5, 0.5, 0.0))
+    agent = GreedyInfoGainAgent(zones_every_steps=25, replan_every_steps=1)
+    agent.reset(env, seed=0)
+    for _ in range(60):
+        env.step(agent.act(None))
+    assert 2 <= len(calls) <= 3  # steps 0, 25, 50
+    assert all(n_xy == n_rssi and n_xy >= 1 for n_xy, n_rssi in calls)
+    assert calls[-1][0] > calls[0][0]  # the path so far, with its readings
+
+
+def test_greedy_blacklists_walled_off_frontiers_for_a_while_and_says_so():
+    belief = _walled_room_with_unreachable_frontier()
+    env = FakeEnv(belief)
+    agent = GreedyInfoGainAgent(unreachable_ttl_steps=200)
+    agent.reset(env, seed=0)
+    for _ in range(5):
+        env.step(agent.act(None))
+    assert agent.stop_reason == "all_blacklisted"
+    assert agent.unreachable.any() and agent.unreachable_until.max() > agent.steps + 150
+
+
+# ------------------------------------------------------------------------------ frontier escape
+def test_escape_goal_reaches_a_hidden_room_behind_the_maps_wall():
+    b = np.full((30, 30), W, np.uint8)
+    b[1:29, 1:14] = F  # the explored room
+    b[1:3, 1:29] = F  # and a corridor along its top
+    b[4:29, 16:29] = U  # a room the map closed off (walls all round): no frontier, hidden
+    env = FakeEnv(b, pose=(0.5, 1.5, 0.0))
+    agent = FrontierAgent()
+    agent.reset(env, seed=0)
+    view = RobotView(**env.robot_view())
+    paths = cost_field(agent._costs(view, True), view.cell, view.grid.resolution_m)
+    goal = agent._escape_goal(view, paths, rooms_only=True)
+    assert goal is not None and goal.kind == "escape"
+    assert 21 <= goal.target[1] <= 23 and 10 <= goal.target[0] <= 22  # the room's deepest cells
+    assert agent._escape_goal(view, paths, rooms_only=False) is not None
+
+
+def test_sweep_goal_is_the_reachable_unvisited_cell_farthest_from_the_path():
+    b = np.full((12, 40), W, np.uint8)
+    b[1:11, 1:39] = F  # a closed, fully known corridor: nothing to explore, so it sweeps
+    env = FakeEnv(b, pose=(0.35, 0.55, 0.0))
+    agent = FrontierAgent()
+    agent.reset(env, seed=0)
+    agent.act(None)
+    assert agent.stop_reason == "no_frontiers"
+    assert agent.goal is not None and agent.goal.kind == "sweep"
+    assert agent.goal.cell[1] >= 35  # the far end of the corridor
+
+
+# ------------------------------------------------------------------------------ cross-pass loop
+def test_cross_pass_loop_is_a_rectangle_across_the_border():
+    b = np.full((30, 60), F, np.uint8)
+    b[:, 26:34] = U
+    b[0, :] = b[-1, :] = W
+    env = FakeEnv(b, pose=(1.5, 1.5, 0.0), routers=((1.0, 1.5), (5.0, 1.5)))
+    agent = CrossPassAgent(pass_trigger_m=10.0, pass_offset_m=0.5, pass_length_m=1.5)
+    agent.reset(env, seed=0)
+    agent.act(None)
+    cells = np.array([agent.goal.cell, *agent.goal.waypoints])
+    xs, ys = cells[:, 1] * 0.1 + 0.05, cells[:, 0] * 0.1 + 0.05
+    # legs along the border (x = 3 m), 0.5 m either side of it; 1.5 m long
+    assert sorted({round(x, 2) for x in xs}) == pytest.approx([2.55, 3.55], abs=0.11)
+    assert np.ptp(ys) == pytest.approx(1.5, abs=0.15)
+    assert len(cells) == 5 and (cells[0] == cells[-1]).all()
