@@ -161,8 +161,14 @@ def test_an_env_with_other_observations_is_refused(waypoint_model):
     env = gym.make("SfW-Explore-v0")
     obs, _ = env.reset(seed=0)
     agent.reset(env)
-    with pytest.raises(ConfigError, match="map_px"):
+    with pytest.raises(ConfigError, match="map_px") as error:
         agent.act(obs)
+    message = str(error.value)
+    assert str(waypoint_model) in message  # which policy
+    assert "'map': (3, 36, 36)" in message and "'map': (3, 64, 64)" in message  # trained vs got
+    assert agent.model_dir == str(waypoint_model)
+    with pytest.raises(ConfigError, match=r"PPOAgent\.act\(obs\) needs the env's \(Dict\)"):
+        agent.act(None)
 
 
 def test_missing_model_is_a_clear_error(tmp_path):
