@@ -214,6 +214,20 @@ class TestBadInput:
         with pytest.raises(ConfigError, match=match):
             env.reset(options=options)
 
+    @pytest.mark.parametrize(
+        "kwargs, match",
+        [
+            ({"crop_px": 10}, r"^crop_px"),
+            ({"max_steps": 10**7 + 1}, r"^max_steps"),
+            ({"max_steps": 1.5}, r"^max_steps"),
+            ({"max_steps": True}, r"^max_steps"),
+            ({"radio": "loud"}, r"^radio must be a dict of overrides, got str"),
+        ],
+    )
+    def test_bad_kwarg_values_name_the_kwarg(self, kwargs, match):
+        with pytest.raises(ConfigError, match=match):
+            gym.make("SfW-ExploreSmall-v0", **kwargs)
+
     def test_bad_kwargs(self):
         with pytest.raises(ConfigError, match="action_type"):
             gym.make("SfW-Explore-v0", action_type="teleport")
