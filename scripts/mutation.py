@@ -344,7 +344,7 @@ def main(argv: list[str] | None = None) -> int:
                 name
                 for f in files
                 for name, status in statuses(f).items()
-                if status != "killed" and name not in equivalent
+                if status not in ("killed", "not checked") and name not in equivalent
             ]
             print(f"re-running {len(names)} mutants that were not killed")
         elif args.sample:
