@@ -91,7 +91,12 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
     "navigation": (["sfw_gym/navigation.py"], ["tests/test_navigation.py"]),
     "agents": (
         sorted(str(p.relative_to(ROOT)) for p in (ROOT / "sfw_gym" / "agents").glob("*.py")),
-        ["tests/test_agents.py", "tests/test_agent_behaviour.py", "tests/test_ppo_agent.py"],
+        [
+            "tests/test_agents.py",
+            "tests/test_agent_rules.py",
+            "tests/test_agent_behaviour.py",
+            "tests/test_ppo_agent.py",
+        ],
     ),
     "env": (
         ["sfw_gym/envs/explore.py", "sfw_gym/envs/waypoint.py"],
