@@ -48,6 +48,20 @@ def test_random_agent_holds_each_draw_for_hold_steps_and_draws_anew_after_a_bump
 def test_random_agent_discrete_actions_cover_all_three():
     actions, _ = random_actions("discrete", hold_steps=1, n=60)
     assert set(np.ravel(actions).tolist()) == {0, 1, 2}
+    env = gym.make(SMALL, action_type="discrete")
+    obs, _ = env.reset(seed=0)
+    agent = RandomAgent(hold_steps=1)
+    agent.reset(env, seed=0)
+    for _ in range(20):  # drawn from the three actions' own commands, not mapped from [-1, 1]²
+        agent.act(obs)
+        assert agent.last_command in {(1.0, 0.0), (0.0, 1.0), (0.0, -1.0)}
+
+
+def test_robot_view_handle_refuses_an_object_without_an_env():
+    from sfw_gym.agents import RobotViewHandle
+
+    with pytest.raises(ConfigError, match="robot_view"):
+        RobotViewHandle(object())
 
 
 def test_random_agent_parameters():

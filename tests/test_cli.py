@@ -30,6 +30,7 @@ TINY_PPO = f"""{SMALL}:
 #: Input files, written to tmp_path by the ``inputs`` fixture; "{tmp}" in argv is tmp_path.
 INPUTS = {
     "log.csv": "x,y,r1\n0,0,-40\n1,0,-45\n1,1,-50\n0,1,-47\n",
+    "log2.csv": "x,y,a,b\n0,0,-40,-60\n1,0,-45,-55\n1,1,-50,-50\n0,1,-47,-58\n",
     "badlog.csv": "x,y,r1\n0,0,-40\n1,0,-4O\n",  # a letter O
     "notjson.json": "{not json",
     "badplan.json": '{"verts": [[0, 0], [1, 0]]}',  # JSON, but no polygon: a FloorplanError
@@ -236,6 +237,8 @@ def test_world_is_reproducible_from_its_seed(inputs, capsys):
 def test_map_reports_which_columns_feed_which_router(inputs, capsys):
     out = run_cli([arg.replace("{tmp}", str(inputs)) for arg in MAP], capsys)
     assert "4 samples, 0 rows skipped" in out and "routers <- columns r1" in out
+    out = run_cli(["map", "log2.csv", "--routers", "0.5,0.5;1.5,0.5", "--out", "m2.png"], capsys)
+    assert "routers <- columns a, b" in out
 
 
 def test_bench_memory_option_reports_rss(inputs, capsys):

@@ -8,7 +8,9 @@ from sfw_gym.cli import main
 def test_demo_writes_the_report(tmp_path, capsys):
     out = tmp_path / "report"
     assert main(["demo", "--out", str(out), "--episodes", "1", "--no-progress"]) == 0
-    assert f"report: {out / 'index.md'}" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert f"report: {out / 'index.md'}" in printed
+    assert "| agent | episodes | coverage |" in printed  # the results table, printed too
     index = (out / "index.md").read_text(encoding="utf-8")
     for agent in ("frontier", "cross-pass", "ppo"):
         assert f"| {agent} | 1 |" in index  # a results row per agent

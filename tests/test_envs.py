@@ -270,3 +270,13 @@ def test_env_classes_are_reachable_lazily_from_the_envs_package():
     assert envs.SfWExploreEnv is SfWExploreEnv and envs.WaypointWrapper is WaypointWrapper
     with pytest.raises(AttributeError):
         envs.NoSuchEnv  # noqa: B018
+
+
+def test_human_render_mode_draws_every_step(monkeypatch):
+    env = gym.make("SfW-ExploreSmall-v0", render_mode="human")
+    env.reset(seed=0)
+    drawn = []
+    monkeypatch.setattr(env.unwrapped, "render", lambda: drawn.append(1))
+    for _ in range(3):
+        env.step(env.action_space.sample())
+    assert len(drawn) == 3
