@@ -28,6 +28,10 @@ class GreedyInfoGainAgent(FrontierAgent):
         distance_offset_m: Added to the path distance (keeps near goals from dominating).
         zones_every_steps: Re-fit the router model this often.
         **frontier_params: Parameters of :class:`FrontierAgent`.
+
+    Attributes:
+        candidates: The latest choice's menu: ``(cell, score)`` per candidate; the goal is the
+            one of highest score.
     """
 
     name = "greedy"
