@@ -224,23 +224,10 @@ def test_cross_pass_loop_is_a_rectangle_across_the_border():
 
 
 # ------------------------------------------------------------------------------ parameters
-def numeric_parameters(cls) -> list[str]:
-    import inspect
-
-    names = []
-    for klass in cls.__mro__:
-        init = klass.__dict__.get("__init__")
-        if init is None:
-            continue
-        for p in inspect.signature(init).parameters.values():
-            if isinstance(p.default, int | float) and not isinstance(p.default, bool):
-                names.append(p.name)
-    return names
-
-
 @pytest.mark.parametrize("cls", [FrontierAgent, CrossPassAgent, GreedyInfoGainAgent, RandomAgent])
 def test_a_bad_value_of_any_parameter_is_an_error_naming_it(cls):
-    names = numeric_parameters(cls)
+    defaults = cls().params()  # every constructor parameter of the class chain
+    names = [k for k, v in defaults.items() if type(v) in (int, float)]
     assert names
     for name in names:
         with pytest.raises(ConfigError, match=rf"^{name} must be"):
