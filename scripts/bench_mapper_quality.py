@@ -50,7 +50,7 @@ from sfw_gym.mapping import (
     SparseInverseKVisibility,
     dense_inverse_k_visibility,
 )
-from sfw_gym.metrics import evaluate_map, k_value_accuracy
+from sfw_gym.mapping.metrics import evaluate_map, k_value_accuracy
 from sfw_gym.world import (
     Floorplan,
     RadioConfig,

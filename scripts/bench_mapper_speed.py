@@ -26,7 +26,7 @@ from dataclasses import replace
 import numpy as np
 
 from sfw_gym.mapping import GridSpec, MapperConfig, SparseInverseKVisibility
-from sfw_gym.metrics import evaluate_map, k_value_accuracy
+from sfw_gym.mapping.metrics import evaluate_map, k_value_accuracy
 
 SIDE_M = 15.0
 WALL_X = 7.5

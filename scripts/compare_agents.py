@@ -3,7 +3,7 @@
 Usage: ``python scripts/compare_agents.py [--episodes 20] [--houseexpo DIR] [--out runs/compare]
 [--agents frontier,cross-pass,random] [--env SfW-ExploreFull-v0] [--workers 2]``
 
-Runs ``sfw_gym.evaluate.evaluate`` twice — ``--episodes`` procedural plans (seeds 0, 1, …) and
+Runs ``sfw_gym.evaluation.evaluate`` twice — ``--episodes`` procedural plans (seeds 0, 1, …) and
 one episode per HouseExpo file (seeds 100, 101, …) — into ``OUT/generated`` and ``OUT/houseexpo``
 (each resumable), then prints both Markdown tables. Same as two ``sfw-gym evaluate`` calls.
 """
@@ -13,7 +13,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from sfw_gym.evaluate import evaluate
+from sfw_gym.evaluation import evaluate
 
 DEFAULT_HOUSEEXPO = Path(__file__).resolve().parents[2] / "shared" / "floorplans" / "houseexpo"
 

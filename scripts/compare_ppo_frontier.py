@@ -14,8 +14,8 @@ import argparse
 import csv
 from pathlib import Path
 
-from sfw_gym.agents.ppo import DEFAULT_MODEL_DIR
-from sfw_gym.evaluate import evaluate
+from sfw_gym.core.data import DEFAULT_MODEL_DIR
+from sfw_gym.evaluation import evaluate
 
 
 def trained_floorplans(model_dir: Path) -> set[str]:
@@ -37,7 +37,7 @@ def main() -> None:
     args = p.parse_args()
     out = Path(args.out)
     result = evaluate(["ppo", "frontier"], args.episodes, args.seed, out=out,
-                      agent_params={"ppo": {"model_dir": args.model}},
+                      agent_params={"ppo": {"path": args.model}},
                       workers=args.workers)  # fmt: skip
     seen = trained_floorplans(Path(args.model))
     plans = {r["floorplan"] for r in result["records"]}

@@ -88,7 +88,7 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
         ],
     ),
     "radio": (["sfw_gym/world/radio.py"], ["tests/test_radio.py"]),
-    "navigation": (["sfw_gym/navigation.py"], ["tests/test_navigation.py"]),
+    "navigation": (["sfw_gym/navigation/planning.py"], ["tests/test_navigation.py"]),
     "agents": (
         sorted(str(p.relative_to(ROOT)) for p in (ROOT / "sfw_gym" / "agents").glob("*.py")),
         [

@@ -5,8 +5,8 @@
 
 from __future__ import annotations
 
+from sfw_gym.core.errors import ConfigError, FloorplanError
 from sfw_gym.envs import ENV_IDS, register_envs
-from sfw_gym.errors import ConfigError, FloorplanError
 
 __version__ = "0.1.0"
 

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sfw_gym.errors import ConfigError, FloorplanError
+from sfw_gym.core.errors import ConfigError, FloorplanError
 
 
 def checked(convert: Callable, ok: Callable, what: str) -> Callable:
@@ -87,7 +87,7 @@ def _cmd_world(args: argparse.Namespace) -> int:
 
 def _cmd_map(args: argparse.Namespace) -> int:
     from sfw_gym.mapping import MapperConfig
-    from sfw_gym.offline import map_log, write_map
+    from sfw_gym.mapping.offline import map_log, write_map
 
     routers = parse_routers(args.routers)
     if isinstance(routers, int):
@@ -128,7 +128,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 def _cmd_train(args: argparse.Namespace) -> int:
     import gymnasium as gym
 
-    from sfw_gym.training import train_ppo
+    from sfw_gym.rl.training import train_ppo
 
     if ":" not in args.env:  # ("module:Env-v0" registers on import, in the workers)
         gym.spec(args.env)  # an unknown id: an --env error, not a missing YAML block
@@ -156,7 +156,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     import json
     from pathlib import Path
 
-    from sfw_gym.evaluate import evaluate
+    from sfw_gym.evaluation import evaluate
 
     def _json(option: str, text: str | None) -> dict:
         try:
@@ -190,7 +190,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
     start = time.perf_counter()
     index = run_demo(args.out, args.episodes, args.seed, workers=args.workers,
-                     progress=not args.no_progress)  # fmt: skip
+                     progress=not args.no_progress, model=args.model)  # fmt: skip
     print(index.parent.joinpath("results.md").read_text(encoding="utf-8"), end="")
     print(f"report: {index} ({time.perf_counter() - start:.0f} s)")
     return 0
@@ -203,7 +203,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", required=True)
 
-    from sfw_gym.demo import DEMO_SEED
+    from sfw_gym.demo import DEMO_EPISODES, DEMO_SEED
     from sfw_gym.world.radio import BANDS, PRESETS
 
     demo = sub.add_parser(
@@ -212,12 +212,17 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument(
         "--out", type=folder, default="sfw-report", help="report folder (default sfw-report)"
     )
-    demo.add_argument("--episodes", type=positive_int, default=3, help="floorplans (default 3)")
+    demo.add_argument(
+        "--episodes", type=positive_int, default=DEMO_EPISODES, help="floorplans (default 3)"
+    )
     demo.add_argument(
         "--seed", type=seed_int, default=DEMO_SEED, help="seed of the first floorplan"
     )
     demo.add_argument(
         "--workers", type=positive_int, default=2, help="worker processes (default 2)"
+    )
+    demo.add_argument(
+        "--model", default=None, help="a trained PPO folder or model.zip (default: the shipped one)"
     )
     demo.add_argument("--no-progress", action="store_true", help="no progress bar")
     demo.set_defaults(func=_cmd_demo)
@@ -285,7 +290,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     bench.set_defaults(func=_cmd_bench)
 
-    from sfw_gym.training import DEFAULT_HYPERPARAMS
+    from sfw_gym.core.data import DEFAULT_HYPERPARAMS
 
     train = sub.add_parser("train", help="train an agent (PPO, stable-baselines3)")
     train.add_argument("algo", choices=["ppo"], help="the algorithm (ppo)")

@@ -11,38 +11,54 @@ import time
 from pathlib import Path
 from typing import Any
 
-from sfw_gym.atomic import write_text_atomic
-from sfw_gym.evaluate import evaluate
+from sfw_gym.core.atomic import write_text_atomic
+from sfw_gym.core.data import scenario
+from sfw_gym.evaluation import evaluate
 
 DEMO_AGENTS = ("frontier", "cross-pass", "ppo")
 DEMO_ENV = "SfW-Explore-v0"  # the shipped policy's env
 #: Floorplan seeds far from those the shipped policy was trained on (its training resets used
-#: seeds 0-3 and their RNG streams; its held-out evaluation 1,000,000+).
-DEMO_SEED = 2_000_000
+#: seeds 0-3 and their RNG streams; its held-out evaluation 1,000,000+): envs/scenarios.yml.
+DEMO_SEED = int(scenario("demo")["seed"])
+DEMO_EPISODES = int(scenario("demo")["episodes"])
 
 
 def run_demo(
     out: str | Path = "sfw-report",
-    episodes: int = 3,
+    episodes: int = DEMO_EPISODES,
     seed: int = DEMO_SEED,
     *,
     workers: int = 2,
     progress: bool = True,
+    model: str | Path | None = None,
 ) -> Path:
-    """Run the demo (resumable, like any evaluation) and write ``OUT/index.md``; return its path."""
+    """Run the demo (resumable, like any evaluation) and write ``OUT/index.md``; return its path.
+
+    ``model``: a trained PPO folder (or its ``model.zip``) instead of the shipped policy.
+    """
     out = Path(out)
     start = time.perf_counter()
     result = evaluate(
-        list(DEMO_AGENTS), episodes, seed, out=out, env_id=DEMO_ENV, workers=workers,
-        gif_episodes=1, progress=progress,
-    )  # fmt: skip
+        list(DEMO_AGENTS),
+        episodes,
+        seed,
+        out=out,
+        env_id=DEMO_ENV,
+        workers=workers,
+        gif_episodes=1,
+        progress=progress,
+        agent_params={"ppo": {"path": str(model)}} if model is not None else None,
+    )
     index = out / "index.md"
     wall_s = time.perf_counter() - start
-    write_text_atomic(index, _index_markdown(out, result, seed, wall_s))
+    policy = str(model) if model is not None else "agents/ppo/SfW-Explore-v0_1"
+    write_text_atomic(index, _index_markdown(out, result, seed, wall_s, policy))
     return index
 
 
-def _index_markdown(out: Path, result: dict[str, Any], seed: int, wall_s: float) -> str:
+def _index_markdown(
+    out: Path, result: dict[str, Any], seed: int, wall_s: float, policy: str
+) -> str:
     records = result["records"]
     episodes = sorted({r["episode"] for r in records})
     plans = {r["episode"]: (r["floorplan"], r["area_m2"]) for r in records}
@@ -51,7 +67,7 @@ def _index_markdown(out: Path, result: dict[str, Any], seed: int, wall_s: float)
         "",
         f"`{DEMO_ENV}` (default radio, two routers, 3,000-step budget): frontier exploration, "
         "frontier with cross-connecting passes, and the pretrained PPO waypoint policy "
-        "(`agents/ppo/SfW-Explore-v0_1`) on the same procedural floorplans, start poses and "
+        f"(`{policy}`) on the same procedural floorplans, start poses and "
         f"seeds ({seed}–{seed + len(episodes) - 1}; never used in training). "
         f"Report written in {wall_s:.0f} s.",
         "",

@@ -8,10 +8,9 @@ import pytest
 
 import sfw_gym  # noqa: F401  (registers the envs)
 from sfw_gym.agents import CrossPassAgent, FrontierAgent, GreedyInfoGainAgent, RandomAgent
-from sfw_gym.agents.base import RobotView
-from sfw_gym.agents.ppo import waypoint_settings
-from sfw_gym.errors import ConfigError
-from sfw_gym.navigation import cost_field, disk_offsets
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.navigation.planning import cost_field, disk_offsets
+from sfw_gym.rl.agent import waypoint_settings
 from tests.test_agents import F, FakeEnv, U, W, _walled_room_with_unreachable_frontier
 
 SMALL = "SfW-ExploreSmall-v0"
@@ -104,7 +103,7 @@ def greedy_on(belief: np.ndarray, routers, pose=(0.05, 0.05, 0.0)):
     agent.reset(env, seed=0)
     agent._zone = np.zeros(belief.shape, np.int64)
     agent._zones_at = agent.steps
-    view = RobotView(**env.robot_view())
+    view = env.robot_view()
     return agent, view
 
 
@@ -186,7 +185,7 @@ def test_escape_goal_reaches_a_hidden_room_behind_the_maps_wall():
     env = FakeEnv(b, pose=(0.5, 1.5, 0.0))
     agent = FrontierAgent()
     agent.reset(env, seed=0)
-    view = RobotView(**env.robot_view())
+    view = env.robot_view()
     paths = cost_field(agent._costs(view, True), view.cell, view.grid.resolution_m)
     goal = agent._escape_goal(view, paths, rooms_only=True)
     assert goal is not None and goal.kind == "escape"

@@ -18,18 +18,21 @@ from sfw_gym.agents import (
     FrontierAgent,
     GreedyInfoGainAgent,
     RandomAgent,
+    RobotView,
     RobotViewHandle,
+    agent_class,
+    make_agent,
+)
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.mapping import GridSpec
+from sfw_gym.navigation import (
     dominance_bands,
     find_frontiers,
     frontier_mask,
     hidden_rooms,
-    make_agent,
     router_scores,
 )
-from sfw_gym.agents.base import VIEW_KEYS
-from sfw_gym.errors import ConfigError
-from sfw_gym.mapping import GridSpec
-from sfw_gym.navigation import (
+from sfw_gym.navigation.planning import (
     PurePursuit,
     cost_field,
     to_discrete,
@@ -128,21 +131,21 @@ class FakeEnv:
         self.unwrapped = self
         self.t = 0
 
-    def robot_view(self) -> dict[str, Any]:
-        return {
-            "belief_u8": self.belief.copy(),
-            "probability": np.where(self.belief == W, 0.9, 0.5).astype(np.float32),
-            "grid": self.grid,
-            "odometry_pose": tuple(self.pose),
-            "routers_xy": self.routers.copy(),
-            "rssi_history": np.tile(self._rssi(), (self.t + 1, 1)),
-            "bumped": False,
-            "radius_m": 0.17,
-            "max_linear_speed_m_s": 0.5,
-            "max_angular_speed_rad_s": 1.5,
-            "control_period_s": 0.2,
-            "action_type": "continuous",
-        }
+    def robot_view(self) -> RobotView:
+        return RobotView(
+            belief_u8=self.belief.copy(),
+            probability=np.where(self.belief == W, 0.9, 0.5).astype(np.float32),
+            grid=self.grid,
+            odometry_pose=tuple(self.pose),
+            routers_xy=self.routers.copy(),
+            rssi_history=np.tile(self._rssi(), (self.t + 1, 1)),
+            bumped=False,
+            radius_m=0.17,
+            max_linear_speed_m_s=0.5,
+            max_angular_speed_rad_s=1.5,
+            control_period_s=0.2,
+            action_type="continuous",
+        )
 
     def _rssi(self) -> np.ndarray:
         d = np.maximum(np.linalg.norm(self.routers - self.pose[:2], axis=1), 1.0)
@@ -235,7 +238,7 @@ class OnlyRobotView:
     def unwrapped(self) -> OnlyRobotView:
         return self
 
-    def robot_view(self) -> dict[str, Any]:
+    def robot_view(self) -> RobotView:
         return object.__getattribute__(self, "_view")()
 
     def __getattr__(self, name: str) -> Any:
@@ -291,12 +294,14 @@ def test_agent_cannot_reach_ground_truth_through_the_interface(name):
         obs, *_ = env2.step(b)
 
 
-def test_robot_view_handle_shows_only_the_documented_keys():
+def test_robot_view_handle_shows_only_the_documented_fields():
     env = gym.make(SMALL)
     env.reset(seed=0)
     view = RobotViewHandle(env)()
-    assert set(vars(view)) == VIEW_KEYS
-    assert not any("true" in k or "truth" in k or "scene" in k for k in VIEW_KEYS)
+    assert isinstance(view, RobotView)
+    fields = set(vars(view))
+    assert fields == {f for f in RobotView.__dataclass_fields__}
+    assert not any("true" in k or "truth" in k or "scene" in k for k in fields)
     with pytest.raises(TypeError):
         pickle.dumps(RobotViewHandle(env))
     with pytest.raises(ConfigError, match="robot_view"):
@@ -306,7 +311,7 @@ def test_robot_view_handle_shows_only_the_documented_keys():
 # ------------------------------------------------------------------------------ interface
 @pytest.mark.parametrize("name", sorted(AGENTS))
 def test_every_agent_builds_without_arguments_and_drives_both_action_types(name):
-    agent = AGENTS[name]()
+    agent = agent_class(name)()
     assert agent.name == name
     assert isinstance(agent.params(), dict)
     for env_kwargs in ({}, {"action_type": "discrete"}):

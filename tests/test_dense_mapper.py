@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.errors import ConfigError
 from sfw_gym.mapping import GridSpec, dense_inverse_k_visibility
 
 GRID = GridSpec((0.0, 0.0), 1.0, (8, 10))

@@ -11,7 +11,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env as gym_check_env
 
 import sfw_gym
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.errors import ConfigError
 
 ENV_IDS = sorted(sfw_gym.ENV_IDS)
 #: Warnings we accept from the checkers, with why.

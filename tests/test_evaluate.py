@@ -11,9 +11,10 @@ import numpy as np
 import pytest
 
 import sfw_gym  # noqa: F401
-from sfw_gym import evaluate as ev
+from sfw_gym import evaluation as ev
+from sfw_gym.evaluation import runner
 from sfw_gym.cli import main
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.errors import ConfigError
 
 SMALL = "SfW-ExploreSmall-v0"
 #: Short episodes keep the suite fast.
@@ -59,7 +60,7 @@ def test_interrupted_run_resumes_without_redoing_episodes(tmp_path, monkeypatch)
         calls.append(spec.key)
         return real(spec)
 
-    monkeypatch.setattr(ev, "run_episode", flaky)
+    monkeypatch.setattr(runner, "run_episode", flaky)
     with pytest.raises(KeyboardInterrupt):
         ev.evaluate(["frontier", "random"], 2, seed=0, out=tmp_path, **TINY)
     done = ev.load_checkpoint(tmp_path / ev.CHECKPOINT)
@@ -73,7 +74,7 @@ def test_interrupted_run_resumes_without_redoing_episodes(tmp_path, monkeypatch)
         rerun.append(spec.key)
         return real(spec)
 
-    monkeypatch.setattr(ev, "run_episode", counting)
+    monkeypatch.setattr(runner, "run_episode", counting)
     result = ev.evaluate(["frontier", "random"], 2, seed=0, out=tmp_path, **TINY)
     assert len(rerun) == 2 and not set(rerun) & set(calls)
     assert len(result["records"]) == 4

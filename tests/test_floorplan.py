@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from shapely.geometry import LineString, Polygon
 
-from sfw_gym.errors import FloorplanError
+from sfw_gym.core.errors import FloorplanError
 from sfw_gym.world.floorplan import Floorplan, floorplan_from_polygon, load_floorplan
 
 

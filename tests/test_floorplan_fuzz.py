@@ -7,7 +7,7 @@ import json
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from sfw_gym.errors import FloorplanError
+from sfw_gym.core.errors import FloorplanError
 from sfw_gym.world.floorplan import Floorplan, load_floorplan
 
 numbers = st.one_of(

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from scipy import ndimage
 from shapely.geometry import Point, Polygon
 
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.errors import ConfigError
 from sfw_gym.world.floorplan import MATERIALS, Floorplan, load_floorplan
 from sfw_gym.world.generator import ROBOT_RADIUS_M, generate_floorplan
 

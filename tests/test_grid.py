@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sfw_gym.errors import ConfigError
-from sfw_gym.mapping import GridSpec, classify_u8, ray_cells
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.mapping import GridSpec, belief_classes, ray_cells
 
 UNIT = GridSpec((0.0, 0.0), 1.0, (5, 5))
 
@@ -73,10 +73,11 @@ def test_bad_covering_raises():
         GridSpec.covering((0.0, 0.0, 1.0, 1.0), 0.1, margin_m=-0.1)
 
 
-def test_classify_u8_thirds():
-    wall, free = classify_u8(np.array([0, 84, 85, 127, 170, 171, 255], np.uint8))
+def test_belief_classes_thirds():
+    free, wall, unknown = belief_classes(np.array([0, 84, 85, 127, 170, 171, 255], np.uint8))
     assert wall.tolist() == [True, True, False, False, False, False, False]
     assert free.tolist() == [False, False, False, False, False, True, True]
+    assert unknown.tolist() == [False, False, True, True, True, False, False]
 
 
 def test_ray_axis_aligned():

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.errors import ConfigError
 from sfw_gym.mapping import KEstimator, MapperConfig
 from sfw_gym.mapping.k_estimation import fit_levels, merge_levels, thresholds_from_levels
 

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from sfw_gym.errors import ConfigError
-from sfw_gym.metrics import (
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.mapping.metrics import (
     coverage,
     entropy_bits,
     evaluate_map,

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from sfw_gym.mapping.grid import GridSpec
-from sfw_gym.navigation import (
+from sfw_gym.navigation.planning import (
     PurePursuit,
     belief_classes,
     cells_to_world,

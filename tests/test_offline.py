@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from sfw_gym.cli import main
-from sfw_gym.errors import ConfigError
-from sfw_gym.mapping import SparseInverseKVisibility, classify_u8
-from sfw_gym.offline import map_log, read_rssi_log, select_router_columns, write_map
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.mapping import SparseInverseKVisibility, belief_classes
+from sfw_gym.mapping.offline import map_log, read_rssi_log, select_router_columns, write_map
 
 # -- a synthetic two-room log (plain numpy) ------------------------------------------------------
 W, H, WALL_X, DOOR_Y = 6.0, 4.0, 3.0, 3.0  # metres; the wall x = 3, 0 <= y <= 3, door above
@@ -117,7 +117,7 @@ def test_map_equals_the_mapper_run_directly(mapped, two_room_log):
 
 def test_wall_found_and_visited_cells_free(mapped, two_room_log):
     grid, occ = mapped.grid, mapped.mapper.occupancy_u8
-    wall, free = classify_u8(occ)
+    free, wall, _ = belief_classes(occ)
     xs, ys = grid.cell_centres()
     near_wall = (np.abs(xs - WALL_X) <= 0.05 + 2 * grid.resolution_m) & (ys <= DOOR_Y + 0.1)
     assert wall[near_wall].sum() >= 0.6 * DOOR_Y / grid.resolution_m  # a wall, not a dot

@@ -8,10 +8,10 @@ import pytest
 import yaml
 
 import sfw_gym  # noqa: F401
-from sfw_gym.agents import PPOAgent
+from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.waypoint import WaypointWrapper
-from sfw_gym.errors import ConfigError
-from sfw_gym.training import train_ppo, wrapper_specs
+from sfw_gym.rl import PPOAgent
+from sfw_gym.rl.training import train_ppo, wrapper_specs
 
 SMALL = "SfW-ExploreSmall-v0"
 WAYPOINTS = {"grid_cells": 4, "max_steps_per_waypoint": 20}
@@ -39,7 +39,7 @@ def waypoint_model(tmp_path_factory):
 
 
 def test_agent_drives_the_raw_env_exactly_as_the_wrapper_did_in_training(waypoint_model):
-    agent = PPOAgent(model_dir=waypoint_model, deterministic=True)
+    agent = PPOAgent(path=waypoint_model, deterministic=True)
     assert agent.waypoints == WAYPOINTS
 
     wrapped = WaypointWrapper(gym.make(SMALL, max_steps=120), **WAYPOINTS)
@@ -67,7 +67,7 @@ def test_agent_drives_the_raw_env_exactly_as_the_wrapper_did_in_training(waypoin
 
 def test_sampled_waypoints_are_reproducible_from_the_agent_seed(waypoint_model):
     def goals(seed):
-        agent = PPOAgent(model_dir=waypoint_model)
+        agent = PPOAgent(path=waypoint_model)
         env = gym.make(SMALL, max_steps=60)
         obs, _ = env.reset(seed=3)
         agent.reset(env, seed=seed)
@@ -88,7 +88,7 @@ def continuous_model(tmp_path_factory):
 
 
 def test_a_policy_on_raw_continuous_actions_drives_directly(continuous_model):
-    agent = PPOAgent(model_dir=continuous_model)
+    agent = PPOAgent(path=continuous_model)
     assert agent.waypoints is None
     env = gym.make(SMALL, max_steps=40)
     obs, _ = env.reset(seed=0)
@@ -118,7 +118,7 @@ def run_ppo(agent: PPOAgent, env_id: str, steps: int, agent_seed: int) -> list:
 def test_deterministic_shipped_policy_takes_the_most_likely_waypoint_whatever_the_agent_seed():
     import torch
 
-    from sfw_gym.envs.waypoint import block_features, waypoint_goal_xy
+    from sfw_gym.navigation import block_features, waypoint_goal_xy
 
     agent = PPOAgent(deterministic=True)  # the shipped waypoint policy
     env = gym.make("SfW-Explore-v0")
@@ -126,13 +126,13 @@ def test_deterministic_shipped_policy_takes_the_most_likely_waypoint_whatever_th
     agent.reset(env, seed=0)
     agent.act(obs)
     view = env.unwrapped.robot_view()
-    blocks = block_features(view["belief_u8"], view["grid"], view["odometry_pose"], 8)
+    blocks = block_features(view.belief_u8, view.grid, view.odometry_pose, 8)
     policy = agent.model.policy
     with torch.no_grad():
         tensor, _ = policy.obs_to_tensor({**obs, "blocks": blocks})
         probs = policy.get_distribution(tensor).distribution.probs[0].numpy()
     assert probs.max() < 0.5  # far from one-hot: a sampled waypoint would differ from the mode
-    np.testing.assert_allclose(agent.goals[0], waypoint_goal_xy(view["grid"], 8, probs.argmax()))
+    np.testing.assert_allclose(agent.goals[0], waypoint_goal_xy(view.grid, 8, probs.argmax()))
     assert run_ppo(agent, "SfW-Explore-v0", 150, 0) == run_ppo(agent, "SfW-Explore-v0", 150, 1)
 
 
@@ -144,7 +144,7 @@ def test_sampling_shipped_policy_repeats_itself_for_one_agent_seed_only():
 
 
 def test_deterministic_continuous_policy_acts_with_its_mean_action(continuous_model):
-    agent = PPOAgent(model_dir=continuous_model, deterministic=True)
+    agent = PPOAgent(path=continuous_model, deterministic=True)
     env = gym.make(SMALL)
     obs, _ = env.reset(seed=0)
     agent.reset(env, seed=0)
@@ -157,7 +157,7 @@ def test_deterministic_continuous_policy_acts_with_its_mean_action(continuous_mo
 
 
 def test_an_env_with_other_observations_is_refused(waypoint_model):
-    agent = PPOAgent(model_dir=waypoint_model)  # trained on SMALL's 36 x 36 images
+    agent = PPOAgent(path=waypoint_model)  # trained on SMALL's 36 x 36 images
     env = gym.make("SfW-Explore-v0")
     obs, _ = env.reset(seed=0)
     agent.reset(env)
@@ -166,14 +166,14 @@ def test_an_env_with_other_observations_is_refused(waypoint_model):
     message = str(error.value)
     assert str(waypoint_model) in message  # which policy
     assert "'map': (3, 36, 36)" in message and "'map': (3, 64, 64)" in message  # trained vs got
-    assert agent.model_dir == str(waypoint_model)
+    assert agent.path == str(waypoint_model)
     with pytest.raises(ConfigError, match=r"PPOAgent\.act\(obs\) needs the env's \(Dict\)"):
         agent.act(None)
 
 
 def test_missing_model_is_a_clear_error(tmp_path):
     with pytest.raises(ConfigError, match=r"model\.zip not found"):
-        PPOAgent(model_dir=tmp_path)
+        PPOAgent(path=tmp_path)
 
 
 def test_env_wrapper_entries_in_rl_zoo_forms():
@@ -191,7 +191,7 @@ def test_env_wrapper_entries_in_rl_zoo_forms():
 def test_waypoint_policy_scores_every_block_with_one_network():
     import torch
 
-    from sfw_gym.agents.waypoint_policy import WaypointPolicy
+    from sfw_gym.rl.policy import WaypointPolicy
 
     env = WaypointWrapper(gym.make(SMALL), grid_cells=3)
     policy = WaypointPolicy(env.observation_space, env.action_space, lambda _: 1e-3)

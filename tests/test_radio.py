@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 from shapely.geometry import Polygon
 
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.constants import NOT_HEARD_DBM
+from sfw_gym.core.errors import ConfigError
 from sfw_gym.world.floorplan import Floorplan, floorplan_from_polygon
-from sfw_gym.world.radio import NOT_HEARD_DBM, RadioConfig, RadioModel
+from sfw_gym.world.radio import RadioConfig, RadioModel
 
 
 def noiseless(**kw) -> RadioConfig:

@@ -11,8 +11,8 @@ import pytest
 
 import sfw_gym  # noqa: F401  (registers the envs)
 from sfw_gym.agents import FrontierAgent
+from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.waypoint import WaypointWrapper
-from sfw_gym.errors import ConfigError
 
 SMALL = "SfW-ExploreSmall-v0"
 

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.errors import ConfigError
 from sfw_gym.world.robot import Pose, Robot, RobotConfig, StepResult
 
 CFG = RobotConfig()

@@ -10,9 +10,15 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from sfw_gym.errors import ConfigError
-from sfw_gym.mapping import GridSpec, MapperConfig, SparseInverseKVisibility, classify_u8, ray_cells
-from sfw_gym.metrics import interior_wall_recall, wall_precision
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.mapping import (
+    GridSpec,
+    MapperConfig,
+    SparseInverseKVisibility,
+    belief_classes,
+    ray_cells,
+)
+from sfw_gym.mapping.metrics import interior_wall_recall, wall_precision
 
 K0 = 20.0 - 40.2  # RSSI at 1 m with no wall: P_tx - PL(1 m)
 WALL_DB = 10.0
@@ -114,14 +120,14 @@ def test_two_rooms_wall_found_within_two_cells(two_room_result):
     est = mapper.occupancy_u8
     assert interior_wall_recall(est, truth, tolerance_cells=2) >= 0.7
     assert wall_precision(est, truth, tolerance_cells=2) >= 0.9
-    wall = classify_u8(est)[0]
+    wall = belief_classes(est)[1]
     xs, _ = grid.cell_centres()
     assert wall[np.abs(xs - WALL_X) <= 0.15].sum() >= 0.7 * DOOR_Y / 0.05  # a wall, not a dot
 
 
 def test_two_rooms_both_interiors_free(two_room_result):
     grid, mapper, _ = two_room_result
-    free = classify_u8(mapper.occupancy_u8)[1]
+    free = belief_classes(mapper.occupancy_u8)[0]
     xs, ys = grid.cell_centres()
     core = (ys > 0.4) & (ys < H - 0.4)
     for lo, hi in ((0.4, WALL_X - 0.4), (WALL_X + 0.4, W - 0.4)):
@@ -139,7 +145,7 @@ def test_pure_line_of_sight_gives_no_wall():
         mapper = run(
             SparseInverseKVisibility(grid, [router], MapperConfig(router_policy=policy)), traj, rssi
         )
-        wall, free = classify_u8(mapper.occupancy_u8)
+        free, wall, _ = belief_classes(mapper.occupancy_u8)
         assert not wall.any()
         xs, ys = grid.cell_centres()
         core = (xs > 0.3) & (xs < 3.7) & (ys > 0.3) & (ys < 3.7)
@@ -286,14 +292,14 @@ def test_entropy_changes_and_views_stay_consistent(two_room_result):
     rssi = rssi_at(traj, mapper.routers_xy[0], TWO_ROOM_WALLS, np.random.default_rng(3))
     total = 0.0
     for p, r in zip(traj, rssi, strict=True):
-        wall0, free0 = classify_u8(fresh.occupancy_u8)
+        free0, wall0, _ = belief_classes(fresh.occupancy_u8)
         cls0 = wall0 * 2 + free0
         total += fresh.update(p, [r])
-        wall1, free1 = classify_u8(fresh.occupancy_u8)
+        free1, wall1, _ = belief_classes(fresh.occupancy_u8)
         cls1 = wall1 * 2 + free1
         assert set(fresh.last_changed_cells.tolist()) == set(np.flatnonzero(cls1 != cls0))
     assert total == pytest.approx(grid.shape[0] * grid.shape[1] - fresh.entropy_bits)
-    assert np.array_equal(fresh.classified, classify_u8(fresh.occupancy_u8)[0] | free1)
+    assert np.array_equal(fresh.classified, belief_classes(fresh.occupancy_u8)[1] | free1)
     p = fresh.probability
     assert p.dtype == np.float32
     assert np.allclose(p, 1 / (1 + np.exp(-fresh.log_odds.astype(np.float64))), atol=1e-6)

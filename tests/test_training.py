@@ -10,8 +10,8 @@ import time
 
 import pytest
 
-from sfw_gym.errors import ConfigError
-from sfw_gym.training import (
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.rl.training import (
     DEFAULT_HYPERPARAMS,
     latest_checkpoint,
     load_hyperparams,
@@ -24,7 +24,7 @@ TINY = {"max_steps": 40}
 
 def test_hyperparams_load_for_every_block():
     params = load_hyperparams("SfW-Explore-v0")
-    assert params["policy"] == "sfw_gym.agents.waypoint_policy.WaypointPolicy"
+    assert params["policy"] == "sfw_gym.rl.policy.WaypointPolicy"
     assert params["env_wrapper"][0]["sfw_gym.envs.waypoint.WaypointWrapper"]["grid_cells"] == 8
     small = load_hyperparams("SfW-ExploreSmall-v0")
     assert small["policy_kwargs"]["net_arch"] == {"pi": [64], "vf": [64]}
@@ -41,7 +41,7 @@ def test_policy_kwargs_are_parsed_safely():
 def test_killed_run_resumes_from_its_last_checkpoint(tmp_path):
     out = tmp_path / "run"
     script = textwrap.dedent(f"""
-        from sfw_gym.training import train_ppo
+        from sfw_gym.rl.training import train_ppo
         train_ppo("SfW-ExploreSmall-v0", 100_000, {str(out)!r}, n_envs=1, env_kwargs={TINY!r},
                   checkpoint_every=64, eval_every=10**9, progress_bar=False)
     """)

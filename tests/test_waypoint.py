@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import sfw_gym  # noqa: F401
+from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.waypoint import WaypointWrapper
-from sfw_gym.errors import ConfigError
 
 
 @pytest.mark.parametrize("env_id", ["SfW-Explore-v0", "SfW-ExploreDiscrete-v0"])
@@ -42,8 +42,8 @@ def test_waypoint_rejects_bad_actions_and_args():
 
 
 def test_waypoint_centres_tile_the_square_around_a_tall_grid():
-    from sfw_gym.envs.waypoint import waypoint_goal_xy
     from sfw_gym.mapping import GridSpec
+    from sfw_gym.navigation import waypoint_goal_xy
 
     grid = GridSpec((0.0, -5.0), 0.5, (20, 4))  # x in [0, 2], y in [-5, 5]: a 10 m square
     centres = waypoint_goal_xy(grid, 2, np.arange(4))
@@ -51,8 +51,8 @@ def test_waypoint_centres_tile_the_square_around_a_tall_grid():
 
 
 def test_block_features_by_hand():
-    from sfw_gym.envs.waypoint import BLOCK_FEATURES, block_features
     from sfw_gym.mapping import GridSpec
+    from sfw_gym.navigation import BLOCK_FEATURES, block_features
 
     belief = np.zeros((4, 4), np.uint8)  # rows 2-3: walls
     belief[0:2, 0:2] = 127  # block 0: unknown
@@ -67,14 +67,14 @@ def test_block_features_by_hand():
 
 
 def test_driver_backs_off_one_step_after_a_bump_then_ends_the_waypoint():
-    from sfw_gym.envs.waypoint import WaypointDriver
+    from sfw_gym.navigation import WaypointDriver
 
     env = gym.make("SfW-Explore-v0")
     env.reset(seed=1)
     view = env.unwrapped.robot_view()
     driver = WaypointDriver(grid_cells=4)
     driver.start(view, 15)
-    pose = view["odometry_pose"]
+    pose = view.odometry_pose
     assert driver.command(pose, bumped=False) is not None
     assert driver.command(pose, bumped=True) == (-1.0, 0.0)  # straight back
     assert driver.command(pose, bumped=False) is None

@@ -7,29 +7,57 @@ Every agent is built with keyword parameters (all optional), bound to an episode
 
 from __future__ import annotations
 
+import importlib
 from typing import Any
 
 from sfw_gym.agents.base import STOP_REASONS, Agent, RobotView, RobotViewHandle
-from sfw_gym.agents.cross_pass import CrossPassAgent, dominance_bands, router_scores
-from sfw_gym.agents.frontier import FrontierAgent, find_frontiers, frontier_mask, hidden_rooms
+from sfw_gym.agents.cross_pass import CrossPassAgent
+from sfw_gym.agents.frontier import FrontierAgent
 from sfw_gym.agents.greedy import GreedyInfoGainAgent
-from sfw_gym.agents.ppo import PPOAgent
 from sfw_gym.agents.random_agent import RandomAgent
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.errors import ConfigError
 
-#: Agents by their command-line name.
-AGENTS: dict[str, type[Agent]] = {
-    cls.name: cls
-    for cls in (FrontierAgent, CrossPassAgent, GreedyInfoGainAgent, RandomAgent, PPOAgent)
+#: Agents by their command-line name, as ``"module:Class"`` entry points imported on first use
+#: (like Gymnasium's env registry): the learned agent lives in :mod:`sfw_gym.rl` and needs the
+#: ``[rl]`` extra (torch, stable-baselines3), which the classical agents do not.
+AGENTS: dict[str, str] = {
+    "frontier": "sfw_gym.agents.frontier:FrontierAgent",
+    "cross-pass": "sfw_gym.agents.cross_pass:CrossPassAgent",
+    "greedy": "sfw_gym.agents.greedy:GreedyInfoGainAgent",
+    "random": "sfw_gym.agents.random_agent:RandomAgent",
+    "ppo": "sfw_gym.rl.agent:PPOAgent",
 }
+
+
+def register_agent(name: str, entry_point: str) -> None:
+    """Make ``make_agent(name)`` (and ``sfw-gym evaluate --agents name``) build your agent."""
+    if ":" not in entry_point:
+        raise ConfigError(
+            f"agent {name!r}: entry point must be 'module:Class', got {entry_point!r}"
+        )
+    AGENTS[name] = entry_point
+
+
+def agent_class(name: str) -> type[Agent]:
+    """The class registered as ``name``."""
+    if name not in AGENTS:
+        raise ConfigError(f"unknown agent {name!r}; known: {sorted(AGENTS)}")
+    module, _, cls = AGENTS[name].partition(":")
+    try:
+        return getattr(importlib.import_module(module), cls)
+    except ImportError as exc:
+        raise ConfigError(
+            f"agent {name!r} needs {exc.name!r}: pip install 'sfw-gym[rl]'"
+            if exc.name in ("torch", "stable_baselines3", "sb3_contrib")
+            else f"agent {name!r}: cannot import {AGENTS[name]} ({exc})"
+        ) from None
 
 
 def make_agent(name: str, **params: Any) -> Agent:
     """Build the agent registered as ``name`` (see :data:`AGENTS`) with ``params``."""
-    if name not in AGENTS:
-        raise ConfigError(f"unknown agent {name!r}; known: {sorted(AGENTS)}")
+    cls = agent_class(name)
     try:
-        return AGENTS[name](**params)
+        return cls(**params)
     except TypeError as exc:
         raise ConfigError(f"agent {name!r}: {exc}") from None
 
@@ -41,14 +69,10 @@ __all__ = [
     "CrossPassAgent",
     "FrontierAgent",
     "GreedyInfoGainAgent",
-    "PPOAgent",
     "RandomAgent",
     "RobotView",
     "RobotViewHandle",
-    "dominance_bands",
-    "find_frontiers",
-    "frontier_mask",
-    "hidden_rooms",
+    "agent_class",
     "make_agent",
-    "router_scores",
+    "register_agent",
 ]

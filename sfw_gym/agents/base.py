@@ -23,22 +23,13 @@ from __future__ import annotations
 import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
-from sfw_gym.errors import ConfigError
-from sfw_gym.mapping.grid import GridSpec
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.navigation.view import RobotView
 
-#: Keys of the robot's view that agents may rely on.
-VIEW_KEYS = frozenset(
-    {
-        "belief_u8", "probability", "grid", "odometry_pose", "routers_xy", "rssi_history",
-        "bumped", "radius_m", "max_linear_speed_m_s", "max_angular_speed_rad_s",
-        "control_period_s", "action_type",
-    }
-)  # fmt: skip
 #: Why an exploring agent stopped looking for goals.
 STOP_REASONS = ("no_frontiers", "all_blacklisted", "max_steps")
 
@@ -46,8 +37,8 @@ STOP_REASONS = ("no_frontiers", "all_blacklisted", "max_steps")
 class RobotViewHandle:
     """A callable that returns the robot's view and exposes nothing else of the environment.
 
-    It keeps only the bound ``robot_view`` method (no attribute names the env) and checks each
-    view against :data:`VIEW_KEYS`, so an agent sees exactly what the robot knows.
+    It keeps only the bound ``robot_view`` method (no attribute names the env), so an agent sees
+    exactly what the robot knows: a :class:`~sfw_gym.navigation.view.RobotView`.
 
     Args:
         env: A Gymnasium env (wrapped or not) whose ``unwrapped`` has ``robot_view()``.
@@ -64,45 +55,17 @@ class RobotViewHandle:
             raise ConfigError(
                 f"env {type(env).__name__} has no robot_view(): agents need SfW-Explore envs"
             )
-        self._fn: Callable[[], dict[str, Any]] = fn
+        self._fn: Callable[[], RobotView] = fn
 
     def __call__(self) -> RobotView:
         """The robot's view now (fresh arrays)."""
-        raw = self._fn()
-        return RobotView(**{k: raw[k] for k in VIEW_KEYS})
+        view = self._fn()
+        if not isinstance(view, RobotView):
+            raise TypeError(f"robot_view() must return a RobotView, got {type(view).__name__}")
+        return view
 
     def __reduce__(self) -> Any:
         raise TypeError("a RobotViewHandle is bound to a live env and cannot be pickled")
-
-
-@dataclass(frozen=True)
-class RobotView:
-    """What the robot knows at one step (see ``SfWExploreEnv.robot_view``)."""
-
-    belief_u8: np.ndarray
-    probability: np.ndarray
-    grid: GridSpec
-    odometry_pose: tuple[float, float, float]
-    routers_xy: np.ndarray
-    rssi_history: np.ndarray
-    bumped: bool
-    radius_m: float
-    max_linear_speed_m_s: float
-    max_angular_speed_rad_s: float
-    control_period_s: float
-    action_type: str
-
-    @property
-    def xy(self) -> np.ndarray:
-        """Odometry position ``(x, y)``."""
-        return np.array(self.odometry_pose[:2], np.float64)
-
-    @property
-    def cell(self) -> tuple[int, int]:
-        """Grid cell ``(row, col)`` of the odometry position (clipped into the grid)."""
-        r, c = self.grid.world_to_cell(self.xy)
-        h, w = self.grid.shape
-        return min(max(int(r), 0), h - 1), min(max(int(c), 0), w - 1)
 
 
 class Agent(ABC):
@@ -208,7 +171,7 @@ class Agent(ABC):
 
     def _to_action(self, linear: float, angular: float) -> Any:
         if self.action_type == "discrete":
-            from sfw_gym.navigation import to_discrete
+            from sfw_gym.navigation.planning import to_discrete
 
             return to_discrete(linear, angular)
         return np.array([linear, angular], np.float32)

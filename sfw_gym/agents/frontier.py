@@ -46,8 +46,15 @@ import numpy as np
 from scipy import ndimage
 
 from sfw_gym.agents.base import Agent, RobotView, check_fraction
-from sfw_gym.errors import ConfigError
-from sfw_gym.navigation import (
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.navigation.frontiers import (
+    EIGHT_CONNECTED,
+    Frontier,
+    find_frontiers,
+    frontier_mask,
+    hidden_rooms,
+)
+from sfw_gym.navigation.planning import (
     CostField,
     PurePursuit,
     belief_classes,
@@ -60,85 +67,6 @@ from sfw_gym.navigation import (
     simplify_path,
     traversal_costs,
 )
-
-_EIGHT = np.ones((3, 3), bool)
-
-
-@dataclass(frozen=True)
-class Frontier:
-    """One frontier cluster.
-
-    Attributes:
-        cells: ``(N, 2)`` cells ``(row, col)``.
-        centroid_rc: Mean cell, ``(row, col)`` floats.
-    """
-
-    cells: np.ndarray
-    centroid_rc: tuple[float, float]
-
-    @property
-    def size(self) -> int:
-        """Number of cells."""
-        return len(self.cells)
-
-
-def frontier_mask(belief_u8: np.ndarray, exclude: np.ndarray | None = None) -> np.ndarray:
-    """Unknown cells 8-adjacent to a believed-free cell (optionally minus ``exclude``)."""
-    free, _, unknown = belief_classes(belief_u8)
-    mask = unknown & ndimage.binary_dilation(free, structure=_EIGHT)
-    if exclude is not None:
-        mask &= ~exclude
-    return mask
-
-
-def hidden_rooms(belief_u8: np.ndarray, min_depth_cells: float) -> np.ndarray:
-    """Per cell, its depth (cells to the nearest known cell) in the unknown space inside the
-    bounding box of the believed-free cells, where that depth is at least ``min_depth_cells``
-    (room-sized pockets, not the band of unknown cells along a wall); else 0."""
-    free, _, unknown = belief_classes(belief_u8)
-    rows, cols = np.flatnonzero(free.any(1)), np.flatnonzero(free.any(0))
-    if not len(rows):
-        return np.zeros(belief_u8.shape)
-    inside = np.zeros(belief_u8.shape, bool)
-    inside[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1] = True
-    depth = ndimage.distance_transform_edt(unknown & inside)
-    return np.where(depth >= min_depth_cells, depth, 0.0)
-
-
-def find_frontiers(
-    belief_u8: np.ndarray, min_size_cells: int = 1, exclude: np.ndarray | None = None
-) -> list[Frontier]:
-    """Frontier clusters of a belief map (0 wall, 255 free, 127 unknown), largest first.
-
-    Args:
-        belief_u8: The belief, ``[row, col]``.
-        min_size_cells: Clusters smaller than this are dropped.
-        exclude: Optional mask of cells that are never frontier cells.
-
-    Returns:
-        The clusters (8-connected), sorted by decreasing size.
-    """
-    mask = frontier_mask(belief_u8, exclude)
-    labels, n = ndimage.label(mask, structure=_EIGHT)
-    if n == 0:
-        return []
-    rows, cols = np.nonzero(labels)
-    lab = labels[rows, cols]
-    sizes = np.bincount(lab, minlength=n + 1)
-    keep = sizes[lab] >= min_size_cells
-    rows, cols, lab = rows[keep], cols[keep], lab[keep]
-    order = np.argsort(lab, kind="stable")
-    rows, cols, lab = rows[order], cols[order], lab[order]
-    starts = np.flatnonzero(np.r_[True, lab[1:] != lab[:-1]]) if len(lab) else []
-    ends = np.r_[starts[1:], len(lab)] if len(lab) else []
-    out = []
-    for a, b in zip(starts, ends, strict=True):
-        cells = np.stack([rows[a:b], cols[a:b]], axis=1)
-        out.append(
-            Frontier(cells, (float(rows[a:b].sum() / (b - a)), float(cols[a:b].sum() / (b - a))))
-        )
-    out.sort(key=lambda f: -f.size)
-    return out
 
 
 @dataclass
@@ -466,7 +394,7 @@ class FrontierAgent(Agent):
         min_depth = max(self.min_hidden_room_depth_m / view.grid.resolution_m, 1.0)
         depth = np.where(failed, 0.0, hidden_rooms(view.belief_u8, min_depth))
         if depth.any():
-            labels, n = ndimage.label(depth > 0, structure=_EIGHT)
+            labels, n = ndimage.label(depth > 0, structure=EIGHT_CONNECTED)
             deepest = ndimage.maximum_position(depth, labels, range(1, n + 1))
             mask[tuple(np.array(deepest).T)] = True
         approach = np.where(mask, self._approach(paths), np.inf)
@@ -525,7 +453,7 @@ class FrontierAgent(Agent):
         exclude = near_bump | self.blacklisted
         if self.min_unknown_region_m2 > 0:
             _, _, unknown = belief_classes(view.belief_u8)
-            labels, n = ndimage.label(unknown, structure=_EIGHT)
+            labels, n = ndimage.label(unknown, structure=EIGHT_CONNECTED)
             if n:
                 area = np.bincount(labels.ravel(), minlength=n + 1) * res * res
                 area[0] = np.inf

@@ -7,10 +7,11 @@ from typing import Any
 import numpy as np
 
 from sfw_gym.agents.base import RobotView, check_fraction
-from sfw_gym.agents.cross_pass import router_scores
-from sfw_gym.agents.frontier import FrontierAgent, Goal, frontier_mask
-from sfw_gym.errors import ConfigError
-from sfw_gym.navigation import CostField, belief_classes
+from sfw_gym.agents.frontier import FrontierAgent, Goal
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.navigation.frontiers import frontier_mask
+from sfw_gym.navigation.planning import CostField, belief_classes
+from sfw_gym.navigation.radio_zones import router_scores
 
 
 class GreedyInfoGainAgent(FrontierAgent):

@@ -5,10 +5,10 @@ from __future__ import annotations
 from typing import Any
 
 from sfw_gym.agents.base import Agent, RobotView
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.constants import DISCRETE_ACTIONS
+from sfw_gym.core.errors import ConfigError
 
 #: (linear, angular) of the discrete actions 0 forward, 1 turn left, 2 turn right.
-_DISCRETE = ((1.0, 0.0), (0.0, 1.0), (0.0, -1.0))
 
 
 class RandomAgent(Agent):
@@ -38,7 +38,7 @@ class RandomAgent(Agent):
     def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
         if self._held <= 0 or view.bumped:
             if self.action_type == "discrete":
-                self._command = _DISCRETE[int(self.rng.integers(len(_DISCRETE)))]
+                self._command = DISCRETE_ACTIONS[int(self.rng.integers(len(DISCRETE_ACTIONS)))]
             else:
                 lin, ang = self.rng.uniform(-1.0, 1.0, 2)
                 self._command = (float(lin), float(ang))

@@ -10,7 +10,8 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.mapping import GridSpec
 from sfw_gym.world import (
     Floorplan,
     RadioConfig,
@@ -35,6 +36,26 @@ class EpisodeScene:
     robot: Robot
     truth_u8: np.ndarray  # 0 wall, 255 free, 127 outside
     grid_origin: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class GroundTruth:
+    """What the simulator knows and the robot does not, for evaluation and figures (agents get
+    :class:`~sfw_gym.navigation.view.RobotView` only).
+
+    Attributes:
+        floorplan: The episode's plan.
+        truth_u8: Ground-truth grid on the belief map's cells (0 wall, 255 free, 127 outside).
+        grid: The belief map's geometry.
+        radio: The radio model (routers, noise-free ``mean_rssi``).
+        trajectory: ``(T, 2)`` true positions so far.
+    """
+
+    floorplan: Floorplan
+    truth_u8: np.ndarray
+    grid: GridSpec
+    radio: RadioModel
+    trajectory: np.ndarray
 
 
 def resolve_floorplan(source: Any, generator_params: dict[str, Any] | None = None) -> Floorplan:

@@ -11,17 +11,17 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from sfw_gym.envs.episode import EpisodeScene, build_scene
+from sfw_gym.core.constants import DISCRETE_ACTION_NAMES, DISCRETE_ACTIONS, NOT_HEARD_DBM
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.envs.episode import EpisodeScene, GroundTruth, build_scene
 from sfw_gym.envs.map_tracker import MapTracker
 from sfw_gym.envs.observation import ObservationBuilder, observation_space
-from sfw_gym.errors import ConfigError
 from sfw_gym.mapping import GridSpec, MapperConfig, SparseInverseKVisibility
-from sfw_gym.world import NOT_HEARD_DBM, Floorplan, RadioConfig, RobotConfig
+from sfw_gym.navigation.view import RobotView
+from sfw_gym.world import Floorplan, RadioConfig, RobotConfig
 
 ACTION_TYPES = ("continuous", "discrete")
 #: Discrete actions: (linear, angular) as fractions of the robot's limits.
-DISCRETE_ACTIONS = ((1.0, 0.0), (0.0, 1.0), (0.0, -1.0))
-DISCRETE_ACTION_NAMES = ("forward", "turn_left", "turn_right")
 RESET_OPTIONS = ("floorplan", "routers", "start_pose")
 
 
@@ -84,7 +84,8 @@ class SfWExploreEnv(gym.Env):
     ``coverage_target`` (0.95), ``collision_penalty`` (0.1), ``reward_scale`` (0.01),
     ``max_steps`` (3000), ``steps_per_m2`` (None: the budget is ``max_steps``; a number: the
     budget is ``min(max_steps, ceil(steps_per_m2 × free area))``), ``render_mode`` (None |
-    "rgb_array" | "human").
+    "rgb_array" | "human"), ``render_size`` ((960, 480): every frame is ``width × height``, the
+    plan letterboxed into it, so video writers work across plans; None: the plan's own size).
     ``reset(options=…)``: ``floorplan`` (a Floorplan, a path or a generator seed), ``routers``
     (positions (R, 2) or a count ≤ n_routers), ``start_pose`` ((x, y, θ)).
 
@@ -114,6 +115,7 @@ class SfWExploreEnv(gym.Env):
         max_steps: int = 3000,
         steps_per_m2: float | None = None,
         render_mode: str | None = None,
+        render_size: tuple[int, int] | None = (960, 480),
     ) -> None:
         if action_type not in ACTION_TYPES:
             raise ConfigError(f"action_type must be one of {ACTION_TYPES}, got {action_type!r}")
@@ -158,6 +160,7 @@ class SfWExploreEnv(gym.Env):
         self.max_steps = max_steps
         self.steps_per_m2 = None if steps_per_m2 is None else float(steps_per_m2)
         self.render_mode = render_mode
+        self.render_size = _frame_size(render_size)
         self._folder_plans = _folder_plans(floorplan)
 
         self.observation_space = observation_space(n_routers, map_px, crop_px)
@@ -282,7 +285,7 @@ class SfWExploreEnv(gym.Env):
             self.tracker.apply(self.mapper.last_changed_cells, self.mapper.occupancy_u8)
             est_k = self.mapper.last_k
             heard = (rssi > NOT_HEARD_DBM) & (est_k >= 0)
-            # k = K means "K or more walls" (sfw_gym.metrics.k_value_accuracy with max_k)
+            # k = K means "K or more walls" (sfw_gym.mapping.metrics.k_value_accuracy with max_k)
             true_k = np.minimum(true_k, self.mapper_config.max_k)
             self.k_correct += int((est_k[heard] == true_k[heard]).sum())
             self.k_total += int(heard.sum())
@@ -325,32 +328,39 @@ class SfWExploreEnv(gym.Env):
         return info
 
     # ------------------------------------------------------------------------------ robot's view
-    def robot_view(self) -> dict[str, Any]:
-        """What the robot knows, for classical agents: never the ground truth.
-
-        Returns a dict with ``belief_u8`` (a copy of the belief map: 0 wall, 255 free, 127
-        unknown), ``probability`` (P(occupied)), ``grid`` (the GridSpec), ``odometry_pose``
-        (x, y, θ), ``routers_xy`` (R, 2), ``rssi_history`` (T, R) dBm, ``bumped`` (last step),
-        the robot's ``radius_m``, its speed limits and the control period.
-        """
+    def robot_view(self) -> RobotView:
+        """What the robot knows (fresh arrays), for agents and planners: never the ground truth."""
         s = self.scene
         if s is None:
             raise gym.error.ResetNeeded("call reset() before robot_view()")
         cfg = self.robot_config
-        return {
-            "belief_u8": self.mapper.occupancy_u8.copy(),
-            "probability": self.mapper.probability,
-            "grid": self.grid,
-            "odometry_pose": tuple(s.robot.odometry_pose),
-            "routers_xy": np.array(s.radio.routers),
-            "rssi_history": np.array(self.rssi_history),
-            "bumped": bool(s.robot.bumped),
-            "radius_m": cfg.radius_m,
-            "max_linear_speed_m_s": cfg.max_linear_speed_m_s,
-            "max_angular_speed_rad_s": cfg.max_angular_speed_rad_s,
-            "control_period_s": cfg.control_period_s,
-            "action_type": self.action_type,
-        }
+        return RobotView(
+            belief_u8=self.mapper.occupancy_u8.copy(),
+            probability=self.mapper.probability,
+            grid=self.grid,
+            odometry_pose=tuple(s.robot.odometry_pose),
+            routers_xy=np.array(s.radio.routers),
+            rssi_history=np.array(self.rssi_history),
+            bumped=bool(s.robot.bumped),
+            radius_m=cfg.radius_m,
+            max_linear_speed_m_s=cfg.max_linear_speed_m_s,
+            max_angular_speed_rad_s=cfg.max_angular_speed_rad_s,
+            control_period_s=cfg.control_period_s,
+            action_type=self.action_type,
+        )
+
+    def ground_truth(self) -> GroundTruth:
+        """The episode's ground truth, for evaluation and figures (never for agents)."""
+        s = self.scene
+        if s is None:
+            raise gym.error.ResetNeeded("call reset() before ground_truth()")
+        return GroundTruth(
+            floorplan=s.floorplan,
+            truth_u8=s.truth_u8,
+            grid=self.grid,
+            radio=s.radio,
+            trajectory=np.asarray(self.trajectory, np.float64).reshape(-1, 2),
+        )
 
     # ------------------------------------------------------------------------------ rendering
     def render(self) -> np.ndarray | None:
@@ -363,7 +373,19 @@ class SfWExploreEnv(gym.Env):
             raise gym.error.ResetNeeded("call reset() before render()")
         from sfw_gym.envs.rendering import draw_frame, show_frame
 
-        frame = draw_frame(self)
+        s = self.scene
+        frame = draw_frame(
+            truth_u8=s.truth_u8,
+            belief_u8=self.mapper.occupancy_u8,
+            grid=self.grid,
+            routers_xy=s.radio.routers,
+            pose=s.robot.pose,
+            odometry_pose=s.robot.odometry_pose,
+            trajectory=self.trajectory,
+            odometry_trajectory=self.odometry_trajectory,
+            robot_radius_m=self.robot_config.radius_m,
+            size=self.render_size,
+        )
         if self.render_mode == "human":
             self._renderer = show_frame(frame, self._renderer, self.metadata["render_fps"])
             return None
@@ -399,6 +421,20 @@ def _check_number(name: str, value: Any, lo: float, hi: float) -> None:
     ok = isinstance(value, int | float | np.number) and not isinstance(value, bool)
     if not ok or not math.isfinite(value) or not lo <= value <= hi:
         raise ConfigError(f"{name} must be a number in [{lo}, {hi}], got {value!r}")
+
+
+def _frame_size(size: Any) -> tuple[int, int] | None:
+    if size is None:
+        return None
+    if (
+        not isinstance(size, (tuple, list))
+        or len(size) != 2
+        or not all(isinstance(v, (int, np.integer)) and 16 <= v <= 8192 for v in size)
+    ):
+        raise ConfigError(
+            f"render_size must be None or (width, height) in [16, 8192] px, got {size!r}"
+        )
+    return int(size[0]), int(size[1])
 
 
 def _make_config(name: str, overrides: dict[str, Any] | None, factory: Any) -> Any:

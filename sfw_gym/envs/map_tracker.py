@@ -1,6 +1,6 @@
 """Map-quality metrics kept up to date cell by cell, so that every step's info is cheap.
 
-The figures equal `sfw_gym.metrics` on the full maps (a test holds them to it); here they cost
+The figures equal `sfw_gym.mapping.metrics` on the full maps (a test holds them to it); here they cost
 O(cells changed this step) instead of O(grid).
 """
 
@@ -10,22 +10,15 @@ import numpy as np
 from numba import njit
 from scipy import ndimage
 
-from sfw_gym import metrics
-from sfw_gym.mapping import classify_u8
+from sfw_gym.mapping import metrics
+from sfw_gym.mapping.grid import CLASS_FREE as FREE
+from sfw_gym.mapping.grid import CLASS_UNKNOWN as UNKNOWN
+from sfw_gym.mapping.grid import CLASS_WALL as WALL
+from sfw_gym.mapping.grid import belief_classes, u8_class
 
-UNKNOWN, FREE, WALL = 0, 1, 2
 # Counter slots.
 _N_KNOWN, _N_EST_FREE, _N_EST_WALL, _COVERED, _AGREE, _KNOWN_BOTH = range(6)
 _FREE_INTER, _WALL_NEAR, _INTERIOR_FOUND = 6, 7, 8
-
-
-@njit(cache=True)
-def _u8_class(v: int) -> int:
-    if v <= 84:
-        return WALL
-    if v >= 171:
-        return FREE
-    return UNKNOWN
 
 
 @njit(cache=True)
@@ -71,7 +64,7 @@ def _apply(changed, est_u8, est_cls, truth_cls, near_wall, interior, found_by, o
     n_rows = est_cls.shape[0] // n_cols
     for i in range(changed.shape[0]):
         cell = changed[i]
-        new = _u8_class(est_u8[cell])
+        new = u8_class(est_u8[cell])
         old = est_cls[cell]
         if new == old:
             continue
@@ -85,17 +78,17 @@ def _apply(changed, est_u8, est_cls, truth_cls, near_wall, interior, found_by, o
 class MapTracker:
     """Coverage, paper IoU, free IoU, wall precision and interior-wall recall of a belief map.
 
-    Each equals its `sfw_gym.metrics` function on the full maps, except that an undefined ratio
+    Each equals its `sfw_gym.mapping.metrics` function on the full maps, except that an undefined ratio
     (empty denominator) reads 0.0 here rather than nan.
 
     Args:
         truth_u8: the ground-truth grid (0 wall, 255 free, 127 outside).
-        tolerance_cells: wall tolerance of precision and recall (as in `sfw_gym.metrics`).
+        tolerance_cells: wall tolerance of precision and recall (as in `sfw_gym.mapping.metrics`).
     """
 
     def __init__(self, truth_u8: np.ndarray, tolerance_cells: float = 2) -> None:
         self.truth_u8 = truth_u8
-        wall, free = classify_u8(truth_u8)
+        free, wall, _ = belief_classes(truth_u8)
         self._truth_cls = (
             np.where(wall, WALL, np.where(free, FREE, UNKNOWN)).astype(np.int8).ravel()
         )
@@ -125,7 +118,7 @@ class MapTracker:
     @staticmethod
     def _ratio(num: int, den: int) -> float:
         # 0.0 while undefined (no wall estimated yet, …): info stays comparable and averageable;
-        # `sfw_gym.metrics` returns nan there instead.
+        # `sfw_gym.mapping.metrics` returns nan there instead.
         return float(num / den) if den else 0.0
 
     @property
@@ -135,30 +128,30 @@ class MapTracker:
 
     @property
     def coverage(self) -> float:
-        """`sfw_gym.metrics.coverage`."""
+        """`sfw_gym.mapping.metrics.coverage`."""
         return self._ratio(self._counts[_COVERED], self._n_truth_free)
 
     @property
     def map_iou(self) -> float:
-        """`sfw_gym.metrics.map_iou` (the paper's)."""
+        """`sfw_gym.mapping.metrics.map_iou` (the paper's)."""
         return self._ratio(self._counts[_AGREE], self._counts[_KNOWN_BOTH])
 
     @property
     def free_iou(self) -> float:
-        """`sfw_gym.metrics.free_iou`."""
+        """`sfw_gym.mapping.metrics.free_iou`."""
         inter = self._counts[_FREE_INTER]
         return self._ratio(inter, self._counts[_N_EST_FREE] + self._n_truth_free - inter)
 
     @property
     def wall_precision(self) -> float:
-        """`sfw_gym.metrics.wall_precision`."""
+        """`sfw_gym.mapping.metrics.wall_precision`."""
         return self._ratio(self._counts[_WALL_NEAR], self._counts[_N_EST_WALL])
 
     @property
     def interior_wall_recall(self) -> float:
-        """`sfw_gym.metrics.interior_wall_recall`."""
+        """`sfw_gym.mapping.metrics.interior_wall_recall`."""
         return self._ratio(self._counts[_INTERIOR_FOUND], self._n_interior)
 
     def map_mse(self, est_u8: np.ndarray) -> float:
-        """`sfw_gym.metrics.map_mse` (graded values: computed on the full map, at episode end)."""
+        """`sfw_gym.mapping.metrics.map_mse` (graded values: computed on the full map, at episode end)."""
         return metrics.map_mse(est_u8, self.truth_u8)

@@ -3,16 +3,20 @@
 from __future__ import annotations
 
 import itertools
-from typing import TYPE_CHECKING, Any
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from skimage.draw import disk, line
 
-if TYPE_CHECKING:
-    from sfw_gym.envs.explore import SfWExploreEnv
+from sfw_gym.core.constants import U8_FREE, U8_UNKNOWN, U8_WALL
+from sfw_gym.mapping.grid import GridSpec, belief_classes
 
-TARGET_HEIGHT_PX = 360
-GREY = {0: (30, 30, 30), 127: (150, 150, 150), 255: (255, 255, 255)}
+#: Panel height when frames take the plan's own size (``render_size=None``).
+NATIVE_HEIGHT_PX = 360
+#: Letterbox margins.
+BACKGROUND = (255, 255, 255)
+GREY = {U8_WALL: (30, 30, 30), U8_UNKNOWN: (150, 150, 150), U8_FREE: (255, 255, 255)}
 ROUTER, ROBOT, PATH, ODOM, RAY = (
     (220, 40, 40),
     (30, 160, 60),
@@ -22,47 +26,76 @@ ROUTER, ROBOT, PATH, ODOM, RAY = (
 )
 
 
-def draw_frame(env: SfWExploreEnv) -> np.ndarray:
-    """An (H, W, 3) uint8 frame: truth | belief, rows flipped so that +y points up."""
-    s = env.scene
-    assert s is not None
-    truth = s.truth_u8
-    scale = max(1, round(TARGET_HEIGHT_PX / truth.shape[0]))
-    left = _grey_rgb(truth)
-    right = _grey_rgb(env.mapper.occupancy_u8)
-    grid = env.grid
+def draw_frame(
+    *,
+    truth_u8: np.ndarray,
+    belief_u8: np.ndarray,
+    grid: GridSpec,
+    routers_xy: np.ndarray,
+    pose: Sequence[float],
+    odometry_pose: Sequence[float],
+    trajectory: Sequence[tuple[float, float]],
+    odometry_trajectory: Sequence[tuple[float, float]],
+    robot_radius_m: float,
+    size: tuple[int, int] | None = None,
+) -> np.ndarray:
+    """An RGB frame: truth with the true path and rays | belief with the odometry path.
 
-    def px(xy: np.ndarray) -> np.ndarray:
-        rc = grid.world_to_grid(np.atleast_2d(xy))[:, ::-1] * scale
-        return rc
+    Rows are flipped so that +y points up. With ``size=(width, height)`` the two panels are
+    scaled to fit (aspect kept) and centred on a white background, so that every plan gives
+    frames of the same shape (video writers need that); with ``None`` each grid cell is an
+    integer number of pixels and the panels are about :data:`NATIVE_HEIGHT_PX` high.
 
-    left = np.kron(left, np.ones((scale, scale, 1), np.uint8))
-    right = np.kron(right, np.ones((scale, scale, 1), np.uint8))
-    h, _w = left.shape[:2]
-    robot_rc = px(np.array(s.robot.pose[:2]))[0]
-    odom_rc = px(np.array(s.robot.odometry_pose[:2]))[0]
-    for rc in px(s.radio.routers):  # rays from every router to the robot, then the routers
+    Returns:
+        ``(height, width, 3)`` uint8.
+    """
+    rows, cols = truth_u8.shape
+    gap_px = 4
+    if size is None:
+        scale = float(max(1, round(NATIVE_HEIGHT_PX / rows)))
+        out_h, out_w = int(rows * scale), int(2 * cols * scale) + gap_px
+    else:
+        out_w, out_h = size
+        scale = min(out_h / rows, (out_w - gap_px) / (2 * cols))
+    panel_h, panel_w = max(1, int(rows * scale)), max(1, int(cols * scale))
+    # nearest-neighbour upscaling of both maps onto the panel's pixels
+    src_r = np.minimum((np.arange(panel_h) / scale).astype(np.int64), rows - 1)
+    src_c = np.minimum((np.arange(panel_w) / scale).astype(np.int64), cols - 1)
+    left = _grey_rgb(truth_u8)[np.ix_(src_r, src_c)]
+    right = _grey_rgb(belief_u8)[np.ix_(src_r, src_c)]
+
+    def px(xy: Any) -> np.ndarray:
+        return grid.world_to_grid(np.atleast_2d(np.asarray(xy, np.float64)))[:, ::-1] * scale
+
+    routers = px(routers_xy) if len(routers_xy) else np.zeros((0, 2))
+    robot_rc, odom_rc = px(pose[:2])[0], px(odometry_pose[:2])[0]
+    for rc in routers:  # rays from every router to the robot, then the routers
         _line(left, rc, robot_rc, RAY)
-    for panel, path, colour in (
-        (left, env.trajectory, PATH),
-        (right, env.odometry_trajectory, ODOM),
-    ):
-        pts = px(np.array(path))
-        for a, b in itertools.pairwise(pts):
+    for panel, path, colour in ((left, trajectory, PATH), (right, odometry_trajectory, ODOM)):
+        for a, b in itertools.pairwise(px(path) if len(path) else []):
             _line(panel, a, b, colour)
     for panel in (left, right):
-        for rc in px(s.radio.routers):
+        for rc in routers:
             _disk(panel, rc, 2.5 * scale / 2 + 2, ROUTER)
-    _disk(left, robot_rc, env.robot_config.radius_m / grid.resolution_m * scale, ROBOT)
-    _disk(right, odom_rc, env.robot_config.radius_m / grid.resolution_m * scale, ROBOT)
-    gap = np.full((h, 4, 3), 255, np.uint8)
-    return np.ascontiguousarray(np.concatenate([left, gap, right], axis=1)[::-1])
+    robot_px = robot_radius_m / grid.resolution_m * scale
+    _disk(left, robot_rc, robot_px, ROBOT)
+    _disk(right, odom_rc, robot_px, ROBOT)
+
+    frame = np.empty((out_h, out_w, 3), np.uint8)
+    frame[:] = BACKGROUND
+    top = (out_h - panel_h) // 2
+    x0 = (out_w - (2 * panel_w + gap_px)) // 2
+    frame[top : top + panel_h, x0 : x0 + panel_w] = left[::-1]
+    x1 = x0 + panel_w + gap_px
+    frame[top : top + panel_h, x1 : x1 + panel_w] = right[::-1]
+    return frame
 
 
 def _grey_rgb(u8: np.ndarray) -> np.ndarray:
-    rgb = np.repeat(u8[..., None], 3, axis=2).astype(np.uint8)
-    rgb[u8 <= 84] = GREY[0]
-    rgb[(u8 > 84) & (u8 < 171)] = GREY[127]
+    _, wall, unknown = belief_classes(u8)
+    rgb = np.repeat(np.asarray(u8, np.uint8)[..., None], 3, axis=2)
+    rgb[wall] = GREY[U8_WALL]
+    rgb[unknown] = GREY[U8_UNKNOWN]
     return rgb
 
 

@@ -8,31 +8,17 @@ from __future__ import annotations
 
 from sfw_gym.mapping.config import MapperConfig
 from sfw_gym.mapping.dense import dense_inverse_k_visibility
-from sfw_gym.mapping.grid import (
-    U8_FREE,
-    U8_FREE_MIN,
-    U8_UNKNOWN,
-    U8_WALL,
-    U8_WALL_MAX,
-    GridSpec,
-    classify_u8,
-)
-from sfw_gym.mapping.k_estimation import NOT_HEARD_DBM, KEstimator
+from sfw_gym.mapping.grid import GridSpec, belief_classes
+from sfw_gym.mapping.k_estimation import KEstimator
 from sfw_gym.mapping.raycast import ray_cells, traverse_grid
 from sfw_gym.mapping.sparse import SparseInverseKVisibility
 
 __all__ = [
-    "NOT_HEARD_DBM",
-    "U8_FREE",
-    "U8_FREE_MIN",
-    "U8_UNKNOWN",
-    "U8_WALL",
-    "U8_WALL_MAX",
     "GridSpec",
     "KEstimator",
     "MapperConfig",
     "SparseInverseKVisibility",
-    "classify_u8",
+    "belief_classes",
     "dense_inverse_k_visibility",
     "ray_cells",
     "traverse_grid",

@@ -6,7 +6,7 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.errors import ConfigError
 
 K_ESTIMATORS = ("distance_aware", "kmeans")
 ROUTER_POLICIES = ("strongest", "all")

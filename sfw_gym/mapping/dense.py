@@ -13,8 +13,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from sfw_gym.errors import ConfigError
-from sfw_gym.mapping.grid import U8_FREE, U8_UNKNOWN, U8_WALL, GridSpec
+from sfw_gym.core.constants import U8_FREE, U8_UNKNOWN, U8_WALL
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.mapping.grid import GridSpec
 from sfw_gym.mapping.raycast import ray_buffer_size, traverse_grid
 
 

@@ -11,30 +11,37 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
-from sfw_gym.errors import ConfigError
-
-# uint8 occupancy convention (the paper's): 0 = wall, 255 = free, 127 = unknown / outside.
-U8_WALL = 0
-U8_UNKNOWN = 127
-U8_FREE = 255
-# Graded maps are classified by thirds: value <= U8_WALL_MAX is a wall (P(occupied) > 2/3),
-# value >= U8_FREE_MIN is free (P(occupied) < 1/3), anything between is unknown.
-U8_WALL_MAX = 84
-U8_FREE_MIN = 171
+from sfw_gym.core.constants import U8_FREE_MIN, U8_WALL_MAX
+from sfw_gym.core.errors import ConfigError
 
 
-def classify_u8(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Split a uint8 occupancy map into wall and free masks.
-
-    Args:
-        values: uint8 map in the 0 wall / 255 free / 127 unknown convention (graded values allowed).
+def belief_classes(belief_u8: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Read a uint8 map (0 wall, 255 free, 127 unknown; graded values allowed) by thirds.
 
     Returns:
-        ``(wall, free)`` boolean arrays of the same shape.
+        ``(free, wall, unknown)`` boolean masks of the map's shape
+        (:data:`~sfw_gym.core.constants.U8_WALL_MAX`, :data:`~sfw_gym.core.constants.U8_FREE_MIN`).
     """
-    v = np.asarray(values)
-    return v <= U8_WALL_MAX, v >= U8_FREE_MIN
+    b = np.asarray(belief_u8)
+    wall = b <= U8_WALL_MAX
+    free = b >= U8_FREE_MIN
+    return free, wall, ~(free | wall)
+
+
+#: Class codes of :func:`u8_class` (numba kernels keep one small int class per cell).
+CLASS_UNKNOWN, CLASS_FREE, CLASS_WALL = 0, 1, 2
+
+
+@njit(cache=True)
+def u8_class(v):
+    """The class code of one belief value: :func:`belief_classes` for a scalar, inside kernels."""
+    if v <= U8_WALL_MAX:
+        return CLASS_WALL
+    if v >= U8_FREE_MIN:
+        return CLASS_FREE
+    return CLASS_UNKNOWN
 
 
 @dataclass(frozen=True)

@@ -47,11 +47,10 @@ import warnings
 import numpy as np
 from numba import njit
 
-from sfw_gym._threads import single_threaded_openmp
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.constants import NOT_HEARD_DBM
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.core.threads import single_threaded_openmp
 from sfw_gym.mapping.config import MapperConfig
-
-NOT_HEARD_DBM = -100.0
 
 
 @njit(cache=True)

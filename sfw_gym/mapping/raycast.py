@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.errors import ConfigError
 from sfw_gym.mapping.grid import GridSpec
 
 _TIE_EPS = 1e-10

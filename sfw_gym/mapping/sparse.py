@@ -52,9 +52,10 @@ import math
 import numpy as np
 from numba import njit
 
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.constants import U8_UNKNOWN
+from sfw_gym.core.errors import ConfigError
 from sfw_gym.mapping.config import MapperConfig
-from sfw_gym.mapping.grid import U8_FREE_MIN, U8_UNKNOWN, U8_WALL_MAX, GridSpec
+from sfw_gym.mapping.grid import CLASS_FREE, CLASS_UNKNOWN, GridSpec, u8_class
 from sfw_gym.mapping.k_estimation import KEstimator, add_samples, k_from_thresholds
 from sfw_gym.mapping.raycast import ray_buffer_size, traverse_grid
 
@@ -78,7 +79,6 @@ _S_ENTROPY, _S_UID, _S_PREV_X, _S_PREV_Y, _S_HAS_PREV, _S_N_TOUCHED, _S_N_CHANGE
     _P_CAP,
 ) = range(13)
 # Cell classes kept in `cls`.
-CLASS_UNKNOWN, CLASS_FREE, CLASS_WALL = 0, 1, 2
 
 
 @njit(cache=True)
@@ -95,15 +95,6 @@ def log_odds_to_u8(lo):
     e = np.exp(-abs(lo))
     p_free = e / (1.0 + e) if lo >= 0.0 else 1.0 / (1.0 + e)
     return min(int(255.0 * p_free), 255)
-
-
-@njit(cache=True)
-def _u8_class(v):
-    if v <= U8_WALL_MAX:
-        return CLASS_WALL
-    if v >= U8_FREE_MIN:
-        return CLASS_FREE
-    return CLASS_UNKNOWN
 
 
 @njit(cache=True)
@@ -405,7 +396,7 @@ def _update_kernel(
     n_c = 0
     for i in range(np.int64(state[_S_N_TOUCHED])):
         cell = touched[i]
-        c = _u8_class(u8[cell])
+        c = u8_class(u8[cell])
         cls[cell] = c
         classified[cell] = c != CLASS_UNKNOWN
         if c != old_cls[i]:

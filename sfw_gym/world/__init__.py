@@ -13,13 +13,12 @@ from sfw_gym.world.floorplan import (
     load_floorplan,
 )
 from sfw_gym.world.generator import generate_floorplan
-from sfw_gym.world.radio import NOT_HEARD_DBM, RadioConfig, RadioModel
+from sfw_gym.world.radio import RadioConfig, RadioModel
 from sfw_gym.world.robot import Pose, Robot, RobotConfig, StepResult
 from sfw_gym.world.routers import place_routers
 
 __all__ = [
     "MATERIALS",
-    "NOT_HEARD_DBM",
     "Floorplan",
     "Pose",
     "RadioConfig",

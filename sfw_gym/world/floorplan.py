@@ -15,8 +15,8 @@ import shapely
 from shapely.geometry import Polygon
 from shapely.validation import explain_validity
 
-from sfw_gym.atomic import write_text_atomic
-from sfw_gym.errors import FloorplanError
+from sfw_gym.core.atomic import write_text_atomic
+from sfw_gym.core.errors import FloorplanError
 from sfw_gym.world.wall_crossing import DEFAULT_MIN_PIECE_M, cross_walls, cross_walls_parallel
 
 #: Wall materials that a floorplan may name; a radio preset maps each to a loss in dB.

@@ -34,7 +34,7 @@ import shapely
 from shapely.geometry import Polygon
 from shapely.geometry.polygon import orient
 
-from sfw_gym.errors import ConfigError, FloorplanError
+from sfw_gym.core.errors import ConfigError, FloorplanError
 from sfw_gym.world.floorplan import Floorplan, Room
 
 #: Kinds of building the generator makes ("random" picks one from the seed).

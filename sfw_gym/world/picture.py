@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sfw_gym.atomic import atomic_path
+from sfw_gym.core.atomic import atomic_path
 from sfw_gym.world.floorplan import Floorplan
 from sfw_gym.world.radio import RadioModel
 

@@ -16,7 +16,8 @@ import numpy as np
 from numba import njit, prange
 from shapely.geometry import Point
 
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.constants import NOT_HEARD_DBM
+from sfw_gym.core.errors import ConfigError
 from sfw_gym.world.floorplan import MATERIALS, Floorplan
 from sfw_gym.world.wall_crossing import DEFAULT_MIN_PIECE_M, _cross_one
 
@@ -24,7 +25,6 @@ from sfw_gym.world.wall_crossing import DEFAULT_MIN_PIECE_M, _cross_one
 _PARALLEL_MIN_POINTS = 256
 
 #: Sentinel RSSI of a router that is not heard.
-NOT_HEARD_DBM = -100
 _SPEED_OF_LIGHT_M_S = 299_792_458.0
 #: Per-material losses at 2.4 GHz (COST-231, IEEE TGax); "generic" is an unknown wall (HouseExpo).
 RESIDENTIAL_LOSS_DB = MappingProxyType(

@@ -36,7 +36,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import pymunk
 
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.errors import ConfigError
 
 __all__ = ["Pose", "Robot", "RobotConfig", "StepResult"]
 

@@ -6,8 +6,8 @@ import numpy as np
 import shapely
 from sklearn.cluster import KMeans
 
-from sfw_gym._threads import single_threaded_openmp
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.core.threads import single_threaded_openmp
 from sfw_gym.world.floorplan import Floorplan
 
 #: Routers keep this clearance from walls (a router on a shelf, not inside the wall).

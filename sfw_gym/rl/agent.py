@@ -2,14 +2,19 @@
 
 The shipped policy picks waypoints (:class:`sfw_gym.envs.waypoint.WaypointWrapper`): every few
 steps it looks at the observation and names a block of the map; the agent then drives there
-step by step with the wrapper's own :class:`~sfw_gym.envs.waypoint.WaypointDriver`, so it
+step by step with the wrapper's own :class:`~sfw_gym.navigation.waypoints.WaypointDriver`, so it
 acts exactly as in training. Policies trained on the env's own continuous actions are driven
 directly.
 """
 
 from __future__ import annotations
 
+import base64
 import functools
+import io
+import json
+import pickle
+import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -17,12 +22,11 @@ import numpy as np
 import yaml
 
 from sfw_gym.agents.base import Agent, RobotView
-from sfw_gym.envs.waypoint import WaypointDriver, block_features
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.data import DEFAULT_MODEL_DIR
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.navigation.waypoints import WaypointDriver, block_features
+from sfw_gym.rl.training import MOVED_CLASSES, import_dotted, wrapper_specs
 
-REPO_ROOT = Path(__file__).resolve().parents[2]
-#: The pretrained policy shipped with the repository (trained by ``sfw-gym train ppo``).
-DEFAULT_MODEL_DIR = REPO_ROOT / "agents" / "ppo" / "SfW-Explore-v0_1"
 WAYPOINT_WRAPPER = "sfw_gym.envs.waypoint.WaypointWrapper"
 
 
@@ -33,14 +37,34 @@ def _load_model(path: str, device: str) -> Any:
 
     # One env's forward pass is tiny: threads only fight the evaluation's other workers.
     torch.set_num_threads(1)
-    return PPO.load(path, device=device)
+    return PPO.load(path, device=device, custom_objects=_moved_objects(path))
+
+
+def _moved_objects(model_zip: str) -> dict[str, Any]:
+    """SB3 ``custom_objects`` for the values a model pickled by a class path that has since
+    moved (:data:`~sfw_gym.rl.training.MOVED_CLASSES`), so that older models keep loading."""
+    with zipfile.ZipFile(model_zip) as archive:
+        data = json.loads(archive.read("data"))
+    out = {}
+    for key, value in data.items():
+        if isinstance(value, dict) and ":serialized:" in value:
+            raw = base64.b64decode(value[":serialized:"])
+            try:
+                pickle.loads(raw)
+            except (ImportError, AttributeError):
+                out[key] = _RenamingUnpickler(io.BytesIO(raw)).load()
+    return out
+
+
+class _RenamingUnpickler(pickle.Unpickler):
+    def find_class(self, module: str, name: str) -> Any:
+        moved = MOVED_CLASSES.get(f"{module}.{name}")
+        return import_dotted(moved) if moved else super().find_class(module, name)
 
 
 def waypoint_settings(config: dict[str, Any]) -> dict[str, int] | None:
     """The WaypointWrapper's kwargs from a training ``config.yml`` (``{}``: its defaults), or
     None if the policy was trained without it."""
-    from sfw_gym.training import wrapper_specs
-
     for name, kwargs in wrapper_specs(config.get("hyperparameters", {}).get("env_wrapper")):
         if name == WAYPOINT_WRAPPER:
             return dict(kwargs)
@@ -51,7 +75,8 @@ class PPOAgent(Agent):
     """Acts with a PPO model trained by ``sfw-gym train ppo`` (by default the shipped one).
 
     Args:
-        model_dir: A training output folder holding ``model.zip`` and ``config.yml``.
+        path: A training output folder holding ``model.zip`` and ``config.yml`` (or that
+            ``model.zip``); by default the shipped policy.
         deterministic: Take the policy's most likely waypoint; else (the default) sample it from
             the policy with the agent's seeded generator, as in training. A deterministic
             policy repeats a waypoint it cannot reach forever (nothing in the observation
@@ -64,22 +89,23 @@ class PPOAgent(Agent):
 
     def __init__(
         self,
-        model_dir: str | Path = DEFAULT_MODEL_DIR,
+        path: str | Path = DEFAULT_MODEL_DIR,
         deterministic: bool = False,
         device: str = "cpu",
         max_steps: int | None = None,
     ) -> None:
         super().__init__(max_steps=max_steps)
-        self.model_dir = str(model_dir)
+        folder = Path(path).parent if Path(path).suffix == ".zip" else Path(path)
+        self.path = str(path)
         self.deterministic = bool(deterministic)
         self.device = device
-        model_path = Path(model_dir) / "model.zip"
-        config_path = Path(model_dir) / "config.yml"
-        for path in (model_path, config_path):
-            if not path.is_file():
+        model_path = folder / "model.zip"
+        config_path = folder / "config.yml"
+        for file in (model_path, config_path):
+            if not file.is_file():
                 raise ConfigError(
-                    f"PPOAgent: {path} not found; train one with `sfw-gym train ppo --out "
-                    f"{self.model_dir}` or pass model_dir="
+                    f"PPOAgent: {file} not found; train one with `sfw-gym train ppo --out "
+                    f"{folder}` or pass path="
                 )
         try:
             config = yaml.safe_load(config_path.read_text(encoding="utf-8")) or {}
@@ -117,7 +143,7 @@ class PPOAgent(Agent):
         if differ:
             got = {k: np.shape(obs.get(k)) for k in differ}
             raise ConfigError(
-                f"PPOAgent: the policy in {self.model_dir} was trained on observations {differ}; "
+                f"PPOAgent: the policy in {self.path} was trained on observations {differ}; "
                 f"this env gives {got} (map_px, crop_px and n_routers must match)"
             )
         self._obs_checked = True
@@ -138,7 +164,7 @@ class PPOAgent(Agent):
                     view.belief_u8, view.grid, view.odometry_pose, self.driver.grid_cells
                 )
                 obs = {**obs, "blocks": blocks}
-            self.driver.start(vars(view), self._choose(obs))
+            self.driver.start(view, self._choose(obs))
             self.goals.append((float(self.driver.goal[0]), float(self.driver.goal[1])))
             command = self.driver.command(view.odometry_pose, False)
         return command

@@ -13,7 +13,7 @@ The first two columns are the robot's position (whatever their names), the other
 - a row whose position is empty or NaN is skipped and counted;
 - a file without a header (first row all numbers) is read as data, columns named ``column<i>``;
 - anything else (missing file, no data rows, a non-numeric or infinite cell, a row with the wrong
-  number of cells) raises :class:`~sfw_gym.errors.ConfigError` naming the file, the line and the
+  number of cells) raises :class:`~sfw_gym.core.errors.ConfigError` naming the file, the line and the
   problem.
 
 :func:`map_log` runs :class:`~sfw_gym.mapping.SparseInverseKVisibility` over the log on a grid
@@ -37,9 +37,10 @@ from typing import IO, Any
 
 import numpy as np
 
-from sfw_gym.atomic import atomic_path, write_text_atomic
-from sfw_gym.errors import ConfigError
-from sfw_gym.mapping import NOT_HEARD_DBM, GridSpec, MapperConfig, SparseInverseKVisibility
+from sfw_gym.core.atomic import atomic_path, write_text_atomic
+from sfw_gym.core.constants import NOT_HEARD_DBM
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.mapping import GridSpec, MapperConfig, SparseInverseKVisibility
 
 BANDS = ("2.4", "5")
 PROGRESS_MIN_ROWS = 5000

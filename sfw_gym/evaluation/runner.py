@@ -23,7 +23,6 @@ dominance zones (noise-free RSSI), the cells that cross-connecting passes target
 from __future__ import annotations
 
 import json
-import math
 import multiprocessing as mp
 from collections.abc import Iterable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -33,25 +32,13 @@ from typing import Any
 
 import numpy as np
 
-from sfw_gym.atomic import atomic_path, write_text_atomic
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.atomic import atomic_path, write_text_atomic
+from sfw_gym.core.constants import U8_FREE
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.evaluation.plots import plot_curves, plot_trajectories
+from sfw_gym.evaluation.report import results_csv, results_markdown
+from sfw_gym.evaluation.stats import summarize
 
-#: Metrics of the results table: (record key, column label, format).
-TABLE_METRICS: tuple[tuple[str, str, str], ...] = (
-    ("coverage", "coverage", "{:.3f}"),
-    ("map_iou", "IoU", "{:.3f}"),
-    ("free_iou", "free IoU", "{:.3f}"),
-    ("k_accuracy", "k-accuracy", "{:.3f}"),
-    ("path_length_m", "path [m]", "{:.0f}"),
-    ("info_gain_per_m", "info gain [bits/m]", "{:.0f}"),
-    ("collisions", "collisions", "{:.0f}"),
-    ("steps_to_coverage_50", "steps to 50 %", "{:.0f}"),
-    ("steps_to_coverage_90", "steps to 90 %", "{:.0f}"),
-    ("zone_band_unknown", "unknown zone-band cells", "{:.0f}"),
-    ("zone_band_unknown_frac", "unknown zone-band fraction", "{:.3f}"),
-)
-#: "steps to x %" metrics are averaged over the episodes that got there (count reported).
-_REACHED_METRICS = ("steps_to_coverage_50", "steps_to_coverage_90")
 CHECKPOINT = "episodes.jsonl"
 
 
@@ -104,17 +91,17 @@ def zone_band_unknown(env: Any, band_m: float = 0.8) -> dict[str, float]:
     """
     from scipy import ndimage
 
-    from sfw_gym.mapping.grid import classify_u8
+    from sfw_gym.mapping.grid import belief_classes
 
-    u = env.unwrapped
-    truth = u.scene.truth_u8
-    free = truth == 255
-    routers = u.scene.radio.routers
+    gt = env.unwrapped.ground_truth()
+    truth = gt.truth_u8
+    free = truth == U8_FREE
+    routers = gt.radio.routers
     if len(routers) < 2 or not free.any():
         return {"zone_band_cells": 0, "zone_band_unknown": 0, "zone_band_unknown_frac": 0.0}
-    xs, ys = u.grid.cell_centres()
+    xs, ys = gt.grid.cell_centres()
     zone = np.full(truth.shape, -1, np.int64)
-    zone[free] = np.argmax(u.scene.radio.mean_rssi(np.stack([xs[free], ys[free]], 1)), axis=1)
+    zone[free] = np.argmax(gt.radio.mean_rssi(np.stack([xs[free], ys[free]], 1)), axis=1)
     border = np.zeros(truth.shape, bool)
     for a, b in (((slice(None, -1), slice(None)), (slice(1, None), slice(None))),
                  ((slice(None), slice(None, -1)), (slice(None), slice(1, None)))):  # fmt: skip
@@ -123,8 +110,8 @@ def zone_band_unknown(env: Any, band_m: float = 0.8) -> dict[str, float]:
         border[b] |= diff
     if not border.any():
         return {"zone_band_cells": 0, "zone_band_unknown": 0, "zone_band_unknown_frac": 0.0}
-    band = free & (ndimage.distance_transform_edt(~border) * u.grid.resolution_m <= band_m)
-    wall, est_free = classify_u8(u.mapper.occupancy_u8)
+    band = free & (ndimage.distance_transform_edt(~border) * gt.grid.resolution_m <= band_m)
+    est_free, wall, _ = belief_classes(env.unwrapped.robot_view().belief_u8)
     unknown = band & ~wall & ~est_free
     n_band = int(band.sum())
     return {
@@ -167,7 +154,7 @@ def run_episode(spec: EpisodeSpec) -> dict[str, Any]:
     summary["info_gain_total_bits"] = entropy_at_start - info["entropy_bits"]
     path_m = info["path_length_m"]
     summary["info_gain_per_m"] = summary["info_gain_total_bits"] / path_m if path_m > 0 else None
-    u = env.unwrapped
+    gt = env.unwrapped.ground_truth()
     reason = agent.stop_reason or ("coverage_target" if terminated else "max_steps")
     record = {
         "key": spec.key,
@@ -175,9 +162,9 @@ def run_episode(spec: EpisodeSpec) -> dict[str, Any]:
         "episode": spec.episode,
         "seed": spec.seed,
         "env_id": spec.env_id,
-        "floorplan": u.scene.floorplan.name,
+        "floorplan": gt.floorplan.name,
         "floorplan_file": spec.floorplan,
-        "area_m2": float(u.scene.floorplan.area_m2),
+        "area_m2": float(gt.floorplan.area_m2),
         "steps": steps,
         "terminated": bool(terminated),
         "stop_reason": reason,
@@ -189,12 +176,12 @@ def run_episode(spec: EpisodeSpec) -> dict[str, Any]:
     if spec.npz_path:
         _write_npz(
             Path(spec.npz_path),
-            truth=u.scene.truth_u8,
-            belief=np.asarray(u.mapper.occupancy_u8),
-            trajectory=np.asarray(u.trajectory, np.float32),
-            routers=np.asarray(u.scene.radio.routers),
-            origin=np.asarray(u.grid.origin_xy),
-            resolution=np.asarray(u.grid.resolution_m),
+            truth=gt.truth_u8,
+            belief=env.unwrapped.robot_view().belief_u8,
+            trajectory=gt.trajectory.astype(np.float32),
+            routers=np.asarray(gt.radio.routers),
+            origin=np.asarray(gt.grid.origin_xy),
+            resolution=np.asarray(gt.grid.resolution_m),
         )
     if spec.gif_path:
         _write_gif(Path(spec.gif_path), frames, fps=env.metadata.get("render_fps", 10))
@@ -221,15 +208,6 @@ def _write_gif(path: Path, frames: list[np.ndarray], fps: int) -> None:
         iio.imwrite(tmp, np.stack(frames), extension=".gif", duration=1000 / fps, loop=0)
 
 
-def _save_figure(fig: Any, path: Path) -> Path:
-    import matplotlib.pyplot as plt
-
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    return path
-
-
 def load_checkpoint(path: Path) -> list[dict[str, Any]]:
     """The records of a JSONL checkpoint (an unreadable trailing line is ignored)."""
     if not path.exists():
@@ -245,195 +223,6 @@ def load_checkpoint(path: Path) -> list[dict[str, Any]]:
 
 def _save_checkpoint(path: Path, records: Iterable[dict[str, Any]]) -> None:
     write_text_atomic(path, "".join(json.dumps(r) + "\n" for r in records))
-
-
-# ---------------------------------------------------------------------------------- statistics
-def mean_ci95(values: Sequence[float]) -> tuple[float, float, int]:
-    """Mean, half-width of its 95 % confidence interval (Student t), and n (nan if n = 0)."""
-    v = np.asarray([x for x in values if x is not None and math.isfinite(x)], np.float64)
-    if len(v) == 0:
-        return math.nan, math.nan, 0
-    if len(v) == 1:
-        return float(v[0]), math.nan, 1
-    from scipy import stats
-
-    half = float(stats.t.ppf(0.975, len(v) - 1) * v.std(ddof=1) / math.sqrt(len(v)))
-    return float(v.mean()), half, len(v)
-
-
-def summarize(records: list[dict[str, Any]], agents: Sequence[str]) -> list[dict[str, Any]]:
-    """Per agent: mean, 95 % CI and n of each table metric, and episode counts."""
-    rows = []
-    for name in agents:
-        recs = [r for r in records if r["agent"] == name]
-        row: dict[str, Any] = {"agent": name, "episodes": len(recs)}
-        for key, _, _ in TABLE_METRICS:
-            vals = [r.get(key) for r in recs]
-            if key in _REACHED_METRICS:
-                vals = [v for v in vals if v is not None and v >= 0]
-            mean, ci, n = mean_ci95([v for v in vals if v is not None])
-            row[f"{key}_mean"], row[f"{key}_ci95"], row[f"{key}_n"] = mean, ci, n
-        cov = [r.get("coverage", 0.0) for r in recs]
-        row["episodes_coverage_ge_90"] = int(sum(c >= 0.9 for c in cov))
-        row["episodes_coverage_ge_80"] = int(sum(c >= 0.8 for c in cov))
-        reasons: dict[str, int] = {}
-        for r in recs:
-            reasons[r["stop_reason"]] = reasons.get(r["stop_reason"], 0) + 1
-        row["stop_reasons"] = ";".join(f"{k}:{v}" for k, v in sorted(reasons.items()))
-        rows.append(row)
-    return rows
-
-
-def results_csv(rows: list[dict[str, Any]]) -> str:
-    """The summary rows as CSV text."""
-    import csv
-    import io
-
-    buf = io.StringIO()
-    writer = csv.DictWriter(buf, fieldnames=list(rows[0]) if rows else ["agent"])
-    writer.writeheader()
-    for row in rows:
-        writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
-    return buf.getvalue()
-
-
-def results_markdown(rows: list[dict[str, Any]]) -> str:
-    """The summary rows as a Markdown table (mean ± 95 % CI)."""
-    head = ["agent", "episodes"] + [label for _, label, _ in TABLE_METRICS] + ["≥ 90 % cov."]
-    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-    for row in rows:
-        cells = [row["agent"], str(row["episodes"])]
-        for key, _, fmt in TABLE_METRICS:
-            mean, ci, n = row[f"{key}_mean"], row[f"{key}_ci95"], row[f"{key}_n"]
-            if n == 0:
-                cell = "–"
-            else:
-                cell = fmt.format(mean) + ("" if math.isnan(ci) else " ± " + fmt.format(ci))
-            if key in _REACHED_METRICS:
-                cell += f" ({n}/{row['episodes']})"
-            cells.append(cell)
-        cells.append(f"{row['episodes_coverage_ge_90']}/{row['episodes']}")
-        lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n"
-
-
-# ---------------------------------------------------------------------------------- figures
-def _colours(agents: Sequence[str]) -> dict[str, Any]:
-    import matplotlib.pyplot as plt
-
-    cmap = plt.get_cmap("tab10")
-    return {a: cmap(i % 10) for i, a in enumerate(agents)}
-
-
-def _mean_band(curves: list[tuple[np.ndarray, np.ndarray]], grid: np.ndarray):
-    """Mean and 95 % CI of step functions sampled on ``grid`` (held at their last value)."""
-    from scipy import stats
-
-    ys = []
-    for x, y in curves:
-        idx = np.clip(np.searchsorted(x, grid, side="right") - 1, 0, len(y) - 1)
-        ys.append(y[idx])
-    a = np.asarray(ys)
-    mean = a.mean(axis=0)
-    if len(a) < 2:
-        return mean, np.zeros_like(mean)
-    half = stats.t.ppf(0.975, len(a) - 1) * a.std(axis=0, ddof=1) / math.sqrt(len(a))
-    return mean, half
-
-
-def plot_curves(records: list[dict[str, Any]], agents: Sequence[str], out: Path) -> list[Path]:
-    """``coverage_vs_steps.png`` and ``iou_vs_path.png`` (mean ± 95 % CI per agent)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    colours = _colours(agents)
-    written = []
-    specs = (
-        ("coverage_vs_steps.png", 0, 1, "steps", "coverage (fraction of free cells classified)"),
-        ("iou_vs_path.png", 3, 2, "path length [m]", "map IoU (cells known in both maps)"),
-    )
-    for fname, xi, yi, xlabel, ylabel in specs:
-        fig, ax = plt.subplots(figsize=(6.4, 4.2))
-        lowest = 1.0
-        for name in agents:
-            curves = []
-            for r in records:
-                if r["agent"] != name or not r.get("curve"):
-                    continue
-                c = np.asarray(r["curve"], np.float64)
-                order = np.argsort(c[:, xi], kind="stable")
-                curves.append((c[order, xi], c[order, yi]))
-            if not curves:
-                continue
-            x_max = max(float(x[-1]) for x, _ in curves)
-            grid = np.linspace(0.0, max(x_max, 1e-9), 200)
-            mean, half = _mean_band(curves, grid)
-            ax.plot(grid, mean, color=colours[name], label=f"{name} (n={len(curves)})")
-            lo, hi = np.clip(mean - half, 0, 1), np.clip(mean + half, 0, 1)
-            ax.fill_between(grid, lo, hi, color=colours[name], alpha=0.2)
-            lowest = min(lowest, float(lo[len(lo) // 20 :].min()))  # past the first few steps
-        ax.set_xlabel(xlabel)
-        ax.set_ylabel(ylabel)
-        # Coverage spans [0, 1]; IoU stays high: zoom in on its range.
-        ax.set_ylim(0.0 if yi == 1 else max(0.0, np.floor(lowest * 20 - 1) / 20), 1.0)
-        ax.grid(alpha=0.3)
-        ax.legend(loc="lower right")
-        written.append(_save_figure(fig, out / fname))
-    return written
-
-
-def plot_trajectories(
-    records: list[dict[str, Any]], agents: Sequence[str], out: Path
-) -> list[Path]:
-    """Per episode (floorplan): every agent's path over the truth, and each final belief."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    colours = _colours(agents)
-    written = []
-    for episode in sorted({r["episode"] for r in records}):
-        recs = {r["agent"]: r for r in records if r["episode"] == episode}
-        data = {}
-        for name in agents:
-            path = out / "episodes" / f"{name}_{episode:04d}.npz"
-            if name in recs and path.exists():
-                with np.load(path) as z:
-                    data[name] = {k: z[k] for k in z.files}
-        if not data:
-            continue
-        first = next(iter(data.values()))
-        h, w = first["truth"].shape
-        res, (ox, oy) = float(first["resolution"]), first["origin"]
-        extent = (ox, ox + w * res, oy, oy + h * res)
-        n = 1 + len(data)
-        fig, axes = plt.subplots(1, n, figsize=(3.2 * n * max(w / h, 0.5), 3.6), squeeze=False)
-        ax = axes[0, 0]
-        ax.imshow(first["truth"], cmap="gray", origin="lower", extent=extent, vmin=0, vmax=255)
-        for name, d in data.items():
-            t = d["trajectory"]
-            ax.plot(t[:, 0], t[:, 1], color=colours[name], lw=0.7, label=name)
-        ax.scatter(*first["routers"].T, marker="^", color="red", s=30, zorder=5)
-        ax.set_title(f"episode {episode}: {recs[next(iter(data))]['floorplan']}", fontsize=8)
-        ax.legend(fontsize=6, loc="upper right")
-        for ax, (name, d) in zip(axes[0, 1:], data.items(), strict=True):
-            ax.imshow(d["belief"], cmap="gray", origin="lower", extent=extent, vmin=0, vmax=255)
-            t = d["trajectory"]
-            ax.plot(t[:, 0], t[:, 1], color=colours[name], lw=0.5)
-            r = recs[name]
-            ax.set_title(
-                f"{name}: cov {r.get('coverage', 0):.2f}, IoU {r.get('map_iou', 0):.2f}",
-                fontsize=8,
-            )
-        for ax in axes[0]:
-            ax.set_xticks([])
-            ax.set_yticks([])
-        plan = recs[next(iter(data))]["floorplan"][:24].replace("/", "_")
-        written.append(_save_figure(fig, out / "trajectories" / f"{episode:04d}_{plan}.png"))
-    return written
 
 
 # ---------------------------------------------------------------------------------- the runner

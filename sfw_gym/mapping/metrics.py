@@ -2,7 +2,7 @@
 
 Maps are uint8 grids in the paper's convention: 0 = wall, 255 = free, 127 = unknown (ground
 truth: 127 = outside the plan). Estimated maps may be graded; every metric classifies them by
-thirds (:func:`sfw_gym.mapping.grid.classify_u8`): ``<= 84`` wall, ``>= 171`` free, else unknown.
+thirds (:func:`sfw_gym.mapping.grid.belief_classes`): ``<= 84`` wall, ``>= 171`` free, else unknown.
 
 What we settled where the paper is ambiguous:
 
@@ -24,8 +24,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from sfw_gym.errors import ConfigError
-from sfw_gym.mapping.grid import classify_u8
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.mapping.grid import belief_classes
 
 __all__ = [
     "coverage",
@@ -83,8 +83,8 @@ def k_value_accuracy(k_est, k_true, max_k: int | None = None) -> float:
 
 
 def _known_both(e: np.ndarray, t: np.ndarray):
-    ew, ef = classify_u8(e)
-    tw, tf = classify_u8(t)
+    ef, ew, _ = belief_classes(e)
+    tf, tw, _ = belief_classes(t)
     both = (ew | ef) & (tw | tf)
     return both, ew, ef, tw, tf
 
@@ -118,8 +118,8 @@ def map_mse(est_u8, truth_u8) -> float:
 def coverage(est_u8, truth_u8) -> float:
     """Explored ratio: fraction of ground-truth free cells the map classifies (free or wall)."""
     e, t = _pair(est_u8, truth_u8)
-    ew, ef = classify_u8(e)
-    tf = classify_u8(t)[1]
+    ef, ew, _ = belief_classes(e)
+    tf = belief_classes(t)[0]
     return _ratio(np.count_nonzero(tf & (ew | ef)), np.count_nonzero(tf))
 
 
@@ -130,8 +130,8 @@ def free_iou(est_u8, truth_u8) -> float:
     cells outside the plan or on walls.
     """
     e, t = _pair(est_u8, truth_u8)
-    ef = classify_u8(e)[1]
-    tf = classify_u8(t)[1]
+    ef = belief_classes(e)[0]
+    tf = belief_classes(t)[0]
     return _ratio(np.count_nonzero(ef & tf), np.count_nonzero(ef | tf))
 
 
@@ -156,8 +156,8 @@ def wall_precision(est_u8, truth_u8, tolerance_cells: float = 2) -> float:
     """
     e, t = _pair(est_u8, truth_u8)
     tol = _check_tol(tolerance_cells)
-    ew = classify_u8(e)[0]
-    tw = classify_u8(t)[0]
+    ew = belief_classes(e)[1]
+    tw = belief_classes(t)[1]
     if not ew.any():
         return float("nan")
     dist = _distance_to(tw)
@@ -199,7 +199,7 @@ def interior_wall_cells(truth_u8, max_thickness_cells: int = 8) -> np.ndarray:
         raise ConfigError(f"truth_u8 must be a 2-D map, got shape {t.shape}")
     if isinstance(max_thickness_cells, bool) or int(max_thickness_cells) < 1:
         raise ConfigError(f"max_thickness_cells must be an int >= 1, got {max_thickness_cells!r}")
-    wall, free = classify_u8(t)
+    free, wall, _ = belief_classes(t)
     result = np.zeros(t.shape, np.bool_)
     for dr, dc in _AXES:
         sides = []
@@ -227,7 +227,7 @@ def interior_wall_recall(
     interior = interior_wall_cells(t, max_thickness_cells)
     if not interior.any():
         return float("nan")
-    dist = _distance_to(classify_u8(e)[0])
+    dist = _distance_to(belief_classes(e)[1])
     return _ratio(np.count_nonzero(dist[interior] <= tol), np.count_nonzero(interior))
 
 

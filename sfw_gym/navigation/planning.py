@@ -17,15 +17,7 @@ import numpy as np
 from scipy import ndimage
 from skimage.graph import MCP_Geometric
 
-from sfw_gym.mapping.grid import U8_FREE_MIN, U8_WALL_MAX, GridSpec
-
-
-def belief_classes(belief_u8: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Threshold a uint8 belief (0 wall, 255 free, 127 unknown) into ``(free, wall, unknown)``."""
-    b = np.asarray(belief_u8)
-    wall = b <= U8_WALL_MAX
-    free = b >= U8_FREE_MIN
-    return free, wall, ~(free | wall)
+from sfw_gym.mapping.grid import GridSpec, belief_classes
 
 
 def traversal_costs(

@@ -24,11 +24,15 @@ from typing import Any
 import numpy as np
 import yaml
 
-from sfw_gym.atomic import atomic_path, write_text_atomic
-from sfw_gym.errors import ConfigError
+from sfw_gym.core.atomic import atomic_path, write_text_atomic
+from sfw_gym.core.data import DEFAULT_HYPERPARAMS
+from sfw_gym.core.errors import ConfigError
 
-REPO_ROOT = Path(__file__).resolve().parents[1]
-DEFAULT_HYPERPARAMS = REPO_ROOT / "agents" / "hyperparams" / "ppo.yml"
+#: Classes that moved, by their old dotted path: configs and models saved before still load.
+MOVED_CLASSES = {
+    "sfw_gym.agents.waypoint_policy.WaypointPolicy": "sfw_gym.rl.policy.WaypointPolicy",
+    "sfw_gym.agents.waypoint_policy.BlockScores": "sfw_gym.rl.policy.BlockScores",
+}
 #: Evaluation episodes draw their floorplans from seeds this far from the training seeds.
 HELD_OUT_SEED_OFFSET = 1_000_000
 _PPO_KEYS = {
@@ -112,10 +116,12 @@ def wrapper_specs(value: Any) -> list[tuple[str, dict[str, Any]]]:
     return specs
 
 
-def _import_dotted(name: str) -> Any:
+def import_dotted(name: str) -> Any:
+    """The object at dotted path ``pkg.mod.Name`` (old paths in :data:`MOVED_CLASSES` resolve to
+    their new home)."""
     import importlib
 
-    module, _, attr = name.rpartition(".")
+    module, _, attr = MOVED_CLASSES.get(name, name).rpartition(".")
     try:
         return getattr(importlib.import_module(module), attr)
     except (ImportError, AttributeError, ValueError) as exc:
@@ -141,7 +147,7 @@ def _make_env_fn(env_id: str, env_kwargs: dict[str, Any], wrappers: list[tuple[s
 
         env = gym.make(env_id, **env_kwargs)
         for name, kwargs in wrappers:
-            env = _import_dotted(name)(env, **kwargs)
+            env = import_dotted(name)(env, **kwargs)
         return env
 
     return make
@@ -201,12 +207,12 @@ def train_ppo(
     n_envs = int(n_envs or params.get("n_envs", 1))
     policy = params.get("policy", "MultiInputPolicy")
     if "." in policy:  # a policy class of one's own, by dotted path
-        policy = _import_dotted(policy)
+        policy = import_dotted(policy)
     ppo_kwargs = {k: v for k, v in params.items() if k in _PPO_KEYS}
     env_kwargs = dict(env_kwargs or {})
     wrappers = wrapper_specs(params.get("env_wrapper"))
     for name, _ in wrappers:
-        _import_dotted(name)
+        import_dotted(name)
 
     previous = latest_checkpoint(out) if resume else None
     start_steps = previous[1] if previous else 0

@@ -1,0 +1,1 @@
+"""The foundation every layer may import: constants, errors, configuration, files, threads."""

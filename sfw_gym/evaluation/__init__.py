@@ -1,0 +1,29 @@
+"""Evaluation: run agents paired on the same plans and seeds, summarise with 95 % confidence
+intervals, write the results table and figures (``sfw-gym evaluate``, :func:`evaluate`)."""
+
+from __future__ import annotations
+
+from sfw_gym.evaluation.report import results_csv, results_markdown
+from sfw_gym.evaluation.runner import (
+    CHECKPOINT,
+    EpisodeSpec,
+    evaluate,
+    load_checkpoint,
+    run_episode,
+    zone_band_unknown,
+)
+from sfw_gym.evaluation.stats import TABLE_METRICS, mean_ci95, summarize
+
+__all__ = [
+    "CHECKPOINT",
+    "TABLE_METRICS",
+    "EpisodeSpec",
+    "evaluate",
+    "load_checkpoint",
+    "mean_ci95",
+    "results_csv",
+    "results_markdown",
+    "run_episode",
+    "summarize",
+    "zone_band_unknown",
+]

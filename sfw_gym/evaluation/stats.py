@@ -1,0 +1,62 @@
+"""Statistics over episode records: means with 95 % confidence intervals, per agent."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+#: Metrics of the results table: (record key, column label, format).
+TABLE_METRICS: tuple[tuple[str, str, str], ...] = (
+    ("coverage", "coverage", "{:.3f}"),
+    ("map_iou", "IoU", "{:.3f}"),
+    ("free_iou", "free IoU", "{:.3f}"),
+    ("k_accuracy", "k-accuracy", "{:.3f}"),
+    ("path_length_m", "path [m]", "{:.0f}"),
+    ("info_gain_per_m", "info gain [bits/m]", "{:.0f}"),
+    ("collisions", "collisions", "{:.0f}"),
+    ("steps_to_coverage_50", "steps to 50 %", "{:.0f}"),
+    ("steps_to_coverage_90", "steps to 90 %", "{:.0f}"),
+    ("zone_band_unknown", "unknown zone-band cells", "{:.0f}"),
+    ("zone_band_unknown_frac", "unknown zone-band fraction", "{:.3f}"),
+)
+#: "steps to x %" metrics are averaged over the episodes that got there (count reported).
+REACHED_METRICS = ("steps_to_coverage_50", "steps_to_coverage_90")
+
+
+def mean_ci95(values: Sequence[float]) -> tuple[float, float, int]:
+    """Mean, half-width of its 95 % confidence interval (Student t), and n (nan if n = 0)."""
+    v = np.asarray([x for x in values if x is not None and math.isfinite(x)], np.float64)
+    if len(v) == 0:
+        return math.nan, math.nan, 0
+    if len(v) == 1:
+        return float(v[0]), math.nan, 1
+    from scipy import stats
+
+    half = float(stats.t.ppf(0.975, len(v) - 1) * v.std(ddof=1) / math.sqrt(len(v)))
+    return float(v.mean()), half, len(v)
+
+
+def summarize(records: list[dict[str, Any]], agents: Sequence[str]) -> list[dict[str, Any]]:
+    """Per agent: mean, 95 % CI and n of each table metric, and episode counts."""
+    rows = []
+    for name in agents:
+        recs = [r for r in records if r["agent"] == name]
+        row: dict[str, Any] = {"agent": name, "episodes": len(recs)}
+        for key, _, _ in TABLE_METRICS:
+            vals = [r.get(key) for r in recs]
+            if key in REACHED_METRICS:
+                vals = [v for v in vals if v is not None and v >= 0]
+            mean, ci, n = mean_ci95([v for v in vals if v is not None])
+            row[f"{key}_mean"], row[f"{key}_ci95"], row[f"{key}_n"] = mean, ci, n
+        cov = [r.get("coverage", 0.0) for r in recs]
+        row["episodes_coverage_ge_90"] = int(sum(c >= 0.9 for c in cov))
+        row["episodes_coverage_ge_80"] = int(sum(c >= 0.8 for c in cov))
+        reasons: dict[str, int] = {}
+        for r in recs:
+            reasons[r["stop_reason"]] = reasons.get(r["stop_reason"], 0) + 1
+        row["stop_reasons"] = ";".join(f"{k}:{v}" for k, v in sorted(reasons.items()))
+        rows.append(row)
+    return rows

@@ -1,0 +1,41 @@
+"""Map analysis and motion on the robot's belief map: frontiers and hidden rooms, router zones,
+cost fields and paths, pure pursuit, and the waypoint driver. Reads maps, never the world.
+"""
+
+from __future__ import annotations
+
+from sfw_gym.navigation.frontiers import Frontier, find_frontiers, frontier_mask, hidden_rooms
+from sfw_gym.navigation.planning import (
+    CostField,
+    PurePursuit,
+    cost_field,
+    to_discrete,
+    traversal_costs,
+)
+from sfw_gym.navigation.radio_zones import dominance_bands, router_scores
+from sfw_gym.navigation.waypoints import (
+    BLOCK_FEATURES,
+    WaypointDriver,
+    block_features,
+    plan_path,
+    waypoint_goal_xy,
+)
+
+__all__ = [
+    "BLOCK_FEATURES",
+    "CostField",
+    "Frontier",
+    "PurePursuit",
+    "WaypointDriver",
+    "block_features",
+    "cost_field",
+    "dominance_bands",
+    "find_frontiers",
+    "frontier_mask",
+    "hidden_rooms",
+    "plan_path",
+    "router_scores",
+    "to_discrete",
+    "traversal_costs",
+    "waypoint_goal_xy",
+]

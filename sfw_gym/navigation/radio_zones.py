@@ -1,0 +1,154 @@
+"""Router dominance zones the robot predicts from its own map and readings.
+
+The sparse mapper updates cells only along the strongest router's ray, so the borders between
+routers' dominance zones stay unknown unless the robot crosses them. These functions predict
+every router's RSSI at every cell (a multi-wall log-distance model on the belief map, corrected
+by the robot's own readings) and find the zones and the bands along their borders.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import ndimage
+from scipy.spatial import cKDTree
+
+from sfw_gym.core.constants import NOT_HEARD_DBM
+from sfw_gym.mapping.grid import GridSpec
+
+
+def wall_crossings(
+    grid: GridSpec, walls: np.ndarray, sources_xy: np.ndarray, points_xy: np.ndarray
+) -> np.ndarray:
+    """Believed walls crossed by each segment source→point: ``(P, R)`` int.
+
+    The segment is sampled every 0.7 cell; each run of wall cells along it counts once.
+    """
+    src = np.asarray(sources_xy, np.float64).reshape(-1, 2)
+    pts = np.asarray(points_xy, np.float64).reshape(-1, 2)
+    out = np.zeros((len(pts), len(src)), np.int64)
+    if not walls.any() or len(pts) == 0:
+        return out
+    h, w = walls.shape
+    padded = np.zeros((h + 2, w + 2), bool)  # a free border: samples outside read "no wall"
+    padded[1:-1, 1:-1] = walls
+    flat_walls = padded.ravel()
+    origin = np.asarray(grid.origin_xy)
+    src_g = (src - origin) / grid.resolution_m + 1.0  # grid coordinates (x, y) in ``padded``
+    pts_g = (pts - origin) / grid.resolution_m + 1.0
+    for r, s0 in enumerate(src_g):
+        n = max(2, int(np.ceil(np.linalg.norm(pts_g - s0, axis=1).max() / 0.7)) + 1)
+        t = np.linspace(0.0, 1.0, n, dtype=np.float32)
+        for a in range(0, len(pts_g), 4096):  # chunks keep the sample arrays small
+            d = (pts_g[a : a + 4096] - s0).astype(np.float32)
+            cx = np.clip(s0[0] + d[:, None, 0] * t, 0, w + 1).astype(np.int32)
+            cy = np.clip(s0[1] + d[:, None, 1] * t, 0, h + 1).astype(np.int32)
+            hit = flat_walls[cy * (w + 2) + cx]
+            out[a : a + 4096, r] = (hit[:, 1:] & ~hit[:, :-1]).sum(axis=1) + hit[:, 0]
+    return out
+
+
+def router_scores(
+    grid: GridSpec,
+    routers_xy: np.ndarray,
+    samples_xy: np.ndarray | None = None,
+    samples_rssi: np.ndarray | None = None,
+    *,
+    walls: np.ndarray | None = None,
+    wall_loss_db: float = 10.0,
+    path_loss_exponent: float = 2.0,
+    residual_radius_m: float = 2.0,
+    coarse_cells: int = 2,
+    max_samples: int = 600,
+) -> np.ndarray:
+    """Predicted RSSI (dBm, up to a common constant) of every router at every cell.
+
+    The multi-wall log-distance model ``c − 10 n log10(max(d, 1 m)) − wall_loss_db · walls``
+    (walls: runs of believed-wall cells on the segment router→cell; one tx power for all
+    routers); with samples, each router's residuals at the samples (readings minus the model,
+    minus their common median) are spread to cells within ``residual_radius_m`` by
+    inverse-distance weighting (what the robot measured beats what it predicts).
+
+    Args:
+        grid: The map geometry.
+        routers_xy: ``(R, 2)`` router positions.
+        samples_xy: ``(T, 2)`` positions of the readings (the robot's odometry).
+        samples_rssi: ``(T, R)`` readings, dBm (``NOT_HEARD_DBM`` when not heard).
+        walls: Optional ``[row, col]`` mask of believed walls.
+        wall_loss_db: Loss per wall in the model (a prior: the robot cannot know it).
+        path_loss_exponent: ``n``.
+        residual_radius_m: Reach of a reading's residual.
+        coarse_cells: The wall term is evaluated every this many cells (speed).
+        max_samples: At most this many (evenly spread) readings are used.
+
+    Returns:
+        ``(R, n_rows, n_cols)`` float64.
+    """
+    xs, ys = grid.cell_centres()
+    cells = np.stack([xs.ravel(), ys.ravel()], axis=1)
+    routers = np.asarray(routers_xy, np.float64).reshape(-1, 2)
+    use_walls = walls is not None and bool(np.any(walls)) and wall_loss_db > 0
+
+    def distance_term(points: np.ndarray) -> np.ndarray:
+        d = np.linalg.norm(points[:, None, :] - routers[None, :, :], axis=2)
+        return -10.0 * path_loss_exponent * np.log10(np.maximum(d, 1.0))
+
+    scores = distance_term(cells)
+    if use_walls:
+        k = max(1, int(coarse_cells))
+        h, w = grid.shape
+        sub = np.stack([xs[::k, ::k].ravel(), ys[::k, ::k].ravel()], axis=1)
+        n_w = wall_crossings(grid, walls, routers, sub).reshape(*xs[::k, ::k].shape, -1)
+        n_w = np.repeat(np.repeat(n_w, k, axis=0), k, axis=1)[:h, :w]
+        scores -= wall_loss_db * n_w.reshape(-1, len(routers))
+    if samples_xy is not None and samples_rssi is not None and len(samples_xy):
+        pts = np.asarray(samples_xy, np.float64).reshape(-1, 2)
+        rssi = np.asarray(samples_rssi, np.float64).reshape(len(pts), -1)
+        if len(pts) > max_samples:
+            keep = np.linspace(0, len(pts) - 1, max_samples).astype(int)
+            pts, rssi = pts[keep], rssi[keep]
+        model = distance_term(pts)
+        if use_walls:
+            model -= wall_loss_db * wall_crossings(grid, walls, routers, pts)
+        resid = rssi - model
+        heard = rssi > NOT_HEARD_DBM
+        if heard.any():
+            resid = resid - float(np.median(resid[heard]))  # routers share one tx power
+        tree = cKDTree(pts)
+        k = min(8, len(pts))
+        dist, idx = tree.query(cells, k=k, distance_upper_bound=residual_radius_m)
+        dist, idx = dist.reshape(len(cells), k), idx.reshape(len(cells), k)
+        found = np.isfinite(dist)
+        idx = np.where(found, idx, 0)
+        for r in range(routers.shape[0]):
+            if not heard[:, r].any():
+                scores[:, r] = -np.inf
+                continue
+            e = np.where(heard[:, r], resid[:, r], 0.0)
+            w = np.where(found & heard[idx, r], 1.0 / (dist + 0.3) ** 2, 0.0)
+            wsum = w.sum(axis=1)
+            scores[:, r] += np.where(
+                wsum > 0, (w * e[idx]).sum(axis=1) / np.maximum(wsum, 1e-12), 0.0
+            )
+    return scores.T.reshape(routers.shape[0], *grid.shape)
+
+
+def dominance_bands(scores: np.ndarray, band_cells: float) -> tuple[np.ndarray, np.ndarray]:
+    """The strongest router per cell and the cells within ``band_cells`` of a zone border.
+
+    Args:
+        scores: ``(R, H, W)`` predicted RSSI per router.
+        band_cells: Half-width of the band, in cells.
+
+    Returns:
+        ``(zone, band)``: ``(H, W)`` int router index, ``(H, W)`` bool.
+    """
+    zone = np.argmax(scores, axis=0)
+    border = np.zeros(zone.shape, bool)
+    border[:-1, :] |= zone[:-1, :] != zone[1:, :]
+    border[1:, :] |= zone[1:, :] != zone[:-1, :]
+    border[:, :-1] |= zone[:, :-1] != zone[:, 1:]
+    border[:, 1:] |= zone[:, 1:] != zone[:, :-1]
+    if not border.any():
+        return zone, border
+    band = ndimage.distance_transform_edt(~border) <= band_cells
+    return zone, band

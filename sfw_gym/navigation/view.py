@@ -1,0 +1,53 @@
+"""What the robot knows at one step: the typed contract between the env and everything that
+drives the robot (agents, the waypoint driver). Never the ground truth."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from sfw_gym.mapping.grid import GridSpec
+
+
+@dataclass(frozen=True)
+class RobotView:
+    """What the robot knows at one step (``SfWExploreEnv.robot_view()``).
+
+    Attributes:
+        belief_u8: A copy of the belief map (0 wall, 255 free, 127 unknown), ``[row, col]``.
+        probability: P(occupied) per cell.
+        grid: The map's geometry.
+        odometry_pose: ``(x, y, θ)`` from odometry (m, rad), not the true pose.
+        routers_xy: ``(R, 2)`` router positions (the robot knows its routers).
+        rssi_history: ``(T, R)`` readings so far, dBm (``NOT_HEARD_DBM`` when not heard).
+        bumped: Whether the last step bumped into something.
+        radius_m: The robot's radius.
+        max_linear_speed_m_s, max_angular_speed_rad_s, control_period_s: Its motion limits.
+        action_type: ``"continuous"`` or ``"discrete"``.
+    """
+
+    belief_u8: np.ndarray
+    probability: np.ndarray
+    grid: GridSpec
+    odometry_pose: tuple[float, float, float]
+    routers_xy: np.ndarray
+    rssi_history: np.ndarray
+    bumped: bool
+    radius_m: float
+    max_linear_speed_m_s: float
+    max_angular_speed_rad_s: float
+    control_period_s: float
+    action_type: str
+
+    @property
+    def xy(self) -> np.ndarray:
+        """Odometry position ``(x, y)``."""
+        return np.array(self.odometry_pose[:2], np.float64)
+
+    @property
+    def cell(self) -> tuple[int, int]:
+        """Grid cell ``(row, col)`` of the odometry position (clipped into the grid)."""
+        r, c = self.grid.world_to_cell(self.xy)
+        h, w = self.grid.shape
+        return min(max(int(r), 0), h - 1), min(max(int(c), 0), w - 1)
