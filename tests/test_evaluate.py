@@ -12,9 +12,9 @@ import pytest
 
 import sfw_gym  # noqa: F401
 from sfw_gym import evaluation as ev
-from sfw_gym.evaluation import runner
 from sfw_gym.cli import main
 from sfw_gym.core.errors import ConfigError
+from sfw_gym.evaluation import runner
 
 SMALL = "SfW-ExploreSmall-v0"
 #: Short episodes keep the suite fast.

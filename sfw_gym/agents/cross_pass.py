@@ -168,8 +168,9 @@ class CrossPassAgent(FrontierAgent):
         c_rc = (int(np.median(rows)), int(np.median(cols)))
         a = int(self.zone[c_rc])
         others = [r for r in range(len(self.scores)) if r != a]
-        b = max(others, key=lambda r: self.scores[r][c_rc])
-        diff = self.scores[a] - self.scores[b]
+        scores = self.scores
+        b = max(others, key=lambda r: scores[r][c_rc])
+        diff = scores[a] - scores[b]
         gy, gx = np.gradient(diff)
         normal = np.array([gx[c_rc], gy[c_rc]])
         if not np.isfinite(normal).all() or np.linalg.norm(normal) < 1e-9:

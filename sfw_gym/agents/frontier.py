@@ -279,7 +279,7 @@ class FrontierAgent(Agent):
         if goal is None:
             return
         goal.bumps += int(bumped)
-        remaining = float(np.linalg.norm(view.xy - view.grid.cell_to_world(goal.cell)))
+        remaining = float(np.linalg.norm(view.xy - view.grid.cell_to_world(np.asarray(goal.cell))))
         if remaining < goal.best_remaining_m - 0.05:
             goal.best_remaining_m = remaining
             goal.steps_without_progress = 0

@@ -117,7 +117,9 @@ class GreedyInfoGainAgent(FrontierAgent):
             cells = cells[np.linspace(0, len(cells) - 1, self.max_candidates).astype(int)]
         dist = approach[cells[:, 0], cells[:, 1]]
         score = self.expected_gain(view, cells) / (dist + self.distance_offset_m)
-        self.candidates = list(zip(map(tuple, cells.tolist()), score.tolist(), strict=True))
+        self.candidates = [
+            ((int(r), int(c)), s) for (r, c), s in zip(cells.tolist(), score.tolist(), strict=True)
+        ]
         i = int(np.argmax(score))
         target = (int(cells[i, 0]), int(cells[i, 1]))
         self._resume()

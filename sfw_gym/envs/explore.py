@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -93,7 +93,7 @@ class SfWExploreEnv(gym.Env):
     - v0: initial release.
     """
 
-    metadata: ClassVar[dict[str, Any]] = {"render_modes": ["rgb_array", "human"], "render_fps": 10}
+    metadata: dict[str, Any] = {"render_modes": ["rgb_array", "human"], "render_fps": 10}  # noqa: RUF012
 
     def __init__(
         self,
@@ -334,11 +334,12 @@ class SfWExploreEnv(gym.Env):
         if s is None:
             raise gym.error.ResetNeeded("call reset() before robot_view()")
         cfg = self.robot_config
+        odom_x, odom_y, odom_theta = s.robot.odometry_pose
         return RobotView(
             belief_u8=self.mapper.occupancy_u8.copy(),
             probability=self.mapper.probability,
             grid=self.grid,
-            odometry_pose=tuple(s.robot.odometry_pose),
+            odometry_pose=(float(odom_x), float(odom_y), float(odom_theta)),
             routers_xy=np.array(s.radio.routers),
             rssi_history=np.array(self.rssi_history),
             bumped=bool(s.robot.bumped),
@@ -423,6 +424,14 @@ def _check_number(name: str, value: Any, lo: float, hi: float) -> None:
         raise ConfigError(f"{name} must be a number in [{lo}, {hi}], got {value!r}")
 
 
+def unwrap_sfw(env: gym.Env) -> SfWExploreEnv:
+    """The SfW-Explore env under ``env``'s wrappers (a ConfigError if there is none)."""
+    base = env.unwrapped
+    if not isinstance(base, SfWExploreEnv):
+        raise ConfigError(f"expected an SfW-Explore env, got {type(base).__name__}")
+    return base
+
+
 def _frame_size(size: Any) -> tuple[int, int] | None:
     if size is None:
         return None
@@ -455,4 +464,4 @@ def _folder_plans(source: Any) -> list[Path]:
     return []
 
 
-__all__ = ["DISCRETE_ACTION_NAMES", "SfWExploreEnv"]
+__all__ = ["DISCRETE_ACTION_NAMES", "SfWExploreEnv", "unwrap_sfw"]

@@ -1,7 +1,7 @@
 """Map-quality metrics kept up to date cell by cell, so that every step's info is cheap.
 
-The figures equal `sfw_gym.mapping.metrics` on the full maps (a test holds them to it); here they cost
-O(cells changed this step) instead of O(grid).
+The figures equal `sfw_gym.mapping.metrics` on the full maps (a test holds them to it); here they
+cost O(cells changed this step) instead of O(grid).
 """
 
 from __future__ import annotations
@@ -78,8 +78,8 @@ def _apply(changed, est_u8, est_cls, truth_cls, near_wall, interior, found_by, o
 class MapTracker:
     """Coverage, paper IoU, free IoU, wall precision and interior-wall recall of a belief map.
 
-    Each equals its `sfw_gym.mapping.metrics` function on the full maps, except that an undefined ratio
-    (empty denominator) reads 0.0 here rather than nan.
+    Each equals its `sfw_gym.mapping.metrics` function on the full maps, except that an undefined
+    ratio (empty denominator) reads 0.0 here rather than nan.
 
     Args:
         truth_u8: the ground-truth grid (0 wall, 255 free, 127 outside).
@@ -153,5 +153,5 @@ class MapTracker:
         return self._ratio(self._counts[_INTERIOR_FOUND], self._n_interior)
 
     def map_mse(self, est_u8: np.ndarray) -> float:
-        """`sfw_gym.mapping.metrics.map_mse` (graded values: computed on the full map, at episode end)."""
+        """`sfw_gym.mapping.metrics.map_mse` (graded values: on the full map, at episode end)."""
         return metrics.map_mse(est_u8, self.truth_u8)

@@ -11,6 +11,7 @@ import numpy as np
 from gymnasium import spaces
 
 from sfw_gym.core.errors import ConfigError
+from sfw_gym.envs.explore import unwrap_sfw
 from sfw_gym.navigation.planning import to_discrete
 from sfw_gym.navigation.waypoints import (
     BLOCK_FEATURES,
@@ -44,11 +45,17 @@ class WaypointWrapper(gym.Wrapper):
         max_steps_per_waypoint: int = 60,
     ):
         super().__init__(env)
-        if not hasattr(env.unwrapped, "robot_view"):
-            raise ConfigError("WaypointWrapper needs an SfW-Explore env (with robot_view())")
+        try:
+            self._robot_view = unwrap_sfw(env).robot_view
+        except ConfigError:
+            raise ConfigError(
+                "WaypointWrapper needs an SfW-Explore env (with robot_view())"
+            ) from None
+        assert isinstance(env.observation_space, spaces.Dict)
         self.driver = WaypointDriver(grid_cells, max_steps_per_waypoint)
         self._collisions = 0
-        self.action_space = spaces.Discrete(grid_cells * grid_cells)
+        self.n_waypoints = grid_cells * grid_cells
+        self.action_space = spaces.Discrete(self.n_waypoints)
         blocks = spaces.Box(0.0, 2.0, (grid_cells * grid_cells, len(BLOCK_FEATURES)), np.float32)
         self.observation_space = spaces.Dict({**env.observation_space.spaces, "blocks": blocks})
 
@@ -61,17 +68,17 @@ class WaypointWrapper(gym.Wrapper):
 
     def goal_xy(self, action: int) -> np.ndarray:
         """World (x, y) of the centre of coarse cell ``action``."""
-        grid = self.env.unwrapped.robot_view().grid
+        grid = self._robot_view().grid
         return waypoint_goal_xy(grid, self.driver.grid_cells, action)
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         """Plan to waypoint ``action`` and drive there (see the class doc)."""
         a = np.asarray(action)
-        if a.shape != () or a.dtype.kind not in "iu" or not 0 <= int(a) < self.action_space.n:
+        if a.shape != () or a.dtype.kind not in "iu" or not 0 <= int(a) < self.n_waypoints:
             raise ValueError(
-                f"waypoint action must be an integer in [0, {self.action_space.n}), got {action!r}"
+                f"waypoint action must be an integer in [0, {self.n_waypoints}), got {action!r}"
             )
-        view = self.env.unwrapped.robot_view()
+        view = self._robot_view()
         self.driver.start(view, int(a))
         pose, bumped = view.odometry_pose, False
         total, collisions = 0.0, self._collisions
@@ -92,7 +99,7 @@ class WaypointWrapper(gym.Wrapper):
         return self._with_blocks(obs), total, terminated, truncated, info
 
     def _with_blocks(self, obs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-        view = self.env.unwrapped.robot_view()
+        view = self._robot_view()
         blocks = block_features(
             view.belief_u8, view.grid, view.odometry_pose, self.driver.grid_cells
         )

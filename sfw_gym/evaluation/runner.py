@@ -35,6 +35,7 @@ import numpy as np
 from sfw_gym.core.atomic import atomic_path, write_text_atomic
 from sfw_gym.core.constants import U8_FREE
 from sfw_gym.core.errors import ConfigError
+from sfw_gym.envs.explore import unwrap_sfw
 from sfw_gym.evaluation.plots import plot_curves, plot_trajectories
 from sfw_gym.evaluation.report import results_csv, results_markdown
 from sfw_gym.evaluation.stats import summarize
@@ -93,7 +94,7 @@ def zone_band_unknown(env: Any, band_m: float = 0.8) -> dict[str, float]:
 
     from sfw_gym.mapping.grid import belief_classes
 
-    gt = env.unwrapped.ground_truth()
+    gt = unwrap_sfw(env).ground_truth()
     truth = gt.truth_u8
     free = truth == U8_FREE
     routers = gt.radio.routers
@@ -111,7 +112,7 @@ def zone_band_unknown(env: Any, band_m: float = 0.8) -> dict[str, float]:
     if not border.any():
         return {"zone_band_cells": 0, "zone_band_unknown": 0, "zone_band_unknown_frac": 0.0}
     band = free & (ndimage.distance_transform_edt(~border) * gt.grid.resolution_m <= band_m)
-    est_free, wall, _ = belief_classes(env.unwrapped.robot_view().belief_u8)
+    est_free, wall, _ = belief_classes(unwrap_sfw(env).robot_view().belief_u8)
     unknown = band & ~wall & ~est_free
     n_band = int(band.sum())
     return {
@@ -138,7 +139,7 @@ def run_episode(spec: EpisodeSpec) -> dict[str, Any]:
     entropy_at_start = info["entropy_bits"]
     agent = make_agent(spec.agent, **spec.agent_params)
     agent.reset(env, seed=spec.seed)
-    frames = [env.render()] if render else []
+    frames: list[Any] = [env.render()] if render else []
     curve: list[tuple[int, float, float, float]] = [(0, info["coverage"], info["map_iou"], 0.0)]
     steps, terminated, truncated = 0, False, False
     while not (terminated or truncated):
@@ -154,7 +155,7 @@ def run_episode(spec: EpisodeSpec) -> dict[str, Any]:
     summary["info_gain_total_bits"] = entropy_at_start - info["entropy_bits"]
     path_m = info["path_length_m"]
     summary["info_gain_per_m"] = summary["info_gain_total_bits"] / path_m if path_m > 0 else None
-    gt = env.unwrapped.ground_truth()
+    gt = unwrap_sfw(env).ground_truth()
     reason = agent.stop_reason or ("coverage_target" if terminated else "max_steps")
     record = {
         "key": spec.key,
@@ -177,7 +178,7 @@ def run_episode(spec: EpisodeSpec) -> dict[str, Any]:
         _write_npz(
             Path(spec.npz_path),
             truth=gt.truth_u8,
-            belief=env.unwrapped.robot_view().belief_u8,
+            belief=unwrap_sfw(env).robot_view().belief_u8,
             trajectory=gt.trajectory.astype(np.float32),
             routers=np.asarray(gt.radio.routers),
             origin=np.asarray(gt.grid.origin_xy),
@@ -196,9 +197,9 @@ def _py(v: Any) -> Any:
 
 
 # ---------------------------------------------------------------------------------- atomic I/O
-def _write_npz(path: Path, **arrays: np.ndarray) -> None:
+def _write_npz(path: Path, **arrays: Any) -> None:
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:
-        np.savez_compressed(fh, **arrays)
+        np.savez_compressed(fh, allow_pickle=False, **arrays)
 
 
 def _write_gif(path: Path, frames: list[np.ndarray], fps: int) -> None:

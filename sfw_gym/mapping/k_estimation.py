@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -247,7 +248,7 @@ def fit_levels(data: np.ndarray, max_k: int, min_gap_db: float, min_fraction: fl
     if np.unique(q).size < n_clusters:
         q = np.quantile(uniq, (np.arange(n_clusters) + 0.5) / n_clusters)
     spread = np.linspace(uniq[0], uniq[-1], n_clusters)
-    best = None
+    best: tuple[Any, np.ndarray] | None = None
     # One thread: the fit is tiny, OpenMP spin-waits cost milliseconds, and a fork stays safe.
     with single_threaded_openmp(), warnings.catch_warnings():
         # Fewer distinct clusters than asked (repeated values) is fine: empty ones are dropped.
@@ -257,6 +258,7 @@ def fit_levels(data: np.ndarray, max_k: int, min_gap_db: float, min_fraction: fl
             labels = km.fit_predict(x[:, None])
             if best is None or km.inertia_ < best[0].inertia_:
                 best = (km, labels)
+    assert best is not None
     km, labels = best
     counts = np.bincount(labels, minlength=n_clusters)
     keep = counts > 0
@@ -332,7 +334,7 @@ class KEstimator:
         self.n_refits = 0
 
     # -- state shared with the mapper's compiled kernel ------------------------------------
-    def _kernel_args(self) -> tuple:
+    def _kernel_args(self) -> tuple[Any, ...]:
         cfg = self.config
         return (
             cfg.k_estimator == "distance_aware",
@@ -380,7 +382,7 @@ class KEstimator:
         """
         rssi = self._check("rssi_dbm", rssi_dbm)
         dist = self._check("distances_m", distances_m)
-        due = add_samples(rssi, dist, *self._kernel_args(), self._feature, self._k)
+        due = add_samples(rssi, dist, *self._kernel_args(), self._feature, self._k)  # type: ignore[call-arg]  # numba
         if due:
             self.refit()
             self._k[:] = self.estimate(self._feature)

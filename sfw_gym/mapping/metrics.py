@@ -52,7 +52,7 @@ def _pair(est, truth) -> tuple[np.ndarray, np.ndarray]:
     return e, t
 
 
-def _ratio(num: int | float, den: int | float) -> float:
+def _ratio(num: float | np.integer, den: float | np.integer) -> float:
     return float(num) / float(den) if den else float("nan")
 
 

@@ -13,7 +13,7 @@ The first two columns are the robot's position (whatever their names), the other
 - a row whose position is empty or NaN is skipped and counted;
 - a file without a header (first row all numbers) is read as data, columns named ``column<i>``;
 - anything else (missing file, no data rows, a non-numeric or infinite cell, a row with the wrong
-  number of cells) raises :class:`~sfw_gym.core.errors.ConfigError` naming the file, the line and the
+  number of cells) raises :class:`~sfw_gym.ConfigError` naming the file, the line and the
   problem.
 
 :func:`map_log` runs :class:`~sfw_gym.mapping.SparseInverseKVisibility` over the log on a grid

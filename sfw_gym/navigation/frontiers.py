@@ -84,8 +84,8 @@ def find_frontiers(
     rows, cols, lab = rows[keep], cols[keep], lab[keep]
     order = np.argsort(lab, kind="stable")
     rows, cols, lab = rows[order], cols[order], lab[order]
-    starts = np.flatnonzero(np.r_[True, lab[1:] != lab[:-1]]) if len(lab) else []
-    ends = np.r_[starts[1:], len(lab)] if len(lab) else []
+    starts = np.flatnonzero(np.r_[True, lab[1:] != lab[:-1]])
+    ends = np.r_[starts[1:], len(lab)]
     out = []
     for a, b in zip(starts, ends, strict=True):
         cells = np.stack([rows[a:b], cols[a:b]], axis=1)

@@ -86,7 +86,8 @@ def router_scores(
     xs, ys = grid.cell_centres()
     cells = np.stack([xs.ravel(), ys.ravel()], axis=1)
     routers = np.asarray(routers_xy, np.float64).reshape(-1, 2)
-    use_walls = walls is not None and bool(np.any(walls)) and wall_loss_db > 0
+    wall_mask = np.zeros(grid.shape, bool) if walls is None else np.asarray(walls, bool)
+    use_walls = bool(wall_mask.any()) and wall_loss_db > 0
 
     def distance_term(points: np.ndarray) -> np.ndarray:
         d = np.linalg.norm(points[:, None, :] - routers[None, :, :], axis=2)
@@ -97,7 +98,7 @@ def router_scores(
         k = max(1, int(coarse_cells))
         h, w = grid.shape
         sub = np.stack([xs[::k, ::k].ravel(), ys[::k, ::k].ravel()], axis=1)
-        n_w = wall_crossings(grid, walls, routers, sub).reshape(*xs[::k, ::k].shape, -1)
+        n_w = wall_crossings(grid, wall_mask, routers, sub).reshape(*xs[::k, ::k].shape, -1)
         n_w = np.repeat(np.repeat(n_w, k, axis=0), k, axis=1)[:h, :w]
         scores -= wall_loss_db * n_w.reshape(-1, len(routers))
     if samples_xy is not None and samples_rssi is not None and len(samples_xy):
@@ -108,7 +109,7 @@ def router_scores(
             pts, rssi = pts[keep], rssi[keep]
         model = distance_term(pts)
         if use_walls:
-            model -= wall_loss_db * wall_crossings(grid, walls, routers, pts)
+            model -= wall_loss_db * wall_crossings(grid, wall_mask, routers, pts)
         resid = rssi - model
         heard = rssi > NOT_HEARD_DBM
         if heard.any():
@@ -124,10 +125,10 @@ def router_scores(
                 scores[:, r] = -np.inf
                 continue
             e = np.where(heard[:, r], resid[:, r], 0.0)
-            w = np.where(found & heard[idx, r], 1.0 / (dist + 0.3) ** 2, 0.0)
-            wsum = w.sum(axis=1)
+            weight = np.where(found & heard[idx, r], 1.0 / (dist + 0.3) ** 2, 0.0)
+            wsum = weight.sum(axis=1)
             scores[:, r] += np.where(
-                wsum > 0, (w * e[idx]).sum(axis=1) / np.maximum(wsum, 1e-12), 0.0
+                wsum > 0, (weight * e[idx]).sum(axis=1) / np.maximum(wsum, 1e-12), 0.0
             )
     return scores.T.reshape(routers.shape[0], *grid.shape)
 

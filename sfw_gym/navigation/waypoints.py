@@ -135,7 +135,8 @@ def plan_path(
     ones; an empty (0, 2) array when nothing is reachable.
     """
     cost = traversal_costs(belief_u8, grid.resolution_m, radius_m, blocked=blocked)
-    start = tuple(int(v) for v in grid.world_to_cell(np.array(pose[:2])))
+    row, col = (int(v) for v in grid.world_to_cell(np.array(pose[:2])))
+    start = (row, col)
     field = cost_field(free_start(cost, start), start, grid.resolution_m)
     reachable = field.reachable()
     if not reachable.any():

@@ -114,7 +114,7 @@ class PPOAgent(Agent):
         self.waypoints = waypoint_settings(config)
         self.model = _load_model(str(model_path), device)
         if self.waypoints is None:
-            self.action_types = ("continuous",)
+            self.action_types = ("continuous",)  # type: ignore[misc]  # this model's only
 
     def _choose(self, obs: dict[str, np.ndarray]) -> int:
         """The policy's waypoint for ``obs``: its mode, or a sample drawn with ``self.rng``."""
@@ -167,4 +167,4 @@ class PPOAgent(Agent):
             self.driver.start(view, self._choose(obs))
             self.goals.append((float(self.driver.goal[0]), float(self.driver.goal[1])))
             command = self.driver.command(view.odometry_pose, False)
-        return command
+        return command if command is not None else (0.0, 0.0)

@@ -22,7 +22,7 @@ class BlockScores(BaseFeaturesExtractor):
     """Features = ``[score of each block (n), every block's features flattened (n·f)]``."""
 
     def __init__(self, observation_space: spaces.Dict, hidden: int = 64) -> None:
-        n, f = observation_space["blocks"].shape
+        n, f = observation_space["blocks"].shape or (0, 0)
         super().__init__(observation_space, features_dim=n + n * f)
         self.n_blocks = n
         self.scorer = nn.Sequential(
@@ -59,7 +59,10 @@ class WaypointPolicy(MultiInputActorCriticPolicy):
 
     def _build(self, lr_schedule: Any) -> None:
         super()._build(lr_schedule)
+        assert isinstance(self.action_space, spaces.Discrete)
         self.action_net = _Scores(int(self.action_space.n))
-        self.optimizer = self.optimizer_class(
-            self.parameters(), lr=lr_schedule(1), **self.optimizer_kwargs
+        self.optimizer = self.optimizer_class(  # as SB3 builds it (its Optimizer type has no lr)
+            self.parameters(),
+            lr=lr_schedule(1),  # type: ignore[call-arg]
+            **self.optimizer_kwargs,
         )

@@ -75,8 +75,8 @@ def parse_policy_kwargs(text: str) -> dict[str, Any]:
             return {kw.arg: value(kw.value) for kw in node.keywords}
         if isinstance(node, ast.List | ast.Tuple):
             return [value(e) for e in node.elts]
-        if isinstance(node, ast.Dict):
-            return {value(k): value(v) for k, v in zip(node.keys, node.values, strict=True)}
+        if isinstance(node, ast.Dict) and all(k is not None for k in node.keys):
+            return {value(k): value(v) for k, v in zip(node.keys, node.values, strict=True)}  # type: ignore[arg-type]
         if isinstance(node, ast.Constant):
             return node.value
         raise ConfigError(f"policy_kwargs: only dict(...) and literals are allowed: {text!r}")
@@ -99,7 +99,7 @@ def wrapper_specs(value: Any) -> list[tuple[str, dict[str, Any]]]:
     """
     if value is None:
         return []
-    specs = []
+    specs: list[tuple[str, dict[str, Any]]] = []
     for entry in value if isinstance(value, list) else [value]:
         if isinstance(entry, str):
             specs.append((entry, {}))
@@ -216,8 +216,8 @@ def train_ppo(
 
     previous = latest_checkpoint(out) if resume else None
     start_steps = previous[1] if previous else 0
-    if start_steps >= timesteps:  # already there (e.g. killed after its last checkpoint)
-        with atomic_path(out / "model.zip") as tmp:
+    if previous is not None and start_steps >= timesteps:  # already there (killed after its last
+        with atomic_path(out / "model.zip") as tmp:  # checkpoint)
             shutil.copyfile(previous[0], tmp)
         steps, wall = start_steps, 0.0
     else:
@@ -292,7 +292,8 @@ def plot_training_curve(out_dir: str | Path) -> Path | None:
     import matplotlib.pyplot as plt
 
     out = Path(out_dir)
-    steps, returns = [], []
+    steps: list[float] = []
+    returns: list[float] = []
 
     def start_of(path: Path) -> int:
         return int(path.name.split("_")[1].split(".")[0])

@@ -291,15 +291,19 @@ def _from_sfw_dict(data: Mapping[str, Any]) -> Floorplan:
         if not isinstance(room, Mapping) or "label" not in room or "box" not in room:
             raise FloorplanError(f"rooms[{i}] must be an object with 'label' and 'box'")
         rooms.append(
-            Room(str(room["label"]), tuple(_parse_numbers(room["box"], f"rooms[{i}].box", 4)))
+            Room(str(room["label"]), _box(_parse_numbers(room["box"], f"rooms[{i}].box", 4)))
         )
     return Floorplan(
         Polygon(shell, hole_rings),
         Polygon(_parse_ring(data["footprint"], "footprint")),
         tuple(materials),
         name=str(data.get("name", "floorplan")),
-        rooms=tuple(rooms),  # type: ignore[arg-type]
+        rooms=tuple(rooms),
     )
+
+
+def _box(v: list[float]) -> tuple[float, float, float, float]:
+    return v[0], v[1], v[2], v[3]
 
 
 def _parse_numbers(values: Any, what: str, n: int) -> list[float]:

@@ -657,10 +657,10 @@ def _build(
 
     # Material of each free-space edge: the wall its midpoint, pushed outward, lands in.
     pts = [np.asarray(ring.coords) for ring in (free.exterior, *free.interiors)]
-    p0 = np.vstack([q[:-1] for q in pts])
+    starts = np.vstack([q[:-1] for q in pts])
     d = np.vstack([q[1:] - q[:-1] for q in pts])
     normal = np.stack([d[:, 1], -d[:, 0]], 1) / np.hypot(d[:, 0], d[:, 1])[:, None]
-    probe = p0 + 0.5 * d + _PUSH * normal
+    probe = starts + 0.5 * d + _PUSH * normal
     inside = _in_region(layout, probe[:, 0], probe[:, 1])
     hit = (
         (probe[:, 0:1] >= r[None, :, 0])

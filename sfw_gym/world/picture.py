@@ -71,7 +71,7 @@ def draw_world(
     with atomic_path(out) as tmp:
         fig.savefig(tmp, dpi=110)
     plt.close(fig)
-    return out
+    return Path(out)
 
 
 def _contour(extent: tuple[float, float, float, float]) -> dict:

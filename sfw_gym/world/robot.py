@@ -171,12 +171,13 @@ class _DriveBody(pymunk.Body):
     angular_rad_s: float
 
 
-def _kinematic_drive(body: _DriveBody, gravity: Any, damping: float, dt: float) -> None:
+def _kinematic_drive(body: Any, gravity: Any, damping: float, dt: float) -> None:
     """pymunk velocity callback: drive along the current heading at the commanded rates.
 
     Called once per substep after positions are integrated and contacts found, before the contact
     solver; the solver then removes any velocity into a wall. A module-level function so that the
-    body (and the space) pickle.
+    body (and the space) pickle. ``body`` is a :class:`_DriveBody` (typed ``Any``: pymunk types
+    the callback's body as a plain ``Body``).
     """
     speed = body.linear_m_s
     angle = body.angle
@@ -190,8 +191,9 @@ class _WorldSpace(pymunk.Space):
     robot_touched: bool
 
 
-def _record_contact(arbiter: pymunk.Arbiter, space: _WorldSpace, data: Any) -> None:
-    """pymunk pre-solve callback: the robot touches a wall during this substep."""
+def _record_contact(arbiter: pymunk.Arbiter, space: Any, data: Any) -> None:
+    """pymunk pre-solve callback: the robot touches a wall during this substep (``space`` is a
+    :class:`_WorldSpace`)."""
     space.robot_touched = True
 
 
