@@ -81,33 +81,41 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
             "sfw_gym/mapping/raycast.py",
         ],
         [
-            "tests/test_sparse_mapper.py",
-            "tests/test_k_estimation.py",
-            "tests/test_grid.py",
-            "tests/test_dense_mapper.py",
+            "tests/mapping/test_sparse_mapper.py",
+            "tests/mapping/test_k_estimation.py",
+            "tests/mapping/test_grid.py",
+            "tests/mapping/test_dense_mapper.py",
         ],
     ),
-    "radio": (["sfw_gym/world/radio.py"], ["tests/test_radio.py"]),
-    "navigation": (["sfw_gym/navigation/planning.py"], ["tests/test_navigation.py"]),
+    "radio": (["sfw_gym/world/radio.py"], ["tests/world/test_radio.py"]),
+    "navigation": (
+        sorted(str(p.relative_to(ROOT)) for p in (ROOT / "sfw_gym" / "navigation").glob("*.py")),
+        [
+            "tests/navigation/test_planning.py",
+            "tests/agents/test_agents.py",
+            "tests/agents/test_agent_rules.py",
+            "tests/envs/test_waypoint.py",
+        ],
+    ),
     "agents": (
         sorted(str(p.relative_to(ROOT)) for p in (ROOT / "sfw_gym" / "agents").glob("*.py")),
         [
-            "tests/test_agents.py",
-            "tests/test_agent_rules.py",
-            "tests/test_agent_behaviour.py",
-            "tests/test_ppo_agent.py",
+            "tests/agents/test_agents.py",
+            "tests/agents/test_agent_rules.py",
+            "tests/agents/test_agent_behaviour.py",
+            "tests/rl/test_ppo_agent.py",
         ],
     ),
     "env": (
         ["sfw_gym/envs/explore.py", "sfw_gym/envs/waypoint.py"],
         [
-            "tests/test_envs.py",
-            "tests/test_explore_env.py",
-            "tests/test_waypoint.py",
-            "tests/test_rewards.py",
+            "tests/envs/test_envs.py",
+            "tests/envs/test_explore_env.py",
+            "tests/envs/test_waypoint.py",
+            "tests/envs/test_rewards.py",
         ],
     ),
-    "cli": (["sfw_gym/cli.py"], ["tests/test_cli.py", "tests/test_demo.py"]),
+    "cli": (["sfw_gym/cli.py"], ["tests/cli/test_cli.py", "tests/cli/test_demo.py"]),
 }
 
 COLUMNS = ["mutants", "killed", "survived", "timeout", "no tests", "other", "equivalent"]
@@ -275,7 +283,7 @@ def section(results: dict) -> str:
         " `scripts/mutation.py --report-only --list-survivors`. mutmut does not mutate decorated"
         " functions, so the numba `@njit` kernels (the sparse mapper's ray update, the k-threshold"
         " kernel, grid traversal, the RSSI and wall-crossing kernels) are not in these numbers:"
-        " they are checked against the dense oracle (`tests/test_dense_mapper.py`) and"
+        " they are checked against the dense oracle (`tests/mapping/test_dense_mapper.py`) and"
         " hand-computed cases instead. Each mutant runs only the tests of its group's test files"
         " that call the mutated function (`GROUPS` in the script)."
     )

@@ -11,7 +11,7 @@ from sfw_gym.agents import CrossPassAgent, FrontierAgent, GreedyInfoGainAgent, R
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.navigation.planning import cost_field, disk_offsets
 from sfw_gym.rl.agent import waypoint_settings
-from tests.test_agents import F, FakeEnv, U, W, _walled_room_with_unreachable_frontier
+from tests.agents.test_agents import F, FakeEnv, U, W, _walled_room_with_unreachable_frontier
 
 SMALL = "SfW-ExploreSmall-v0"
 

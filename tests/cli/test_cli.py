@@ -3,7 +3,7 @@ its outputs; bad input exits 2 with one error line that names the offending argu
 usage lines may come first), never a traceback.
 
 ``demo``'s good run (three agents on full-size plans) is too slow for this table; it is covered by
-``tests/test_demo.py``. ``train``'s good case here is a single 32-step PPO rollout.
+``tests/cli/test_demo.py``. ``train``'s good case here is a single 32-step PPO rollout.
 """
 
 from __future__ import annotations
@@ -161,7 +161,7 @@ CASES = [
         id="train-hyperparams-malformed"),
     bad([*TRAIN, "--out", "{tmp}/afile"], r"argument --out: .*afile", id="train-out-is-a-file"),
     bad(["train", "a2c"], r"argument algo: invalid choice: 'a2c'", id="train-algo-unknown"),
-    # -- demo (its good run: tests/test_demo.py)
+    # -- demo (its good run: tests/cli/test_demo.py)
     bad([*DEMO, "--episodes", "0"], r"argument --episodes: .*'0'", id="demo-episodes-0"),
     bad([*DEMO, "--workers", "0"], r"argument --workers: .*'0'", id="demo-workers-0"),
     bad([*DEMO, "--seed", "-1"], r"argument --seed: .*'-1'", id="demo-seed-negative"),
