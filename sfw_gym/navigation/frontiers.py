@@ -82,6 +82,8 @@ def find_frontiers(
     sizes = np.bincount(lab, minlength=n + 1)
     keep = sizes[lab] >= min_size_cells
     rows, cols, lab = rows[keep], cols[keep], lab[keep]
+    if not len(lab):
+        return []
     order = np.argsort(lab, kind="stable")
     rows, cols, lab = rows[order], cols[order], lab[order]
     starts = np.flatnonzero(np.r_[True, lab[1:] != lab[:-1]])
