@@ -20,13 +20,13 @@ the true k-values) stays out of reach.
 
 from __future__ import annotations
 
-import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from typing import Any, ClassVar
 
 import numpy as np
 
+from sfw_gym.core.config import check
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.navigation.view import RobotView
 
@@ -88,9 +88,7 @@ class Agent(ABC):
     action_types: ClassVar[tuple[str, ...]] = ("continuous", "discrete")
 
     def __init__(self, max_steps: int | None = None) -> None:
-        if max_steps is not None and (not isinstance(max_steps, int) or max_steps < 1):
-            raise ConfigError(f"max_steps must be None or an int >= 1, got {max_steps!r}")
-        self.max_steps = max_steps
+        self.max_steps = check("max_steps", max_steps, integer=True, ge=1, optional=True)
         self.stop_reason: str | None = None
         self.steps = 0
         self._view: RobotViewHandle | None = None
@@ -175,11 +173,3 @@ class Agent(ABC):
 
             return to_discrete(linear, angular)
         return np.array([linear, angular], np.float32)
-
-
-def check_fraction(name: str, value: Any, lo: float = 0.0, hi: float = math.inf) -> float:
-    """Validate a finite number in ``[lo, hi]`` (a ConfigError naming ``name`` otherwise)."""
-    ok = isinstance(value, int | float | np.number) and not isinstance(value, bool)
-    if not ok or not math.isfinite(value) or not lo <= value <= hi:
-        raise ConfigError(f"{name} must be a number in [{lo}, {hi}], got {value!r}")
-    return float(value)

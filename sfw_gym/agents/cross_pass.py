@@ -28,9 +28,9 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 
-from sfw_gym.agents.base import RobotView, check_fraction
+from sfw_gym.agents.base import RobotView
 from sfw_gym.agents.frontier import FrontierAgent, Goal
-from sfw_gym.core.errors import ConfigError
+from sfw_gym.core.config import check
 from sfw_gym.mapping.grid import GridSpec
 from sfw_gym.navigation.planning import CostField, belief_classes, mark_disk
 from sfw_gym.navigation.radio_zones import dominance_bands, router_scores, wall_crossings
@@ -70,21 +70,15 @@ class CrossPassAgent(FrontierAgent):
         **frontier_params: Any,
     ) -> None:
         super().__init__(**frontier_params)
-        self.pass_spacing_m = check_fraction("pass_spacing_m", pass_spacing_m)
-        self.band_bonus = check_fraction("band_bonus", band_bonus)
-        self.wall_loss_db = check_fraction("wall_loss_db", wall_loss_db)
-        self.band_m = check_fraction("band_m", band_m, 0.05)
-        self.min_band_area_m2 = check_fraction("min_band_area_m2", min_band_area_m2)
-        self.pass_trigger_m = check_fraction("pass_trigger_m", pass_trigger_m)
-        self.pass_length_m = check_fraction("pass_length_m", pass_length_m, 0.1)
-        self.pass_offset_m = check_fraction("pass_offset_m", pass_offset_m, 0.05)
-        if (
-            isinstance(zones_every_steps, bool)
-            or not isinstance(zones_every_steps, int)
-            or (zones_every_steps < 1)
-        ):
-            raise ConfigError(f"zones_every_steps must be an int >= 1, got {zones_every_steps!r}")
-        self.zones_every_steps = zones_every_steps
+        self.pass_spacing_m = check("pass_spacing_m", pass_spacing_m, ge=0.0)
+        self.band_bonus = check("band_bonus", band_bonus, ge=0.0)
+        self.wall_loss_db = check("wall_loss_db", wall_loss_db, ge=0.0)
+        self.band_m = check("band_m", band_m, ge=0.05)
+        self.min_band_area_m2 = check("min_band_area_m2", min_band_area_m2, ge=0.0)
+        self.pass_trigger_m = check("pass_trigger_m", pass_trigger_m, ge=0.0)
+        self.pass_length_m = check("pass_length_m", pass_length_m, ge=0.1)
+        self.pass_offset_m = check("pass_offset_m", pass_offset_m, ge=0.05)
+        self.zones_every_steps = check("zones_every_steps", zones_every_steps, integer=True, ge=1)
 
     def _on_reset(self, view: RobotView) -> None:
         super()._on_reset(view)

@@ -45,8 +45,8 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 
-from sfw_gym.agents.base import Agent, RobotView, check_fraction
-from sfw_gym.core.errors import ConfigError
+from sfw_gym.agents.base import Agent, RobotView
+from sfw_gym.core.config import check
 from sfw_gym.navigation.frontiers import (
     EIGHT_CONNECTED,
     Frontier,
@@ -158,38 +158,39 @@ class FrontierAgent(Agent):
         max_steps: int | None = None,
     ) -> None:
         super().__init__(max_steps=max_steps)
-        self.gain_scale = check_fraction("gain_scale", gain_scale)
-        self.potential_scale = check_fraction("potential_scale", potential_scale)
-        self.min_frontier_size_m = check_fraction("min_frontier_size_m", min_frontier_size_m)
-        self.blacklist_radius_m = check_fraction("blacklist_radius_m", blacklist_radius_m)
-        self.unknown_cost = check_fraction("unknown_cost", unknown_cost, 1.0)
-        self.bump_exclusion_m = check_fraction("bump_exclusion_m", bump_exclusion_m)
-        self.lookahead_m = check_fraction("lookahead_m", lookahead_m, 0.05)
-        for name, v, lo in (("progress_timeout_steps", progress_timeout_steps, 1),
-                            ("replan_every_steps", replan_every_steps, 1),
-                            ("backoff_steps", backoff_steps, 0),
-                            ("max_bumps_per_goal", max_bumps_per_goal, 1),
-                            ("blacklist_ttl_steps", blacklist_ttl_steps, 1),
-                            ("unreachable_ttl_steps", unreachable_ttl_steps, 1),
-                            ("stall_steps", stall_steps, 1)):  # fmt: skip
-            if isinstance(v, bool) or not isinstance(v, int) or v < lo:
-                raise ConfigError(f"{name} must be an int >= {lo}, got {v!r}")
-        self.progress_timeout_steps = progress_timeout_steps
-        self.replan_every_steps = replan_every_steps
-        self.backoff_steps = backoff_steps
-        self.max_bumps_per_goal = max_bumps_per_goal
-        self.blacklist_ttl_steps = blacklist_ttl_steps
-        self.unreachable_ttl_steps = unreachable_ttl_steps
-        self.stall_steps = stall_steps
-        self.stall_gain_m2 = check_fraction("stall_gain_m2", stall_gain_m2)
-        self.min_unknown_region_m2 = check_fraction("min_unknown_region_m2", min_unknown_region_m2)
-        self.turn_cost_m_per_rad = check_fraction("turn_cost_m_per_rad", turn_cost_m_per_rad)
-        self.escape_wall_cost = check_fraction("escape_wall_cost", escape_wall_cost, 1.0)
-        self.min_hidden_room_depth_m = check_fraction(
-            "min_hidden_room_depth_m", min_hidden_room_depth_m
+        self.gain_scale = check("gain_scale", gain_scale, ge=0.0)
+        self.potential_scale = check("potential_scale", potential_scale, ge=0.0)
+        self.min_frontier_size_m = check("min_frontier_size_m", min_frontier_size_m, ge=0.0)
+        self.blacklist_radius_m = check("blacklist_radius_m", blacklist_radius_m, ge=0.0)
+        self.unknown_cost = check("unknown_cost", unknown_cost, ge=1.0)
+        self.bump_exclusion_m = check("bump_exclusion_m", bump_exclusion_m, ge=0.0)
+        self.lookahead_m = check("lookahead_m", lookahead_m, ge=0.05)
+        self.progress_timeout_steps = check(
+            "progress_timeout_steps", progress_timeout_steps, integer=True, ge=1
         )
-        self.escape_blacklist_radius_m = check_fraction(
-            "escape_blacklist_radius_m", escape_blacklist_radius_m
+        self.replan_every_steps = check(
+            "replan_every_steps", replan_every_steps, integer=True, ge=1
+        )
+        self.backoff_steps = check("backoff_steps", backoff_steps, integer=True, ge=0)
+        self.max_bumps_per_goal = check(
+            "max_bumps_per_goal", max_bumps_per_goal, integer=True, ge=1
+        )
+        self.blacklist_ttl_steps = check(
+            "blacklist_ttl_steps", blacklist_ttl_steps, integer=True, ge=1
+        )
+        self.unreachable_ttl_steps = check(
+            "unreachable_ttl_steps", unreachable_ttl_steps, integer=True, ge=1
+        )
+        self.stall_steps = check("stall_steps", stall_steps, integer=True, ge=1)
+        self.stall_gain_m2 = check("stall_gain_m2", stall_gain_m2, ge=0.0)
+        self.min_unknown_region_m2 = check("min_unknown_region_m2", min_unknown_region_m2, ge=0.0)
+        self.turn_cost_m_per_rad = check("turn_cost_m_per_rad", turn_cost_m_per_rad, ge=0.0)
+        self.escape_wall_cost = check("escape_wall_cost", escape_wall_cost, ge=1.0)
+        self.min_hidden_room_depth_m = check(
+            "min_hidden_room_depth_m", min_hidden_room_depth_m, ge=0.0
+        )
+        self.escape_blacklist_radius_m = check(
+            "escape_blacklist_radius_m", escape_blacklist_radius_m, ge=0.0
         )
 
     # -- episode ---------------------------------------------------------------------------------

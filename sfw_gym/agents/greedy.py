@@ -6,9 +6,9 @@ from typing import Any
 
 import numpy as np
 
-from sfw_gym.agents.base import RobotView, check_fraction
+from sfw_gym.agents.base import RobotView
 from sfw_gym.agents.frontier import FrontierAgent, Goal
-from sfw_gym.core.errors import ConfigError
+from sfw_gym.core.config import check
 from sfw_gym.navigation.frontiers import frontier_mask
 from sfw_gym.navigation.planning import CostField, belief_classes
 from sfw_gym.navigation.radio_zones import router_scores
@@ -45,13 +45,9 @@ class GreedyInfoGainAgent(FrontierAgent):
         **frontier_params: Any,
     ) -> None:
         super().__init__(**frontier_params)
-        for name, v in (("max_candidates", max_candidates),
-                        ("zones_every_steps", zones_every_steps)):  # fmt: skip
-            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-                raise ConfigError(f"{name} must be an int >= 1, got {v!r}")
-        self.max_candidates = max_candidates
-        self.distance_offset_m = check_fraction("distance_offset_m", distance_offset_m, 0.01)
-        self.zones_every_steps = zones_every_steps
+        self.max_candidates = check("max_candidates", max_candidates, integer=True, ge=1)
+        self.distance_offset_m = check("distance_offset_m", distance_offset_m, ge=0.01)
+        self.zones_every_steps = check("zones_every_steps", zones_every_steps, integer=True, ge=1)
 
     def _on_reset(self, view: RobotView) -> None:
         super()._on_reset(view)

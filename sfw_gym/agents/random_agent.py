@@ -5,8 +5,8 @@ from __future__ import annotations
 from typing import Any
 
 from sfw_gym.agents.base import Agent, RobotView
+from sfw_gym.core.config import check
 from sfw_gym.core.constants import DISCRETE_ACTIONS
-from sfw_gym.core.errors import ConfigError
 
 #: (linear, angular) of the discrete actions 0 forward, 1 turn left, 2 turn right.
 
@@ -27,9 +27,7 @@ class RandomAgent(Agent):
 
     def __init__(self, hold_steps: int = 5, max_steps: int | None = None) -> None:
         super().__init__(max_steps=max_steps)
-        if isinstance(hold_steps, bool) or not isinstance(hold_steps, int) or hold_steps < 1:
-            raise ConfigError(f"hold_steps must be an int >= 1, got {hold_steps!r}")
-        self.hold_steps = hold_steps
+        self.hold_steps = check("hold_steps", hold_steps, integer=True, ge=1)
 
     def _on_reset(self, view: RobotView) -> None:
         self._held = 0

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+import inspect
 import math
-from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -11,18 +11,17 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from sfw_gym.core.config import unknown_key_error
 from sfw_gym.core.constants import DISCRETE_ACTION_NAMES, DISCRETE_ACTIONS, NOT_HEARD_DBM
 from sfw_gym.core.errors import ConfigError
+from sfw_gym.envs.config import RESET_OPTIONS, ExploreConfig, RewardConfig
 from sfw_gym.envs.episode import EpisodeScene, GroundTruth, build_scene
 from sfw_gym.envs.map_tracker import MapTracker
 from sfw_gym.envs.observation import ObservationBuilder, observation_space
 from sfw_gym.mapping import GridSpec, MapperConfig, SparseInverseKVisibility
 from sfw_gym.navigation.view import RobotView
 from sfw_gym.world import Floorplan, RadioConfig, RobotConfig
-
-ACTION_TYPES = ("continuous", "discrete")
-#: Discrete actions: (linear, angular) as fractions of the robot's limits.
-RESET_OPTIONS = ("floorplan", "routers", "start_pose")
+from sfw_gym.world.generator import GeneratorConfig
 
 
 class SfWExploreEnv(gym.Env):
@@ -116,49 +115,53 @@ class SfWExploreEnv(gym.Env):
         steps_per_m2: float | None = None,
         render_mode: str | None = None,
         render_size: tuple[int, int] | None = (960, 480),
+        **unknown: Any,
     ) -> None:
-        if action_type not in ACTION_TYPES:
-            raise ConfigError(f"action_type must be one of {ACTION_TYPES}, got {action_type!r}")
+        if unknown:
+            params = inspect.signature(type(self)).parameters.values()
+            valid = [p.name for p in params if p.kind is not p.VAR_KEYWORD]
+            raise unknown_key_error("SfW-Explore kwargs", next(iter(unknown)), valid)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ConfigError(
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "
                 f"got {render_mode!r}"
             )
-        _check_int("n_routers", n_routers, 1, 16)
-        _check_int("map_px", map_px, 36, 512)
-        _check_int("crop_px", crop_px, 36, 512)
-        _check_int("max_steps", max_steps, 1, 10**7)
-        if steps_per_m2 is not None:
-            _check_number("steps_per_m2", steps_per_m2, 1e-3, 1e5)
-        _check_number("resolution_m", resolution_m, 0.02, 1.0)
-        _check_number("coverage_target", coverage_target, 0.0, 1.0)
-        _check_number("collision_penalty", collision_penalty, 0.0, 1e6)
-        _check_number("reward_scale", reward_scale, 0.0, 1e6)
-        self.action_type = action_type
-        self.floorplan_source = floorplan
-        self.generator_params = dict(generator or {})
-        self.n_routers = n_routers
-        self.radio_config = _make_config(
-            "radio", radio, lambda **kw: RadioConfig.preset(radio_preset, band=radio_band, **kw)
+        self.config = ExploreConfig(
+            action_type=action_type, n_routers=n_routers, radio_preset=radio_preset,
+            radio_band=radio_band, resolution_m=resolution_m, map_px=map_px, crop_px=crop_px,
+            max_steps=max_steps, steps_per_m2=steps_per_m2,
+        )  # fmt: skip
+        self.reward_config = RewardConfig(
+            reward_scale=reward_scale,
+            collision_penalty=collision_penalty,
+            coverage_target=coverage_target,
         )
-        self.robot_config = _make_config("robot", robot, RobotConfig)
+        cfg = self.config
+        self.action_type = cfg.action_type
+        self.floorplan_source = floorplan
+        self.generator_params = GeneratorConfig.from_dict(generator, "generator").to_dict()
+        self.n_routers = cfg.n_routers
+        self.radio_config = RadioConfig.preset(
+            cfg.radio_preset, band=cfg.radio_band, **_overrides("radio", radio)
+        )
+        self.robot_config = RobotConfig.from_dict(robot, "robot")
         # The robot knows its routers: their RSSI at 1 m with no wall (P_tx − PL(1 m)) calibrates
         # k = 0, so a router first heard through a wall is not read one wall short.
         # (distance-aware estimation only: raw RSSI has no fixed no-wall level).
         mapper_defaults: dict[str, Any] = {"robot_radius_m": self.robot_config.radius_m}
-        if (mapper or {}).get("k_estimator", "distance_aware") == "distance_aware":
+        if _overrides("mapper", mapper).get("k_estimator", "distance_aware") == "distance_aware":
             k0 = self.radio_config.tx_power_dbm - self.radio_config.d0_loss_db
             mapper_defaults["k0_level_dbm"] = k0
-        self.mapper_config = _make_config(
-            "mapper", {**mapper_defaults, **(mapper or {})}, MapperConfig
+        self.mapper_config = MapperConfig.from_dict(
+            {**mapper_defaults, **_overrides("mapper", mapper)}, "mapper"
         )
-        self.resolution_m = float(resolution_m)
-        self.map_px, self.crop_px = map_px, crop_px
-        self.coverage_target = float(coverage_target)
-        self.collision_penalty = float(collision_penalty)
-        self.reward_scale = float(reward_scale)
-        self.max_steps = max_steps
-        self.steps_per_m2 = None if steps_per_m2 is None else float(steps_per_m2)
+        self.resolution_m = cfg.resolution_m
+        self.map_px, self.crop_px = cfg.map_px, cfg.crop_px
+        self.coverage_target = self.reward_config.coverage_target
+        self.collision_penalty = self.reward_config.collision_penalty
+        self.reward_scale = self.reward_config.reward_scale
+        self.max_steps = cfg.max_steps
+        self.steps_per_m2 = cfg.steps_per_m2
         self.render_mode = render_mode
         self.render_size = _frame_size(render_size)
         self._folder_plans = _folder_plans(floorplan)
@@ -178,9 +181,9 @@ class SfWExploreEnv(gym.Env):
         """Start an episode: floorplan, routers, start pose, an empty map (see the class doc)."""
         super().reset(seed=seed)
         options = dict(options or {})
-        unknown = sorted(set(options) - set(RESET_OPTIONS))
-        if unknown:
-            raise ConfigError(f"unknown reset option(s) {unknown}; valid: {list(RESET_OPTIONS)}")
+        for key in options:
+            if key not in RESET_OPTIONS:
+                raise unknown_key_error("reset options", key, RESET_OPTIONS)
         plan = options.get("floorplan", self._default_floorplan())
         self.scene = build_scene(
             plan,
@@ -403,25 +406,13 @@ class SfWExploreEnv(gym.Env):
     def config_dict(self) -> dict[str, Any]:
         """The effective configuration (JSON-serialisable), for logs and reproducibility."""
         return {
-            "action_type": self.action_type,
+            **self.config.to_dict(),
+            **self.reward_config.to_dict(),
+            "generator": self.generator_params,
             "radio": self.radio_config.to_dict(),
-            "robot": asdict(self.robot_config),
+            "robot": self.robot_config.to_dict(),
             "mapper": self.mapper_config.to_dict(),
-            "resolution_m": self.resolution_m,
-            "max_steps": self.max_steps,
-            "steps_per_m2": self.steps_per_m2,
         }
-
-
-def _check_int(name: str, value: Any, lo: int, hi: int) -> None:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer) or not lo <= value <= hi:
-        raise ConfigError(f"{name} must be an integer in [{lo}, {hi}], got {value!r}")
-
-
-def _check_number(name: str, value: Any, lo: float, hi: float) -> None:
-    ok = isinstance(value, int | float | np.number) and not isinstance(value, bool)
-    if not ok or not math.isfinite(value) or not lo <= value <= hi:
-        raise ConfigError(f"{name} must be a number in [{lo}, {hi}], got {value!r}")
 
 
 def unwrap_sfw(env: gym.Env) -> SfWExploreEnv:
@@ -446,13 +437,12 @@ def _frame_size(size: Any) -> tuple[int, int] | None:
     return int(size[0]), int(size[1])
 
 
-def _make_config(name: str, overrides: dict[str, Any] | None, factory: Any) -> Any:
-    if overrides is not None and not isinstance(overrides, dict):
-        raise ConfigError(f"{name} must be a dict of overrides, got {type(overrides).__name__}")
-    try:
-        return factory(**(overrides or {}))
-    except TypeError as exc:
-        raise ConfigError(f"{name}: {exc}") from None
+def _overrides(name: str, values: Any) -> dict[str, Any]:
+    if values is None:
+        return {}
+    if not isinstance(values, dict):
+        raise ConfigError(f"{name} must be a dict of overrides, got {type(values).__name__}")
+    return values
 
 
 def _folder_plans(source: Any) -> list[Path]:

@@ -3,25 +3,17 @@
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
-from typing import Any
+from dataclasses import dataclass
 
+from sfw_gym.core.config import Config, setting
 from sfw_gym.core.errors import ConfigError
 
 K_ESTIMATORS = ("distance_aware", "kmeans")
 ROUTER_POLICIES = ("strongest", "all")
 
 
-def _is_number(v: Any) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-
-
-def _is_int(v: Any) -> bool:
-    return isinstance(v, int) and not isinstance(v, bool)
-
-
 @dataclass(frozen=True)
-class MapperConfig:
+class MapperConfig(Config):
     """Configuration of the RSSI->k estimator and the sparse inverse k-visibility mapper.
 
     Log-odds fields are natural-log odds of "occupied" added per observation; negative = free.
@@ -81,116 +73,53 @@ class MapperConfig:
             and carry no entropy.
     """
 
-    k_estimator: str = "distance_aware"
-    max_k: int = 3
-    filter_window: int = 3
-    filter_reset_db: float | None = None
-    path_loss_exponent: float = 2.0
-    min_distance_m: float = 1.0
-    refit_min_samples: int = 32
-    refit_growth: float = 1.5
-    refit_max_interval: int = 2000
-    fit_buffer_size: int = 4096
-    prior_wall_loss_db: float = 10.0
-    k0_level_dbm: float | None = None
-    min_cluster_gap_db: float = 7.0
-    min_level_fraction: float = 0.02
-    router_policy: str = "strongest"
-    robot_radius_m: float = 0.17
-    free_log_odds: float = -0.4
-    footprint_log_odds: float = -1.0
-    bump_log_odds: float = 3.0
-    wall_peak_probability: float = 0.8
-    wall_ref_length_m: float = 0.5
-    wall_sigma_fraction: float = 0.15
-    wall_sigma_min_m: float = 0.05
-    wall_cap_factor: float = 2.0
-    log_odds_min: float = -4.0
-    log_odds_max: float = 4.0
-    trajectory_gap_max_m: float = 1.0
-    extend_past_robot: bool = True
+    k_estimator: str = setting("distance_aware", choices=K_ESTIMATORS)
+    max_k: int = setting(3, integer=True, ge=1, le=32)
+    filter_window: int = setting(3, integer=True, ge=1, le=10_000)
+    filter_reset_db: float | None = setting(None, ge=0.0, optional=True)
+    path_loss_exponent: float = setting(2.0, gt=0.0)
+    min_distance_m: float = setting(1.0, gt=0.0)
+    refit_min_samples: int = setting(32, integer=True, ge=2, le=10**9)
+    refit_growth: float = setting(1.5, gt=1.0)
+    refit_max_interval: int = setting(2000, integer=True, ge=1, le=10**9)
+    fit_buffer_size: int = setting(4096, integer=True, ge=16, le=10**8)
+    prior_wall_loss_db: float = setting(10.0, gt=0.0)
+    k0_level_dbm: float | None = setting(None, optional=True)
+    min_cluster_gap_db: float = setting(7.0, ge=0.0)
+    min_level_fraction: float = setting(0.02, ge=0.0, lt=0.5)
+    router_policy: str = setting("strongest", choices=ROUTER_POLICIES)
+    robot_radius_m: float = setting(0.17, ge=0.0)
+    free_log_odds: float = setting(-0.4, lt=0.0)
+    footprint_log_odds: float = setting(-1.0, lt=0.0)
+    bump_log_odds: float = setting(3.0, gt=0.0)
+    wall_peak_probability: float = setting(0.8, gt=0.5, lt=1.0)
+    wall_ref_length_m: float = setting(0.5, gt=0.0)
+    wall_sigma_fraction: float = setting(0.15, gt=0.0)
+    wall_sigma_min_m: float = setting(0.05, gt=0.0)
+    wall_cap_factor: float = setting(2.0, gt=0.0)
+    log_odds_min: float = setting(-4.0, lt=0.0)
+    log_odds_max: float = setting(4.0, gt=0.0)
+    trajectory_gap_max_m: float = setting(1.0, ge=0.0)
+    extend_past_robot: bool = setting(True, choices=(True, False))
     outer_bounds_m: tuple[float, float, float, float] | None = None
 
-    def __post_init__(self) -> None:
-        if self.k_estimator not in K_ESTIMATORS:
+    def validate(self) -> None:
+        if self.k0_level_dbm is not None and self.k_estimator != "distance_aware":
             raise ConfigError(
-                f"k_estimator must be one of {K_ESTIMATORS}, got {self.k_estimator!r}"
+                "k0_level_dbm needs k_estimator='distance_aware' (raw RSSI has no fixed "
+                f"no-wall level), got k_estimator={self.k_estimator!r}"
             )
-        if self.router_policy not in ROUTER_POLICIES:
-            raise ConfigError(
-                f"router_policy must be one of {ROUTER_POLICIES}, got {self.router_policy!r}"
-            )
-        ints = {
-            "max_k": (1, 32),
-            "filter_window": (1, 10_000),
-            "refit_min_samples": (2, 10**9),
-            "refit_max_interval": (1, 10**9),
-            "fit_buffer_size": (16, 10**8),
-        }
-        for name, (lo, hi) in ints.items():
-            v = getattr(self, name)
-            if not _is_int(v) or not lo <= v <= hi:
-                raise ConfigError(f"{name} must be an int in [{lo}, {hi}], got {v!r}")
-        positive = (
-            "path_loss_exponent",
-            "min_distance_m",
-            "prior_wall_loss_db",
-            "wall_ref_length_m",
-            "wall_sigma_fraction",
-            "wall_sigma_min_m",
-            "wall_cap_factor",
-            "log_odds_max",
-            "bump_log_odds",
-        )
-        for name in positive:
-            v = getattr(self, name)
-            if not _is_number(v) or v <= 0:
-                raise ConfigError(f"{name} must be a finite number > 0, got {v!r}")
-        non_negative = ("min_cluster_gap_db", "robot_radius_m", "trajectory_gap_max_m")
-        for name in non_negative:
-            v = getattr(self, name)
-            if not _is_number(v) or v < 0:
-                raise ConfigError(f"{name} must be a finite number >= 0, got {v!r}")
-        for name in ("free_log_odds", "footprint_log_odds", "log_odds_min"):
-            v = getattr(self, name)
-            if not _is_number(v) or v >= 0:
-                raise ConfigError(f"{name} must be a finite number < 0, got {v!r}")
-        f = self.min_level_fraction
-        if not _is_number(f) or not 0.0 <= f < 0.5:
-            raise ConfigError(f"min_level_fraction must be in [0, 0.5), got {f!r}")
-        if not _is_number(self.refit_growth) or self.refit_growth <= 1.0:
-            raise ConfigError(f"refit_growth must be a number > 1, got {self.refit_growth!r}")
-        p = self.wall_peak_probability
-        if not _is_number(p) or not 0.5 < p < 1.0:
-            raise ConfigError(f"wall_peak_probability must be in (0.5, 1), got {p!r}")
-        reset = self.filter_reset_db
-        if reset is not None and (not _is_number(reset) or reset < 0):
-            raise ConfigError(
-                f"filter_reset_db must be None or a finite number >= 0, got {reset!r}"
-            )
-        if self.k0_level_dbm is not None:
-            if not _is_number(self.k0_level_dbm):
-                raise ConfigError(f"k0_level_dbm must be None or finite, got {self.k0_level_dbm!r}")
-            if self.k_estimator != "distance_aware":
-                raise ConfigError(
-                    "k0_level_dbm needs k_estimator='distance_aware' (raw RSSI has no fixed "
-                    f"no-wall level), got k_estimator={self.k_estimator!r}"
-                )
-        if not isinstance(self.extend_past_robot, bool):
-            raise ConfigError(f"extend_past_robot must be a bool, got {self.extend_past_robot!r}")
         if self.outer_bounds_m is not None:
             b = self.outer_bounds_m
-            ok = isinstance(b, (tuple, list)) and len(b) == 4 and all(_is_number(v) for v in b)
+            ok = (
+                isinstance(b, (tuple, list))
+                and len(b) == 4
+                and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in b)
+                and all(math.isfinite(v) for v in b)
+            )
             if not ok or not (b[2] > b[0] and b[3] > b[1]):
                 raise ConfigError(
                     f"outer_bounds_m must be None or (xmin, ymin, xmax, ymax) with max > min, "
                     f"got {b!r}"
                 )
             object.__setattr__(self, "outer_bounds_m", tuple(float(v) for v in b))
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-serialisable dict of the fields (round-trips through ``MapperConfig(**d)``)."""
-        d = asdict(self)
-        if d["outer_bounds_m"] is not None:
-            d["outer_bounds_m"] = list(d["outer_bounds_m"])
-        return d

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sfw_gym.core.errors import ConfigError
+from sfw_gym.core.config import check
 from sfw_gym.mapping.grid import GridSpec
 from sfw_gym.navigation.planning import (
     PurePursuit,
@@ -38,11 +38,8 @@ class WaypointDriver:
     """
 
     def __init__(self, grid_cells: int = 8, max_steps_per_waypoint: int = 60) -> None:
-        for name, value in (("grid_cells", grid_cells),
-                            ("max_steps_per_waypoint", max_steps_per_waypoint)):  # fmt: skip
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ConfigError(f"{name} must be a positive integer, got {value!r}")
-        self.grid_cells, self.max_steps = grid_cells, max_steps_per_waypoint
+        self.grid_cells = check("grid_cells", grid_cells, integer=True, ge=1)
+        self.max_steps = check("max_steps_per_waypoint", max_steps_per_waypoint, integer=True, ge=1)
         self.follower = PurePursuit()
         self.bumps = np.zeros((0, 0), bool)
         self.path = np.zeros((0, 2))

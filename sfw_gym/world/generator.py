@@ -34,6 +34,7 @@ import shapely
 from shapely.geometry import Polygon
 from shapely.geometry.polygon import orient
 
+from sfw_gym.core.config import Config, setting
 from sfw_gym.core.errors import ConfigError, FloorplanError
 from sfw_gym.world.floorplan import Floorplan, Room
 
@@ -50,15 +51,24 @@ ROBOT_RADIUS_M = 0.17
 #: Range (m) accepted for ``door_width_m``.
 MIN_DOOR_M, MAX_DOOR_M = 0.8, 1.2
 
-_PARAMS: dict[str, Any] = {
-    "kind": "random",
-    "area_m2": None,
-    "shape": "random",
-    "exterior_material": None,
-    "door_width_m": None,
-    "extra_door_prob": None,
-    "name": None,
-}
+
+@dataclass(frozen=True)
+class GeneratorConfig(Config):
+    """The overrides :func:`generate_floorplan` takes (None / "random": drawn from the seed)."""
+
+    kind: str = setting("random", choices=(*KINDS, "random"))
+    area_m2: float | None = setting(None, optional=True, ge=MIN_AREA_M2, le=MAX_AREA_M2)
+    shape: str = setting("random", choices=(*SHAPES, "random"))
+    exterior_material: str | None = setting(None, optional=True, choices=EXTERIOR_MATERIALS)
+    door_width_m: float | None = setting(None, optional=True, ge=MIN_DOOR_M, le=MAX_DOOR_M)
+    extra_door_prob: float | None = setting(None, optional=True, ge=0.0, le=1.0)
+    name: str | None = None
+
+    def validate(self) -> None:
+        if self.name is not None and not isinstance(self.name, str):
+            raise ConfigError(f"GeneratorConfig.name must be a string or None, got {self.name!r}")
+
+
 _GRID = 5  # cm: room tiles snap to this grid
 _DOOR_CLEAR = 20  # cm: doorway jamb to the wall line's junction (centre line)
 _MIN_DOOR = 80  # cm
@@ -118,16 +128,16 @@ def generate_floorplan(seed: int, **params: Any) -> Floorplan:
     kind = KINDS[int(rng.integers(len(KINDS)))]
     shape = "L" if rng.random() < 0.35 else "rectangle"
     u_material = rng.random()
-    kind = kind if p["kind"] == "random" else p["kind"]
+    kind = kind if p.kind == "random" else p.kind
     ext_material = EXTERIOR_MATERIALS[int(u_material < (0.6 if kind == "office" else 0.4))]
     drawn_area = math.exp(rng.uniform(*np.log((42.0, 160.0) if kind == "apartment" else (60, 195))))
-    shape = shape if p["shape"] == "random" else p["shape"]
-    ext_material = p["exterior_material"] or ext_material
-    area = float(p["area_m2"] if p["area_m2"] is not None else drawn_area)
-    extra = p["extra_door_prob"]
+    shape = shape if p.shape == "random" else p.shape
+    ext_material = p.exterior_material or ext_material
+    area = float(p.area_m2 if p.area_m2 is not None else drawn_area)
+    extra = p.extra_door_prob
     extra = (0.2 if kind == "apartment" else 0.1) if extra is None else float(extra)
-    door_cm = None if p["door_width_m"] is None else _snap(100.0 * p["door_width_m"])
-    name = p["name"] if p["name"] is not None else f"gen-{kind}-{int(seed)}"
+    door_cm = None if p.door_width_m is None else _snap(100.0 * p.door_width_m)
+    name = p.name if p.name is not None else f"gen-{kind}-{int(seed)}"
 
     lo, hi = max(MIN_AREA_M2, 0.85 * area), min(MAX_AREA_M2, 1.15 * area)
     aim = float(np.clip(area, MIN_AREA_M2 * 1.04, MAX_AREA_M2 / 1.04))
@@ -155,37 +165,10 @@ def generate_floorplan(seed: int, **params: Any) -> Floorplan:
     )
 
 
-def _validate(seed: Any, params: dict[str, Any]) -> dict[str, Any]:
+def _validate(seed: Any, params: dict[str, Any]) -> GeneratorConfig:
     if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
         raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
-    unknown = sorted(set(params) - set(_PARAMS))
-    if unknown:
-        raise ConfigError(
-            f"generate_floorplan: unknown parameter(s) {unknown}; valid: {sorted(_PARAMS)}"
-        )
-    p = {**_PARAMS, **params}
-    if p["kind"] not in (*KINDS, "random"):
-        raise ConfigError(f"kind must be one of {[*KINDS, 'random']}, got {p['kind']!r}")
-    if p["shape"] not in (*SHAPES, "random"):
-        raise ConfigError(f"shape must be one of {[*SHAPES, 'random']}, got {p['shape']!r}")
-    if p["exterior_material"] is not None and p["exterior_material"] not in EXTERIOR_MATERIALS:
-        raise ConfigError(
-            f"exterior_material must be one of {list(EXTERIOR_MATERIALS)} or None, "
-            f"got {p['exterior_material']!r}"
-        )
-    for key, lo, hi in (
-        ("area_m2", MIN_AREA_M2, MAX_AREA_M2),
-        ("door_width_m", MIN_DOOR_M, MAX_DOOR_M),
-        ("extra_door_prob", 0.0, 1.0),
-    ):
-        v = p[key]
-        if v is None:
-            continue
-        if isinstance(v, bool) or not isinstance(v, numbers.Real) or not lo <= float(v) <= hi:
-            raise ConfigError(f"{key} must be a number in [{lo:g}, {hi:g}] or None, got {v!r}")
-    if p["name"] is not None and not isinstance(p["name"], str):
-        raise ConfigError(f"name must be a string or None, got {p['name']!r}")
-    return p
+    return GeneratorConfig.from_dict(params, "generate_floorplan")
 
 
 # --------------------------------------------------------------------------------------- layouts

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Any
 
@@ -16,6 +16,7 @@ import numpy as np
 from numba import njit, prange
 from shapely.geometry import Point
 
+from sfw_gym.core.config import Config, Range, setting
 from sfw_gym.core.constants import NOT_HEARD_DBM
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.world.floorplan import MATERIALS, Floorplan
@@ -44,7 +45,7 @@ def _uniform_losses(loss_db: float) -> dict[str, float]:
 
 
 @dataclass(frozen=True)
-class RadioConfig:
+class RadioConfig(Config):
     """Radio model parameters (DESIGN.md defaults: the ``default`` preset at 2.4 GHz).
 
     ``path_loss_d0_db`` of ``None`` means the free-space loss at ``reference_distance_m`` for
@@ -52,42 +53,19 @@ class RadioConfig:
     clamped to it.
     """
 
-    frequency_ghz: float = 2.437
-    tx_power_dbm: float = 20.0
-    path_loss_d0_db: float | None = None
-    reference_distance_m: float = 1.0
-    path_loss_exponent: float = 2.0
+    frequency_ghz: float = setting(2.437, gt=0.0)
+    tx_power_dbm: float = setting(20.0)
+    path_loss_d0_db: float | None = setting(None, optional=True)
+    reference_distance_m: float = setting(1.0, gt=0.0)
+    path_loss_exponent: float = setting(2.0, gt=0.0)
     wall_loss_db: Mapping[str, float] = field(default_factory=lambda: _uniform_losses(10.0))
-    max_total_wall_loss_db: float = 45.0
-    shadowing_sigma_db: float = 4.0
-    shadowing_correlation_m: float = 5.0
-    noise_sigma_db: float = 2.0
-    sensitivity_dbm: float = -90.0
+    max_total_wall_loss_db: float = setting(45.0, ge=0.0)
+    shadowing_sigma_db: float = setting(4.0, ge=0.0)
+    shadowing_correlation_m: float = setting(5.0, gt=0.0)
+    noise_sigma_db: float = setting(2.0, ge=0.0)
+    sensitivity_dbm: float = setting(-90.0)
 
-    def __post_init__(self) -> None:
-        positive = (
-            "frequency_ghz",
-            "reference_distance_m",
-            "path_loss_exponent",
-            "shadowing_correlation_m",
-        )
-        non_negative = ("max_total_wall_loss_db", "shadowing_sigma_db", "noise_sigma_db")
-        for name in (*positive, *non_negative, "tx_power_dbm", "sensitivity_dbm"):
-            value = getattr(self, name)
-            if (
-                isinstance(value, bool)
-                or not isinstance(value, int | float)
-                or not math.isfinite(value)
-            ):
-                raise ConfigError(f"RadioConfig.{name} must be a finite number, got {value!r}")
-            if name in positive and value <= 0:
-                raise ConfigError(f"RadioConfig.{name} must be > 0, got {value!r}")
-            if name in non_negative and value < 0:
-                raise ConfigError(f"RadioConfig.{name} must be ≥ 0, got {value!r}")
-        if self.path_loss_d0_db is not None and not math.isfinite(self.path_loss_d0_db):
-            raise ConfigError(
-                f"RadioConfig.path_loss_d0_db must be finite, got {self.path_loss_d0_db!r}"
-            )
+    def validate(self) -> None:
         if not isinstance(self.wall_loss_db, Mapping):
             raise ConfigError("RadioConfig.wall_loss_db must map material names to losses in dB")
         missing = sorted(set(MATERIALS) - set(self.wall_loss_db))
@@ -97,14 +75,15 @@ class RadioConfig:
                 f"RadioConfig.wall_loss_db must give a loss for exactly {list(MATERIALS)}; "
                 f"missing {missing}, unknown {unknown}"
             )
-        for material, loss in self.wall_loss_db.items():
-            if not (isinstance(loss, int | float) and math.isfinite(loss) and loss >= 0):
-                raise ConfigError(
-                    f"RadioConfig.wall_loss_db[{material!r}] must be ≥ 0, got {loss!r}"
-                )
+        loss = Range(ge=0.0)
         # A private plain copy: picklable, and safe from the caller's later edits.
         object.__setattr__(
-            self, "wall_loss_db", {m: float(v) for m, v in self.wall_loss_db.items()}
+            self,
+            "wall_loss_db",
+            {
+                m: loss.check(f"RadioConfig.wall_loss_db[{m!r}]", v)
+                for m, v in self.wall_loss_db.items()
+            },
         )
 
     @classmethod
@@ -123,10 +102,9 @@ class RadioConfig:
             raise ConfigError(f"unknown radio preset {name!r}; choose one of {list(PRESETS)}")
         if band not in BANDS:
             raise ConfigError(f"unknown radio band {band!r}; choose one of {list(BANDS)}")
-        try:
-            return cls(frequency_ghz=BANDS[band], wall_loss_db=losses[name], **overrides)
-        except TypeError as exc:
-            raise ConfigError(f"RadioConfig.preset: {exc}") from None
+        return cls.from_dict(
+            {"frequency_ghz": BANDS[band], "wall_loss_db": losses[name], **overrides}, "radio"
+        )
 
     @property
     def d0_loss_db(self) -> float:
@@ -138,10 +116,6 @@ class RadioConfig:
     def noiseless(self) -> RadioConfig:
         """The same model without shadowing or temporal noise."""
         return replace(self, shadowing_sigma_db=0.0, noise_sigma_db=0.0)
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-serialisable fields."""
-        return asdict(self)
 
 
 class ShadowingField:

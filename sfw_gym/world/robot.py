@@ -28,7 +28,6 @@ substep in which the robot's disc touches a wall.
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, NamedTuple
@@ -36,6 +35,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import pymunk
 
+from sfw_gym.core.config import Config, setting
 from sfw_gym.core.errors import ConfigError
 
 __all__ = ["Pose", "Robot", "RobotConfig", "StepResult"]
@@ -88,7 +88,7 @@ class StepResult:
 
 
 @dataclass(frozen=True)
-class RobotConfig:
+class RobotConfig(Config):
     """Robot geometry, limits, physics resolution and odometry noise.
 
     Attributes:
@@ -108,50 +108,26 @@ class RobotConfig:
             than ``radius_m`` to a wall line.
     """
 
-    radius_m: float = 0.17
-    max_linear_speed_m_s: float = 0.5
-    max_angular_speed_rad_s: float = 1.5
-    control_period_s: float = 0.2
-    physics_substeps: int = 10
-    odometry_translation_std: float = 0.0
-    odometry_heading_std_rad: float = 0.0
-    wall_radius_m: float = 0.01
+    radius_m: float = setting(0.17, gt=0.0)
+    max_linear_speed_m_s: float = setting(0.5, gt=0.0)
+    max_angular_speed_rad_s: float = setting(1.5, gt=0.0)
+    control_period_s: float = setting(0.2, gt=0.0)
+    physics_substeps: int = setting(10, integer=True, ge=1)
+    odometry_translation_std: float = setting(0.0, ge=0.0)
+    odometry_heading_std_rad: float = setting(0.0, ge=0.0)
+    wall_radius_m: float = setting(0.01, ge=0.0)
 
-    def __post_init__(self) -> None:
-        """Validate every field; raise ConfigError naming the first bad one."""
-        for name in ("radius_m", "max_linear_speed_m_s", "max_angular_speed_rad_s"):
-            self._check_real(name, positive=True)
-        self._check_real("control_period_s", positive=True)
-        for name in ("odometry_translation_std", "odometry_heading_std_rad", "wall_radius_m"):
-            self._check_real(name, positive=False)
-        substeps = self.physics_substeps
-        if isinstance(substeps, bool) or not isinstance(substeps, numbers.Integral):
-            raise ConfigError(f"RobotConfig.physics_substeps must be an integer, got {substeps!r}")
-        if substeps < 1:
-            raise ConfigError(f"RobotConfig.physics_substeps must be >= 1, got {substeps}")
-        object.__setattr__(self, "physics_substeps", int(substeps))
+    def validate(self) -> None:
         travel = self.max_substep_travel_m
         if travel > MAX_SUBSTEP_TRAVEL_M:
             need = math.ceil(
                 self.max_linear_speed_m_s * self.control_period_s / MAX_SUBSTEP_TRAVEL_M
             )
             raise ConfigError(
-                f"RobotConfig.physics_substeps={substeps} lets the robot move {travel:.4f} m per "
-                f"substep at full speed (limit {MAX_SUBSTEP_TRAVEL_M} m); use at least {need}"
+                f"RobotConfig.physics_substeps={self.physics_substeps} lets the robot move "
+                f"{travel:.4f} m per substep at full speed (limit {MAX_SUBSTEP_TRAVEL_M} m); "
+                f"use at least {need}"
             )
-
-    def _check_real(self, name: str, *, positive: bool) -> None:
-        value = getattr(self, name)
-        if isinstance(value, bool) or not isinstance(value, numbers.Real):
-            raise ConfigError(f"RobotConfig.{name} must be a real number, got {value!r}")
-        value = float(value)
-        if not math.isfinite(value):
-            raise ConfigError(f"RobotConfig.{name} must be finite, got {value}")
-        if positive and value <= 0.0:
-            raise ConfigError(f"RobotConfig.{name} must be > 0, got {value}")
-        if not positive and value < 0.0:
-            raise ConfigError(f"RobotConfig.{name} must be >= 0, got {value}")
-        object.__setattr__(self, name, value)
 
     @property
     def substep_s(self) -> float:

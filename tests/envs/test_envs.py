@@ -188,8 +188,10 @@ class TestBadInput:
                 env.unwrapped.step(action)
 
     def test_unknown_reset_option(self, env):
-        with pytest.raises(ConfigError, match=r"unknown reset option.*'colour'"):
+        with pytest.raises(ConfigError, match=r"reset options: unknown key 'colour'"):
             env.reset(options={"colour": "red"})
+        with pytest.raises(ConfigError, match=r"unknown key 'start'; did you mean 'start_pose'"):
+            env.reset(options={"start": (1.0, 1.0, 0.0)})
 
     def test_router_in_a_wall(self, env):
         with pytest.raises(ConfigError, match=r"router 0 .* (inside a wall|outside the building)"):
