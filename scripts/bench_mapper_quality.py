@@ -65,8 +65,15 @@ ROBOT_RADIUS_M = 0.17
 CLEARANCE_M = ROBOT_RADIUS_M + 0.02
 STEP_M = 0.05
 PLAN_RES_M = 0.05  # grid of the transit planner
-METRICS = ("paper_iou", "free_iou", "wall_precision", "interior_wall_recall", "k_accuracy",
-           "k_exact", "coverage")  # fmt: skip
+METRICS = (
+    "paper_iou",
+    "free_iou",
+    "wall_precision",
+    "interior_wall_recall",
+    "k_accuracy",
+    "k_exact",
+    "coverage",
+)
 ORACLE_METRICS = ("oracle_free_iou", "oracle_wall_recall")
 TARGETS = {"paper_iou": 0.95, "free_iou": 0.85, "wall_precision": 0.8, "interior_wall_recall": 0.7}
 
@@ -82,8 +89,10 @@ class TransitPlanner:
         self.origin = np.array([xmin - PLAN_RES_M, ymin - PLAN_RES_M])
         nx = math.ceil((xmax - xmin) / PLAN_RES_M) + 3
         ny = math.ceil((ymax - ymin) / PLAN_RES_M) + 3
-        gx, gy = np.meshgrid(self.origin[0] + (np.arange(nx) + 0.5) * PLAN_RES_M,
-                             self.origin[1] + (np.arange(ny) + 0.5) * PLAN_RES_M)  # fmt: skip
+        gx, gy = np.meshgrid(
+            self.origin[0] + (np.arange(nx) + 0.5) * PLAN_RES_M,
+            self.origin[1] + (np.arange(ny) + 0.5) * PLAN_RES_M,
+        )
         self.centres = np.stack([gx.ravel(), gy.ravel()], axis=1)
         ok = shapely.contains_xy(region, gx, gy)
         self.ok = ok
@@ -288,12 +297,17 @@ def main() -> None:
     parser.add_argument("--generated", type=int, default=20, help="generated plans (seeds 0..N-1)")
     parser.add_argument("--resolution", type=float, default=0.1)
     parser.add_argument("--spacing", type=float, default=0.5, help="lawnmower pass spacing, m")
-    parser.add_argument("--survey", choices=["wall+lawnmower", "lawnmower"],
-                        default="wall+lawnmower")  # fmt: skip
-    parser.add_argument("--table", action="store_true",
-                        help="estimators x policies x calibration (aggregates only)")  # fmt: skip
-    parser.add_argument("--oracle", action="store_true",
-                        help="also the dense oracle's free IoU, interior-wall recall")  # fmt: skip
+    parser.add_argument(
+        "--survey", choices=["wall+lawnmower", "lawnmower"], default="wall+lawnmower"
+    )
+    parser.add_argument(
+        "--table", action="store_true", help="estimators x policies x calibration (aggregates only)"
+    )
+    parser.add_argument(
+        "--oracle",
+        action="store_true",
+        help="also the dense oracle's free IoU, interior-wall recall",
+    )
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args()
     sources = [str(p) for p in sorted(HOUSEEXPO.glob("*.json"))]
@@ -301,13 +315,25 @@ def main() -> None:
     radio = RadioConfig()
     k0 = radio.tx_power_dbm - radio.d0_loss_db  # what the environment passes
     configs = configs_for(args.table, k0)
-    cases = [Case(s, args.noise, tuple(configs), args.resolution, args.spacing,
-                  args.survey == "wall+lawnmower", args.oracle) for s in sources]  # fmt: skip
+    cases = [
+        Case(
+            s,
+            args.noise,
+            tuple(configs),
+            args.resolution,
+            args.spacing,
+            args.survey == "wall+lawnmower",
+            args.oracle,
+        )
+        for s in sources
+    ]
     with ProcessPoolExecutor(args.workers) as pool:
         per_plan = list(pool.map(run_case, cases))
-    print(f"noise={args.noise}, {args.resolution} m cells, survey {args.survey} "
-          f"({args.spacing} m passes, {CLEARANCE_M:.2f} m clearance), k0 = {k0:.1f} dBm, "
-          f"{len(sources)} plans")  # fmt: skip
+    print(
+        f"noise={args.noise}, {args.resolution} m cells, survey {args.survey} "
+        f"({args.spacing} m passes, {CLEARANCE_M:.2f} m clearance), k0 = {k0:.1f} dBm, "
+        f"{len(sources)} plans"
+    )
     cols = METRICS + (ORACLE_METRICS if args.oracle else ())
     summary = []
     for c, (label, _) in enumerate(configs):
@@ -317,10 +343,14 @@ def main() -> None:
             print("| plan | samples | " + " | ".join(cols) + " |")
             print("|---" * (len(cols) + 2) + "|")
             for r in results:
-                print(f"| {r['plan']} | {r['samples']} | "
-                      + " | ".join(fmt(r[m]) for m in cols) + " |")  # fmt: skip
-        fails = [(r["plan"], m, round(r[m], 3)) for r in results for m, t in TARGETS.items()
-                 if r[m] < t]  # fmt: skip
+                print(
+                    f"| {r['plan']} | {r['samples']} | "
+                    + " | ".join(fmt(r[m]) for m in cols)
+                    + " |"
+                )
+        fails = [
+            (r["plan"], m, round(r[m], 3)) for r in results for m, t in TARGETS.items() if r[m] < t
+        ]
         undefined = [(r["plan"], m) for r in results for m in TARGETS if r[m] != r[m]]
         summary.append((label, results, fails, undefined))
     print("\n## aggregate over plans (mean / min)\n")
@@ -334,8 +364,10 @@ def main() -> None:
         print(f"| {label} | " + " | ".join(cells) + f" | {len({p for p, _, _ in fails})} |")
     print(f"\ntargets {TARGETS}")
     for label, _, fails, undefined in summary:
-        print(f"{label}: below a target: {fails if fails else 'none'}"
-              + (f"; undefined (nan): {undefined}" if undefined else ""))  # fmt: skip
+        print(
+            f"{label}: below a target: {fails if fails else 'none'}"
+            + (f"; undefined (nan): {undefined}" if undefined else "")
+        )
 
 
 if __name__ == "__main__":

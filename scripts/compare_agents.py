@@ -36,8 +36,15 @@ def main() -> None:
     else:
         print(f"no HouseExpo folder at {he}: generated plans only")
     for name, episodes, seed, plans in runs:
-        result = evaluate(agents, episodes, seed, out=out / name, env_id=args.env,
-                          floorplans=plans, workers=args.workers)  # fmt: skip
+        result = evaluate(
+            agents,
+            episodes,
+            seed,
+            out=out / name,
+            env_id=args.env,
+            floorplans=plans,
+            workers=args.workers,
+        )
         print(f"\n### {name} ({episodes} episodes, {args.env})\n")
         print((out / name / "results.md").read_text(encoding="utf-8"))
         print(f"{len(result['files'])} files in {out / name}")

@@ -36,13 +36,20 @@ def main() -> None:
     p.add_argument("--workers", type=int, default=2)
     args = p.parse_args()
     out = Path(args.out)
-    result = evaluate(["ppo", "frontier"], args.episodes, args.seed, out=out,
-                      agent_params={"ppo": {"path": args.model}},
-                      workers=args.workers)  # fmt: skip
+    result = evaluate(
+        ["ppo", "frontier"],
+        args.episodes,
+        args.seed,
+        out=out,
+        agent_params={"ppo": {"path": args.model}},
+        workers=args.workers,
+    )
     seen = trained_floorplans(Path(args.model))
     plans = {r["floorplan"] for r in result["records"]}
-    print(f"{len(plans)} evaluation floorplans; {len(seen)} in the training logs; "
-          f"overlap: {sorted(plans & seen) or 'none'}")  # fmt: skip
+    print(
+        f"{len(plans)} evaluation floorplans; {len(seen)} in the training logs; "
+        f"overlap: {sorted(plans & seen) or 'none'}"
+    )
     print((out / "results.md").read_text(encoding="utf-8"))
 
 

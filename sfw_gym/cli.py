@@ -189,8 +189,14 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     from sfw_gym.demo import run_demo
 
     start = time.perf_counter()
-    index = run_demo(args.out, args.episodes, args.seed, workers=args.workers,
-                     progress=not args.no_progress, model=args.model)  # fmt: skip
+    index = run_demo(
+        args.out,
+        args.episodes,
+        args.seed,
+        workers=args.workers,
+        progress=not args.no_progress,
+        model=args.model,
+    )
     print(index.parent.joinpath("results.md").read_text(encoding="utf-8"), end="")
     print(f"report: {index} ({time.perf_counter() - start:.0f} s)")
     return 0
@@ -266,13 +272,17 @@ def build_parser() -> argparse.ArgumentParser:
         help="border around the data, metres (default 1)",
     )
     mp.add_argument(
-        "--band", choices=["2.4", "5"], default=None,
+        "--band",
+        choices=["2.4", "5"],
+        default=None,
         help="with 2 RSSI columns per router: which band (default 2.4)",
-    )  # fmt: skip
+    )
     mp.add_argument(
-        "--policy", choices=["strongest", "all"], default="strongest",
+        "--policy",
+        choices=["strongest", "all"],
+        default="strongest",
         help="update along the strongest router's ray (the paper) or all heard routers",
-    )  # fmt: skip
+    )
     mp.add_argument(
         "--y-down", action="store_true", help="the CSV's y grows downward (image pixels)"
     )
@@ -314,18 +324,20 @@ def build_parser() -> argparse.ArgumentParser:
         "evaluate", help="compare agents on the same floorplans and seeds (table, curves, paths)"
     )
     ev.add_argument(
-        "--agents", default="frontier,cross-pass,random",
+        "--agents",
+        default="frontier,cross-pass,random",
         help="comma-separated: frontier, cross-pass, greedy, random, ppo (default: "
         "frontier,cross-pass,random)",
-    )  # fmt: skip
+    )
     ev.add_argument(
         "--episodes", type=positive_int, default=10, help="episodes per agent (default 10)"
     )
     ev.add_argument("--seed", type=seed_int, default=0, help="episode i uses reset(seed=SEED + i)")
     ev.add_argument(
-        "--floorplans", default=None, help="folder of plan files (cycled) or one file; "
-        "default: the env's procedural plans",
-    )  # fmt: skip
+        "--floorplans",
+        default=None,
+        help="folder of plan files (cycled) or one file; default: the env's procedural plans",
+    )
     ev.add_argument("--env", default="SfW-Explore-v0", help="env id (default SfW-Explore-v0)")
     ev.add_argument("--env-kwargs", default=None, help="extra gym.make kwargs as JSON")
     ev.add_argument(

@@ -6,11 +6,11 @@ from __future__ import annotations
 import fnmatch
 import subprocess
 import sys
-import tomllib
 import zipfile
 from pathlib import Path
 
 import pytest
+import tomllib
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -59,8 +59,12 @@ def test_every_data_file_the_package_reads_is_in_the_wheel():
         "package-data"
     ]["sfw_gym"]
     package = REPO / "sfw_gym"
-    read = [data.DEFAULT_MODEL_DIR / "model.zip", data.DEFAULT_MODEL_DIR / "config.yml",
-            data.DEFAULT_HYPERPARAMS, data.SCENARIOS]  # fmt: skip
+    read = [
+        data.DEFAULT_MODEL_DIR / "model.zip",
+        data.DEFAULT_MODEL_DIR / "config.yml",
+        data.DEFAULT_HYPERPARAMS,
+        data.SCENARIOS,
+    ]
     for path in read:
         assert path.is_file(), path
         rel = path.resolve().relative_to(package.resolve()).as_posix()

@@ -98,9 +98,13 @@ class CrossPassAgent(FrontierAgent):
         n = min(len(traj), len(hist))
         _, walls, _ = belief_classes(view.belief_u8)
         self.scores = router_scores(
-            view.grid, view.routers_xy, traj[len(traj) - n :], hist[len(hist) - n :],
-            walls=walls | self.bumps, wall_loss_db=self.wall_loss_db,
-        )  # fmt: skip
+            view.grid,
+            view.routers_xy,
+            traj[len(traj) - n :],
+            hist[len(hist) - n :],
+            walls=walls | self.bumps,
+            wall_loss_db=self.wall_loss_db,
+        )
         self.zone, self.band = dominance_bands(self.scores, self.band_m / view.grid.resolution_m)
 
     def _choose_goal(self, view: RobotView, paths: CostField) -> Goal | None:

@@ -127,10 +127,16 @@ class SfWExploreEnv(gym.Env):
                 f"got {render_mode!r}"
             )
         self.config = ExploreConfig(
-            action_type=action_type, n_routers=n_routers, radio_preset=radio_preset,
-            radio_band=radio_band, resolution_m=resolution_m, map_px=map_px, crop_px=crop_px,
-            max_steps=max_steps, steps_per_m2=steps_per_m2,
-        )  # fmt: skip
+            action_type=action_type,
+            n_routers=n_routers,
+            radio_preset=radio_preset,
+            radio_band=radio_band,
+            resolution_m=resolution_m,
+            map_px=map_px,
+            crop_px=crop_px,
+            max_steps=max_steps,
+            steps_per_m2=steps_per_m2,
+        )
         self.reward_config = RewardConfig(
             reward_scale=reward_scale,
             collision_penalty=collision_penalty,

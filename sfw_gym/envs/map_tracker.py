@@ -22,8 +22,9 @@ _FREE_INTER, _WALL_NEAR, _INTERIOR_FOUND = 6, 7, 8
 
 
 @njit(cache=True)
-def _account(cell, cls, sign, truth_cls, near_wall, interior, found_by, offsets, n_rows, n_cols,
-             counts):  # fmt: skip
+def _account(
+    cell, cls, sign, truth_cls, near_wall, interior, found_by, offsets, n_rows, n_cols, counts
+):
     """Add (sign=+1) or remove (-1) one cell's estimated class from the counters."""
     if cls == UNKNOWN:
         return
@@ -59,8 +60,9 @@ def _account(cell, cls, sign, truth_cls, near_wall, interior, found_by, offsets,
 
 
 @njit(cache=True)
-def _apply(changed, est_u8, est_cls, truth_cls, near_wall, interior, found_by, offsets, n_cols,
-           counts):  # fmt: skip
+def _apply(
+    changed, est_u8, est_cls, truth_cls, near_wall, interior, found_by, offsets, n_cols, counts
+):
     n_rows = est_cls.shape[0] // n_cols
     for i in range(changed.shape[0]):
         cell = changed[i]
@@ -68,10 +70,12 @@ def _apply(changed, est_u8, est_cls, truth_cls, near_wall, interior, found_by, o
         old = est_cls[cell]
         if new == old:
             continue
-        _account(cell, old, -1, truth_cls, near_wall, interior, found_by, offsets, n_rows, n_cols,
-                 counts)  # fmt: skip
-        _account(cell, new, 1, truth_cls, near_wall, interior, found_by, offsets, n_rows, n_cols,
-                 counts)  # fmt: skip
+        _account(
+            cell, old, -1, truth_cls, near_wall, interior, found_by, offsets, n_rows, n_cols, counts
+        )
+        _account(
+            cell, new, 1, truth_cls, near_wall, interior, found_by, offsets, n_rows, n_cols, counts
+        )
         est_cls[cell] = new
 
 
@@ -110,10 +114,17 @@ class MapTracker:
         """Account for the cells whose class changed in the last map update."""
         if len(changed_cells):
             _apply(
-                np.asarray(changed_cells, np.int64), est_u8.ravel(), self._est_cls,
-                self._truth_cls, self._near_wall, self._interior, self._found_by, self._offsets,
-                self.truth_u8.shape[1], self._counts,
-            )  # fmt: skip
+                np.asarray(changed_cells, np.int64),
+                est_u8.ravel(),
+                self._est_cls,
+                self._truth_cls,
+                self._near_wall,
+                self._interior,
+                self._found_by,
+                self._offsets,
+                self.truth_u8.shape[1],
+                self._counts,
+            )
 
     @staticmethod
     def _ratio(num: int, den: int) -> float:

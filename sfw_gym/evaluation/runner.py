@@ -104,8 +104,10 @@ def zone_band_unknown(env: Any, band_m: float = 0.8) -> dict[str, float]:
     zone = np.full(truth.shape, -1, np.int64)
     zone[free] = np.argmax(gt.radio.mean_rssi(np.stack([xs[free], ys[free]], 1)), axis=1)
     border = np.zeros(truth.shape, bool)
-    for a, b in (((slice(None, -1), slice(None)), (slice(1, None), slice(None))),
-                 ((slice(None), slice(None, -1)), (slice(None), slice(1, None)))):  # fmt: skip
+    for a, b in (
+        ((slice(None, -1), slice(None)), (slice(1, None), slice(None))),
+        ((slice(None), slice(None, -1)), (slice(None), slice(1, None))),
+    ):
         diff = (zone[a] != zone[b]) & (zone[a] >= 0) & (zone[b] >= 0)
         border[a] |= diff
         border[b] |= diff
@@ -336,10 +338,17 @@ def evaluate(
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     specs = episode_specs(
-        agents, episodes, seed, out=out, env_id=env_id, floorplans=floorplans,
-        env_kwargs=env_kwargs, agent_params=agent_params, gif_episodes=gif_episodes,
+        agents,
+        episodes,
+        seed,
+        out=out,
+        env_id=env_id,
+        floorplans=floorplans,
+        env_kwargs=env_kwargs,
+        agent_params=agent_params,
+        gif_episodes=gif_episodes,
         curve_every=curve_every,
-    )  # fmt: skip
+    )
     ckpt = out / CHECKPOINT
     records = load_checkpoint(ckpt)
     done = {r["key"] for r in records}
@@ -347,12 +356,19 @@ def evaluate(
     write_text_atomic(
         out / "config.json",
         json.dumps(
-            {"agents": agents, "episodes": episodes, "seed": seed, "env_id": env_id,
-             "floorplans": str(floorplans) if floorplans else None,
-             "env_kwargs": env_kwargs or {}, "agent_params": agent_params or {}},
+            {
+                "agents": agents,
+                "episodes": episodes,
+                "seed": seed,
+                "env_id": env_id,
+                "floorplans": str(floorplans) if floorplans else None,
+                "env_kwargs": env_kwargs or {},
+                "agent_params": agent_params or {},
+            },
             indent=2,
-        ) + "\n",
-    )  # fmt: skip
+        )
+        + "\n",
+    )
     _run_all(todo, records, ckpt, workers, progress, total=len(specs), done=len(specs) - len(todo))
     keys = {s.key for s in specs}
     mine = [r for r in records if r["key"] in keys]

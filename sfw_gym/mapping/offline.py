@@ -479,9 +479,14 @@ def _draw(result: OfflineMap, occ: np.ndarray, fh: IO[bytes], y_down: bool) -> N
     fig, ax = plt.subplots(figsize=(width, min(max(width * aspect, 3.0), 14.0) + 0.8))
     try:
         im = ax.imshow(
-            occ, cmap="gray", vmin=0, vmax=255, origin="lower", extent=(x0, x1, y0, y1),
+            occ,
+            cmap="gray",
+            vmin=0,
+            vmax=255,
+            origin="lower",
+            extent=(x0, x1, y0, y1),
             interpolation="nearest",
-        )  # fmt: skip
+        )
         cbar = fig.colorbar(im, ax=ax, shrink=0.7, ticks=[0, 127, 255])
         cbar.ax.set_yticklabels(["wall", "unknown", "free"])
         p = result.positions_m
@@ -491,9 +496,13 @@ def _draw(result: OfflineMap, occ: np.ndarray, fh: IO[bytes], y_down: bool) -> N
         for r, ((rx, ry), name) in enumerate(zip(result.routers_m, result.columns, strict=True)):
             ax.plot(rx, ry, "r^", ms=10, label="router" if r == 0 else None)
             ax.annotate(
-                f"R{r + 1} ({name})", (rx, ry), color="red", xytext=(5, 5),
-                textcoords="offset points", fontsize=8,
-            )  # fmt: skip
+                f"R{r + 1} ({name})",
+                (rx, ry),
+                color="red",
+                xytext=(5, 5),
+                textcoords="offset points",
+                fontsize=8,
+            )
         if y_down:
             ax.invert_yaxis()
         ax.set_aspect("equal")

@@ -201,8 +201,9 @@ def _wall_candidates(j0, j1, dk, s_mid, ray, l_tot, cls, n_cols):
 
 
 @njit(cache=True)
-def _push_anchors(raster_r, rows, cols, t0, t1, l_tot, thresholds_r, n_thr_r, lo, hi,
-                  anc_j, anc_s, anc_k, n_anc):  # fmt: skip
+def _push_anchors(
+    raster_r, rows, cols, t0, t1, l_tot, thresholds_r, n_thr_r, lo, hi, anc_j, anc_s, anc_k, n_anc
+):
     """Append the visited ray cells lo..hi-1 (trajectory points) as anchors with their k."""
     for j in range(lo, hi):
         f = raster_r[rows[j], cols[j]]
@@ -216,9 +217,22 @@ def _push_anchors(raster_r, rows, cols, t0, t1, l_tot, thresholds_r, n_thr_r, lo
 
 @njit(cache=True)
 def _ray_update(
-    r, k_robot, gx, gy, rgx, rgy, extend, params, raster, thresholds, n_thr, maps, track, ray,
+    r,
+    k_robot,
+    gx,
+    gy,
+    rgx,
+    rgy,
+    extend,
+    params,
+    raster,
+    thresholds,
+    n_thr,
+    maps,
+    track,
+    ray,
     anchors,
-):  # fmt: skip
+):
     """Segment the ray of router ``r`` at earlier trajectory points and update every piece."""
     rows, cols, t0, t1 = ray
     anc_j, anc_s, anc_k = anchors
@@ -252,15 +266,43 @@ def _ray_update(
     anc_s[0] = 0.0
     anc_k[0] = 0
     n_anc = 1
-    n_anc = _push_anchors(raster[r], rows, cols, t0, t1, l_tot, thresholds[r], n_thr[r],
-                          0, i_r, anc_j, anc_s, anc_k, n_anc)  # fmt: skip
+    n_anc = _push_anchors(
+        raster[r],
+        rows,
+        cols,
+        t0,
+        t1,
+        l_tot,
+        thresholds[r],
+        n_thr[r],
+        0,
+        i_r,
+        anc_j,
+        anc_s,
+        anc_k,
+        n_anc,
+    )
     anc_j[n_anc] = i_r
     anc_s[n_anc] = dist
     anc_k[n_anc] = k_robot
     n_anc += 1
     if extend:
-        n_anc = _push_anchors(raster[r], rows, cols, t0, t1, l_tot, thresholds[r], n_thr[r],
-                              i_r + 1, n, anc_j, anc_s, anc_k, n_anc)  # fmt: skip
+        n_anc = _push_anchors(
+            raster[r],
+            rows,
+            cols,
+            t0,
+            t1,
+            l_tot,
+            thresholds[r],
+            n_thr[r],
+            i_r + 1,
+            n,
+            anc_j,
+            anc_s,
+            anc_k,
+            n_anc,
+        )
     rad = params[_P_RADIUS] / params[_P_RES]
     lmin = params[_P_LMIN]
     lmax = params[_P_LMAX]
@@ -298,19 +340,55 @@ def _ray_update(
 
 @njit(cache=True)
 def _update_kernel(
-    gx, gy, rssi, bumped, heading, routers_g, policy_all, extend, params, kest, feature, k_out,
-    selected, dist_buf, raster, maps, track, ray, anchors,
-):  # fmt: skip
+    gx,
+    gy,
+    rssi,
+    bumped,
+    heading,
+    routers_g,
+    policy_all,
+    extend,
+    params,
+    kest,
+    feature,
+    k_out,
+    selected,
+    dist_buf,
+    raster,
+    maps,
+    track,
+    ray,
+    anchors,
+):
     """One full update; returns ``(gain_bits, refit_due)``, or ``(nan, False)`` untouched if an
     RSSI value is not finite."""
     for r in range(rssi.shape[0]):
         if not np.isfinite(rssi[r]):
             return np.nan, False
     (
-        kest_da, kest_n, kest_dmin, kest_gap, kest_cal, kest_reset, ring, ring_pos, ring_count,
-        fit_buf, fit_n, fit_stride, n_seen, n_fit_seen, next_refit, thresholds, n_thr, fitted,
-        prior, fit_range, novel, novel_needed,
-    ) = kest  # fmt: skip
+        kest_da,
+        kest_n,
+        kest_dmin,
+        kest_gap,
+        kest_cal,
+        kest_reset,
+        ring,
+        ring_pos,
+        ring_count,
+        fit_buf,
+        fit_n,
+        fit_stride,
+        n_seen,
+        n_fit_seen,
+        next_refit,
+        thresholds,
+        n_thr,
+        fitted,
+        prior,
+        fit_range,
+        novel,
+        novel_needed,
+    ) = kest
     lo, _, u8, cls, classified, _, _ = maps
     touched, old_cls, changed, state = track
     rows, cols, t0, t1 = ray
@@ -326,10 +404,33 @@ def _update_kernel(
     for r in range(n_r):
         dist_buf[r] = res * np.sqrt((gx - routers_g[r, 0]) ** 2 + (gy - routers_g[r, 1]) ** 2)
     due = add_samples(
-        rssi, dist_buf, kest_da, kest_n, kest_dmin, kest_gap, kest_cal, kest_reset, ring, ring_pos,
-        ring_count, fit_buf, fit_n, fit_stride, n_seen, n_fit_seen, next_refit, thresholds, n_thr,
-        fitted, prior, fit_range, novel, novel_needed, feature, k_out,
-    )  # fmt: skip
+        rssi,
+        dist_buf,
+        kest_da,
+        kest_n,
+        kest_dmin,
+        kest_gap,
+        kest_cal,
+        kest_reset,
+        ring,
+        ring_pos,
+        ring_count,
+        fit_buf,
+        fit_n,
+        fit_stride,
+        n_seen,
+        n_fit_seen,
+        next_refit,
+        thresholds,
+        n_thr,
+        fitted,
+        prior,
+        fit_range,
+        novel,
+        novel_needed,
+        feature,
+        k_out,
+    )
     gain = 0.0
     # Rule 1: footprint free; a bump marks the contact cell ahead occupied.
     rad = params[_P_RADIUS] / res
@@ -372,9 +473,22 @@ def _update_kernel(
     for q in range(n_sel):
         r = selected[q]
         gain += _ray_update(
-            r, k_out[r], gx, gy, routers_g[r, 0], routers_g[r, 1], extend, params, raster,
-            thresholds, n_thr, maps, track, ray, anchors,
-        )  # fmt: skip
+            r,
+            k_out[r],
+            gx,
+            gy,
+            routers_g[r, 0],
+            routers_g[r, 1],
+            extend,
+            params,
+            raster,
+            thresholds,
+            n_thr,
+            maps,
+            track,
+            ray,
+            anchors,
+        )
     # Trajectory raster (after the rays, so this reading is not its own anchor).
     n_traj = 0
     if state[_S_HAS_PREV] > 0.0:
@@ -478,22 +592,33 @@ class SparseInverseKVisibility:
         self._inside = inside
         self._stamp = np.zeros(n_cells, np.int64)
         self._maps = (
-            self._lo, self._ent, self._u8, self._cls, self._classified, inside, self._stamp,
-        )  # fmt: skip
+            self._lo,
+            self._ent,
+            self._u8,
+            self._cls,
+            self._classified,
+            inside,
+            self._stamp,
+        )
         self._changed = np.empty(touched_cap, np.int64)
         self._state = np.zeros(7, np.float64)
         self._track = (
-            np.empty(touched_cap, np.int64), np.empty(touched_cap, np.int8), self._changed,
+            np.empty(touched_cap, np.int64),
+            np.empty(touched_cap, np.int8),
+            self._changed,
             self._state,
-        )  # fmt: skip
+        )
         self._ray = (
-            np.empty(ray_n, np.int64), np.empty(ray_n, np.int64), np.empty(ray_n, np.float64),
+            np.empty(ray_n, np.int64),
+            np.empty(ray_n, np.int64),
             np.empty(ray_n, np.float64),
-        )  # fmt: skip
+            np.empty(ray_n, np.float64),
+        )
         self._anchors = (
-            np.empty(ray_n + 2, np.int64), np.empty(ray_n + 2, np.float64),
             np.empty(ray_n + 2, np.int64),
-        )  # fmt: skip
+            np.empty(ray_n + 2, np.float64),
+            np.empty(ray_n + 2, np.int64),
+        )
         self._raster = np.full((n_r, h, w), np.nan, np.float32)
         self._selected = np.zeros(n_r, np.int64)
         self._dist = np.empty(n_r, np.float64)
@@ -586,11 +711,26 @@ class SparseInverseKVisibility:
                 raise ConfigError(f"heading_rad must be finite or None, got {heading_rad!r}")
         ke = self._k_estimator
         gain, due = _update_kernel(
-            gx, gy, rssi, bool(bumped), heading, self._routers_g, self._policy_all,
-            self.config.extend_past_robot, self._params, self._kest, ke._feature, ke._k,
-            self._selected, self._dist, self._raster, self._maps, self._track, self._ray,
+            gx,
+            gy,
+            rssi,
+            bool(bumped),
+            heading,
+            self._routers_g,
+            self._policy_all,
+            self.config.extend_past_robot,
+            self._params,
+            self._kest,
+            ke._feature,
+            ke._k,
+            self._selected,
+            self._dist,
+            self._raster,
+            self._maps,
+            self._track,
+            self._ray,
             self._anchors,
-        )  # fmt: skip
+        )
         if gain != gain:
             raise ConfigError(
                 f"rssi_dbm must be finite (use -100 dBm for 'not heard'), got {rssi.tolist()}"

@@ -76,8 +76,10 @@ def free_start(cost: np.ndarray, start_rc: tuple[int, int], radius_cells: int = 
     out = cost.copy()
     r, c = start_rc
     h, w = out.shape
-    sl = (slice(max(r - radius_cells, 0), r + radius_cells + 1),
-          slice(max(c - radius_cells, 0), c + radius_cells + 1))  # fmt: skip
+    sl = (
+        slice(max(r - radius_cells, 0), r + radius_cells + 1),
+        slice(max(c - radius_cells, 0), c + radius_cells + 1),
+    )
     patch = out[sl]
     patch[~np.isfinite(patch)] = 20.0
     if 0 <= r < h and 0 <= c < w and not np.isfinite(out[r, c]):

@@ -138,8 +138,11 @@ class PPOAgent(Agent):
     def _check_obs(self, obs: Any) -> None:
         """The env's observations must be those the policy was trained on."""
         trained = self.model.observation_space.spaces
-        differ = {k: v.shape for k, v in trained.items()
-                  if k != "blocks" and np.shape(obs.get(k)) != v.shape}  # fmt: skip
+        differ = {
+            k: v.shape
+            for k, v in trained.items()
+            if k != "blocks" and np.shape(obs.get(k)) != v.shape
+        }
         if differ:
             got = {k: np.shape(obs.get(k)) for k in differ}
             raise ConfigError(

@@ -26,10 +26,12 @@ class BlockScores(BaseFeaturesExtractor):
         super().__init__(observation_space, features_dim=n + n * f)
         self.n_blocks = n
         self.scorer = nn.Sequential(
-            nn.Linear(f, hidden), nn.Tanh(),
-            nn.Linear(hidden, hidden), nn.Tanh(),
+            nn.Linear(f, hidden),
+            nn.Tanh(),
+            nn.Linear(hidden, hidden),
+            nn.Tanh(),
             nn.Linear(hidden, 1),
-        )  # fmt: skip
+        )
 
     def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
         blocks = observations["blocks"]

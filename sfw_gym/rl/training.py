@@ -36,9 +36,18 @@ MOVED_CLASSES = {
 #: Evaluation episodes draw their floorplans from seeds this far from the training seeds.
 HELD_OUT_SEED_OFFSET = 1_000_000
 _PPO_KEYS = {
-    "n_steps", "batch_size", "n_epochs", "gamma", "gae_lambda", "learning_rate", "clip_range",
-    "ent_coef", "vf_coef", "max_grad_norm", "policy_kwargs",
-}  # fmt: skip
+    "n_steps",
+    "batch_size",
+    "n_epochs",
+    "gamma",
+    "gae_lambda",
+    "learning_rate",
+    "clip_range",
+    "ent_coef",
+    "vf_coef",
+    "max_grad_norm",
+    "policy_kwargs",
+}
 
 
 def load_hyperparams(env_id: str, path: str | Path = DEFAULT_HYPERPARAMS) -> dict[str, Any]:
@@ -221,28 +230,63 @@ def train_ppo(
             shutil.copyfile(previous[0], tmp)
         steps, wall = start_steps, 0.0
     else:
-        venv = _make_venv(env_id, n_envs, seed + start_steps, env_kwargs, wrappers,
-                          out / f"train_{start_steps}.monitor.csv")  # fmt: skip
-        eval_env = _make_venv(env_id, 1, seed + HELD_OUT_SEED_OFFSET, env_kwargs, wrappers,
-                              out / f"eval_{start_steps}.monitor.csv")  # fmt: skip
+        venv = _make_venv(
+            env_id,
+            n_envs,
+            seed + start_steps,
+            env_kwargs,
+            wrappers,
+            out / f"train_{start_steps}.monitor.csv",
+        )
+        eval_env = _make_venv(
+            env_id,
+            1,
+            seed + HELD_OUT_SEED_OFFSET,
+            env_kwargs,
+            wrappers,
+            out / f"eval_{start_steps}.monitor.csv",
+        )
         try:
             if previous:
-                model = PPO.load(previous[0], env=venv, device=device,
-                                 tensorboard_log=str(out / "tb"))  # fmt: skip
+                model = PPO.load(
+                    previous[0], env=venv, device=device, tensorboard_log=str(out / "tb")
+                )
             else:
-                model = PPO(policy, venv, seed=seed, device=device, verbose=0,
-                            tensorboard_log=str(out / "tb"), **ppo_kwargs)  # fmt: skip
-            callbacks = CallbackList([
-                CheckpointCallback(max(checkpoint_every // n_envs, 1), str(out / "checkpoints"),
-                                   name_prefix="ppo"),
-                EvalCallback(eval_env, n_eval_episodes=eval_episodes,
-                             eval_freq=max(eval_every // n_envs, 1), log_path=str(out / "eval"),
-                             best_model_save_path=None, deterministic=False, verbose=0),
-            ])  # fmt: skip
+                model = PPO(
+                    policy,
+                    venv,
+                    seed=seed,
+                    device=device,
+                    verbose=0,
+                    tensorboard_log=str(out / "tb"),
+                    **ppo_kwargs,
+                )
+            callbacks = CallbackList(
+                [
+                    CheckpointCallback(
+                        max(checkpoint_every // n_envs, 1),
+                        str(out / "checkpoints"),
+                        name_prefix="ppo",
+                    ),
+                    EvalCallback(
+                        eval_env,
+                        n_eval_episodes=eval_episodes,
+                        eval_freq=max(eval_every // n_envs, 1),
+                        log_path=str(out / "eval"),
+                        best_model_save_path=None,
+                        deterministic=False,
+                        verbose=0,
+                    ),
+                ]
+            )
             start = time.perf_counter()
-            model.learn(total_timesteps=timesteps - start_steps, callback=callbacks,
-                        reset_num_timesteps=previous is None, progress_bar=progress_bar,
-                        tb_log_name="ppo")  # fmt: skip
+            model.learn(
+                total_timesteps=timesteps - start_steps,
+                callback=callbacks,
+                reset_num_timesteps=previous is None,
+                progress_bar=progress_bar,
+                tb_log_name="ppo",
+            )
             wall = time.perf_counter() - start
             _save_atomic(model, out / "model.zip")
             # A final checkpoint, so that a later resume starts from the end of this run.
@@ -320,8 +364,13 @@ def plot_training_curve(out_dir: str | Path) -> Path | None:
         ax.plot(s[k - 1 :], smooth, label=f"training (mean of last {k})")
     if evals.exists():
         ev = np.load(evals)
-        ax.errorbar(ev["timesteps"], ev["results"].mean(1), yerr=ev["results"].std(1), fmt="o-",
-                    label="held-out seeds")  # fmt: skip
+        ax.errorbar(
+            ev["timesteps"],
+            ev["results"].mean(1),
+            yerr=ev["results"].std(1),
+            fmt="o-",
+            label="held-out seeds",
+        )
     ax.set_xlabel("agent steps (waypoints with WaypointWrapper)")
     ax.set_ylabel("episode return (≈ m² mapped)")
     ax.legend()

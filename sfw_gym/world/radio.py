@@ -222,8 +222,20 @@ def _rssi_parallel(edges, edge_loss, routers, pts, params, tables, origin, spaci
     k = np.empty((m, routers.shape[0]), np.int32)
     n_chunks = (m + 511) // 512
     for c in prange(n_chunks):
-        _rssi_range(edges, edge_loss, routers, pts, params, tables, origin, spacing, rssi, k,
-                    c * 512, min(m, (c + 1) * 512))  # fmt: skip
+        _rssi_range(
+            edges,
+            edge_loss,
+            routers,
+            pts,
+            params,
+            tables,
+            origin,
+            spacing,
+            rssi,
+            k,
+            c * 512,
+            min(m, (c + 1) * 512),
+        )
     return rssi, k
 
 
@@ -252,12 +264,24 @@ class RadioModel:
         losses = self.config.wall_loss_db
         self._edge_loss_db = np.array([losses[m] for m in floorplan.edge_materials], np.float64)
         cfg = self.config
-        self._params = np.array([cfg.tx_power_dbm, self._d0_loss_db, 10.0 * cfg.path_loss_exponent,
-                                 cfg.reference_distance_m, cfg.max_total_wall_loss_db,
-                                 DEFAULT_MIN_PIECE_M])  # fmt: skip
+        self._params = np.array(
+            [
+                cfg.tx_power_dbm,
+                self._d0_loss_db,
+                10.0 * cfg.path_loss_exponent,
+                cfg.reference_distance_m,
+                cfg.max_total_wall_loss_db,
+                DEFAULT_MIN_PIECE_M,
+            ]
+        )
         if cfg.shadowing_sigma_db > 0:
-            field = ShadowingField(floorplan.bounds, len(self.routers), cfg.shadowing_sigma_db,
-                                   cfg.shadowing_correlation_m, self.rng)  # fmt: skip
+            field = ShadowingField(
+                floorplan.bounds,
+                len(self.routers),
+                cfg.shadowing_sigma_db,
+                cfg.shadowing_correlation_m,
+                self.rng,
+            )
             self._shadow_args = (field.table_db, field.origin, field.spacing_m)
         else:  # a flat zero table: no shadowing
             self._shadow_args = (np.zeros((len(self.routers), 2, 2)), np.zeros(2), 1.0)
@@ -284,8 +308,14 @@ class RadioModel:
     def _model(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Mean RSSI (M, R) and true k (M, R) at points, in one compiled pass."""
         kernel = _rssi_parallel if len(pts) >= _PARALLEL_MIN_POINTS else _rssi
-        return kernel(self.floorplan.edges, self._edge_loss_db, self.routers, pts, self._params,
-                      *self._shadow_args)  # fmt: skip
+        return kernel(
+            self.floorplan.edges,
+            self._edge_loss_db,
+            self.routers,
+            pts,
+            self._params,
+            *self._shadow_args,
+        )
 
     def true_k(self, points: np.ndarray) -> np.ndarray:
         """Number of walls between each router and each point: (M, R) int."""

@@ -278,8 +278,20 @@ def test_agent_cannot_reach_ground_truth_through_the_interface(name):
         proxy_actions.append(np.asarray(a).copy())
         obs, *_ = env.step(a)
     # The agent holds no ground truth: not the env, its scene, plan, radio, robot or truth grid.
-    forbidden = {id(x) for x in (env, u, u.scene, u.scene.floorplan, u.scene.radio, u.scene.robot,
-                                 u.scene.truth_u8, u.mapper, u.tracker)}  # fmt: skip
+    forbidden = {
+        id(x)
+        for x in (
+            env,
+            u,
+            u.scene,
+            u.scene.floorplan,
+            u.scene.radio,
+            u.scene.robot,
+            u.scene.truth_u8,
+            u.mapper,
+            u.tracker,
+        )
+    }
     held = _reachable(agent, stop=(RobotViewHandle,))
     assert not [type(o).__name__ for o in held if id(o) in forbidden]
     assert not any(type(o).__module__.startswith("sfw_gym.world") for o in held)

@@ -61,30 +61,54 @@ def bad(argv: list[str], error: str, id: str):
 
 CASES = [
     # -- world
-    ok(["world", "--seed", "3", "--out", "{tmp}/out/w.png", "--resolution", "0.3"], "out/w.png",
-       id="world"),
+    ok(
+        ["world", "--seed", "3", "--out", "{tmp}/out/w.png", "--resolution", "0.3"],
+        "out/w.png",
+        id="world",
+    ),
     bad([*WORLD, "--seed", "-1"], r"argument --seed: .*'-1'", id="world-seed-negative"),
     bad([*WORLD, "--resolution", "0"], r"argument --resolution: .*'0'", id="world-resolution-0"),
     bad([*WORLD, "--resolution", "nan"], r"argument --resolution", id="world-resolution-nan"),
     bad([*WORLD, "--routers", "0"], r"--routers: .*'0'", id="world-routers-0"),
     bad([*WORLD, "--routers", "1,2;3"], r"--routers: .*'1,2;3'", id="world-routers-malformed"),
-    bad([*WORLD, "--preset", "nope"], r"argument --preset: invalid choice: 'nope'",
-        id="world-preset-unknown"),
+    bad(
+        [*WORLD, "--preset", "nope"],
+        r"argument --preset: invalid choice: 'nope'",
+        id="world-preset-unknown",
+    ),
     bad([*WORLD, "--band", "7"], r"argument --band: invalid choice: '7'", id="world-band-unknown"),
-    bad([*WORLD, "--floorplan", "{tmp}/missing.json"], r"missing\.json: cannot read",
-        id="world-floorplan-missing"),
-    bad([*WORLD, "--floorplan", "{tmp}/notjson.json"], r"notjson\.json: not valid JSON",
-        id="world-floorplan-not-json"),
-    bad([*WORLD, "--floorplan", "{tmp}/badplan.json"], r"badplan\.json: .*at least 3",
-        id="world-floorplan-malformed"),
-    bad([*WORLD, "--seed", "1", "--floorplan", "{tmp}/badplan.json"],
-        r"argument --floorplan: not allowed with argument --seed", id="world-seed-and-floorplan"),
+    bad(
+        [*WORLD, "--floorplan", "{tmp}/missing.json"],
+        r"missing\.json: cannot read",
+        id="world-floorplan-missing",
+    ),
+    bad(
+        [*WORLD, "--floorplan", "{tmp}/notjson.json"],
+        r"notjson\.json: not valid JSON",
+        id="world-floorplan-not-json",
+    ),
+    bad(
+        [*WORLD, "--floorplan", "{tmp}/badplan.json"],
+        r"badplan\.json: .*at least 3",
+        id="world-floorplan-malformed",
+    ),
+    bad(
+        [*WORLD, "--seed", "1", "--floorplan", "{tmp}/badplan.json"],
+        r"argument --floorplan: not allowed with argument --seed",
+        id="world-seed-and-floorplan",
+    ),
     # -- map
     ok(MAP, "m.png", "m.npy", "m.json", id="map"),
-    bad(["map", "{tmp}/missing.csv", "--routers", "1,1"], r"missing\.csv: no such file",
-        id="map-log-missing"),
-    bad(["map", "{tmp}/badlog.csv", "--routers", "1,1"], r"badlog\.csv:3: column 'r1'",
-        id="map-log-malformed"),
+    bad(
+        ["map", "{tmp}/missing.csv", "--routers", "1,1"],
+        r"missing\.csv: no such file",
+        id="map-log-missing",
+    ),
+    bad(
+        ["map", "{tmp}/badlog.csv", "--routers", "1,1"],
+        r"badlog\.csv:3: column 'r1'",
+        id="map-log-malformed",
+    ),
     bad(["map", "{tmp}", "--routers", "1,1"], r"is a directory", id="map-log-directory"),
     bad([*MAP, "--scale", "-1"], r"argument --scale: .*'-1'", id="map-scale-negative"),
     bad([*MAP, "--scale", "0"], r"argument --scale: .*'0'", id="map-scale-0"),
@@ -102,63 +126,124 @@ CASES = [
     bad([*BENCH, "--steps", "-5"], r"argument --steps: .*'-5'", id="bench-steps-negative"),
     bad([*BENCH, "--steps", "ten"], r"argument --steps: .*'ten'", id="bench-steps-not-int"),
     bad([*BENCH, "--resets", "0"], r"argument --resets: .*'0'", id="bench-resets-0"),
-    bad([*BENCH, "--memory-steps", "-1"], r"argument --memory-steps: .*'-1'",
-        id="bench-memory-steps-negative"),
+    bad(
+        [*BENCH, "--memory-steps", "-1"],
+        r"argument --memory-steps: .*'-1'",
+        id="bench-memory-steps-negative",
+    ),
     bad([*BENCH, "--env", "Nope-v0"], r"--env Nope-v0: .*doesn't exist", id="bench-env-unknown"),
-    bad([*BENCH, "--agent-params", '{"random": 3}'], r"unrecognized arguments: --agent-params",
-        id="bench-agent-params-unknown-option"),
+    bad(
+        [*BENCH, "--agent-params", '{"random": 3}'],
+        r"unrecognized arguments: --agent-params",
+        id="bench-agent-params-unknown-option",
+    ),
     # -- evaluate
     ok(EVALUATE, "ev/results.md", "ev/results.csv", "ev/coverage_vs_steps.png", id="evaluate"),
     bad([*EVALUATE, "--episodes", "0"], r"argument --episodes: .*'0'", id="evaluate-episodes-0"),
     bad([*EVALUATE, "--workers", "0"], r"argument --workers: .*'0'", id="evaluate-workers-0"),
     bad([*EVALUATE, "--seed", "-1"], r"argument --seed: .*'-1'", id="evaluate-seed-negative"),
-    bad([*EVALUATE, "--gif-episodes", "-1"], r"argument --gif-episodes: .*'-1'",
-        id="evaluate-gif-episodes-negative"),
-    bad([*EVALUATE, "--agents", "random,nope"], r"--agents: unknown agent\(s\) \['nope'\]",
-        id="evaluate-agent-unknown"),
+    bad(
+        [*EVALUATE, "--gif-episodes", "-1"],
+        r"argument --gif-episodes: .*'-1'",
+        id="evaluate-gif-episodes-negative",
+    ),
+    bad(
+        [*EVALUATE, "--agents", "random,nope"],
+        r"--agents: unknown agent\(s\) \['nope'\]",
+        id="evaluate-agent-unknown",
+    ),
     bad([*EVALUATE, "--agents", ","], r"--agents: give at least one", id="evaluate-agents-none"),
-    bad([*EVALUATE, "--env", "Nope-v0"], r"--env Nope-v0: .*doesn't exist",
-        id="evaluate-env-unknown"),
-    bad([*EVALUATE, "--env-kwargs", "{bad"], r"--env-kwargs: not valid JSON",
-        id="evaluate-env-kwargs-bad-json"),
-    bad([*EVALUATE, "--env-kwargs", "[1]"], r"--env-kwargs: expected a JSON object",
-        id="evaluate-env-kwargs-not-object"),
-    bad([*EVALUATE, "--env-kwargs", '{"nope": 1}'], r"--env-kwargs: .*'nope'",
-        id="evaluate-env-kwargs-unknown-key"),
-    bad([*EVALUATE, "--env-kwargs", '{"max_steps": -1}'], r"--env-kwargs: max_steps",
-        id="evaluate-env-kwargs-bad-value"),
-    bad([*EVALUATE, "--agent-params", "{bad"], r"--agent-params: not valid JSON",
-        id="evaluate-agent-params-bad-json"),
-    bad([*EVALUATE, "--agent-params", '{"random": 3}'], r"--agent-params: 'random': expected",
-        id="evaluate-agent-params-not-object"),
-    bad([*EVALUATE, "--agent-params", '{"random": {"nope": 1}}'], r"--agent-params: .*'nope'",
-        id="evaluate-agent-params-unknown-parameter"),
-    bad([*EVALUATE, "--agent-params", '{"nope": {}}'], r"--agent-params: unknown agent 'nope'",
-        id="evaluate-agent-params-unknown-agent"),
-    bad([*EVALUATE, "--floorplans", "{tmp}/missing"], r"--floorplans .*missing: no \.json",
-        id="evaluate-floorplans-missing"),
-    bad([*EVALUATE, "--floorplans", "{tmp}/badplans"], r"plan\.json: .*at least 3",
-        id="evaluate-floorplans-malformed"),
-    bad([*EVALUATE, "--out", "{tmp}/afile"], r"argument --out: .*afile",
-        id="evaluate-out-is-a-file"),
+    bad(
+        [*EVALUATE, "--env", "Nope-v0"],
+        r"--env Nope-v0: .*doesn't exist",
+        id="evaluate-env-unknown",
+    ),
+    bad(
+        [*EVALUATE, "--env-kwargs", "{bad"],
+        r"--env-kwargs: not valid JSON",
+        id="evaluate-env-kwargs-bad-json",
+    ),
+    bad(
+        [*EVALUATE, "--env-kwargs", "[1]"],
+        r"--env-kwargs: expected a JSON object",
+        id="evaluate-env-kwargs-not-object",
+    ),
+    bad(
+        [*EVALUATE, "--env-kwargs", '{"nope": 1}'],
+        r"--env-kwargs: .*'nope'",
+        id="evaluate-env-kwargs-unknown-key",
+    ),
+    bad(
+        [*EVALUATE, "--env-kwargs", '{"max_steps": -1}'],
+        r"--env-kwargs: max_steps",
+        id="evaluate-env-kwargs-bad-value",
+    ),
+    bad(
+        [*EVALUATE, "--agent-params", "{bad"],
+        r"--agent-params: not valid JSON",
+        id="evaluate-agent-params-bad-json",
+    ),
+    bad(
+        [*EVALUATE, "--agent-params", '{"random": 3}'],
+        r"--agent-params: 'random': expected",
+        id="evaluate-agent-params-not-object",
+    ),
+    bad(
+        [*EVALUATE, "--agent-params", '{"random": {"nope": 1}}'],
+        r"--agent-params: .*'nope'",
+        id="evaluate-agent-params-unknown-parameter",
+    ),
+    bad(
+        [*EVALUATE, "--agent-params", '{"nope": {}}'],
+        r"--agent-params: unknown agent 'nope'",
+        id="evaluate-agent-params-unknown-agent",
+    ),
+    bad(
+        [*EVALUATE, "--floorplans", "{tmp}/missing"],
+        r"--floorplans .*missing: no \.json",
+        id="evaluate-floorplans-missing",
+    ),
+    bad(
+        [*EVALUATE, "--floorplans", "{tmp}/badplans"],
+        r"plan\.json: .*at least 3",
+        id="evaluate-floorplans-malformed",
+    ),
+    bad(
+        [*EVALUATE, "--out", "{tmp}/afile"], r"argument --out: .*afile", id="evaluate-out-is-a-file"
+    ),
     # -- train
     ok(TRAIN, "run/model.zip", "run/config.yml", id="train"),
     bad([*TRAIN, "--timesteps", "0"], r"argument --timesteps: .*'0'", id="train-timesteps-0"),
     bad([*TRAIN, "--n-envs", "0"], r"argument --n-envs: .*'0'", id="train-n-envs-0"),
     bad([*TRAIN, "--n-envs", "-1"], r"argument --n-envs: .*'-1'", id="train-n-envs-negative"),
     bad([*TRAIN, "--seed", "-1"], r"argument --seed: .*'-1'", id="train-seed-negative"),
-    bad([*TRAIN, "--checkpoint-every", "0"], r"argument --checkpoint-every: .*'0'",
-        id="train-checkpoint-every-0"),
+    bad(
+        [*TRAIN, "--checkpoint-every", "0"],
+        r"argument --checkpoint-every: .*'0'",
+        id="train-checkpoint-every-0",
+    ),
     bad([*TRAIN, "--eval-every", "0"], r"argument --eval-every: .*'0'", id="train-eval-every-0"),
-    bad([*TRAIN, "--eval-episodes", "0"], r"argument --eval-episodes: .*'0'",
-        id="train-eval-episodes-0"),
+    bad(
+        [*TRAIN, "--eval-episodes", "0"],
+        r"argument --eval-episodes: .*'0'",
+        id="train-eval-episodes-0",
+    ),
     bad([*TRAIN, "--env", "Nope-v0"], r"--env Nope-v0: .*doesn't exist", id="train-env-unknown"),
-    bad([*TRAIN, "--env", "CartPole-v1"], r"no hyperparameters for 'CartPole-v1'",
-        id="train-env-without-hyperparams"),
-    bad([*TRAIN, "--hyperparams", "{tmp}/missing.yml"], r"missing\.yml: cannot read",
-        id="train-hyperparams-missing"),
-    bad([*TRAIN, "--hyperparams", "{tmp}/bad.yml"], r"bad\.yml: cannot read",
-        id="train-hyperparams-malformed"),
+    bad(
+        [*TRAIN, "--env", "CartPole-v1"],
+        r"no hyperparameters for 'CartPole-v1'",
+        id="train-env-without-hyperparams",
+    ),
+    bad(
+        [*TRAIN, "--hyperparams", "{tmp}/missing.yml"],
+        r"missing\.yml: cannot read",
+        id="train-hyperparams-missing",
+    ),
+    bad(
+        [*TRAIN, "--hyperparams", "{tmp}/bad.yml"],
+        r"bad\.yml: cannot read",
+        id="train-hyperparams-malformed",
+    ),
     bad([*TRAIN, "--out", "{tmp}/afile"], r"argument --out: .*afile", id="train-out-is-a-file"),
     bad(["train", "a2c"], r"argument algo: invalid choice: 'a2c'", id="train-algo-unknown"),
     # -- demo (its good run: tests/cli/test_demo.py)
@@ -168,7 +253,7 @@ CASES = [
     bad([*DEMO, "--out", "{tmp}/afile"], r"argument --out: .*afile", id="demo-out-is-a-file"),
     # -- no command
     bad(["nope"], r"argument command: invalid choice: 'nope'", id="command-unknown"),
-]  # fmt: skip
+]
 
 
 @pytest.fixture
@@ -212,8 +297,13 @@ def test_console_script_reports_bad_input_in_one_line(tmp_path):
     exe = shutil.which("sfw-gym", path=str(Path(sys.executable).parent)) or shutil.which("sfw-gym")
     if exe is None:
         pytest.fail("no sfw-gym executable: install the package (pip install -e .)")
-    proc = subprocess.run([exe, "map", "missing.csv", "--routers", "1,1"], cwd=tmp_path,
-                          capture_output=True, text=True, timeout=120)  # fmt: skip
+    proc = subprocess.run(
+        [exe, "map", "missing.csv", "--routers", "1,1"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert proc.returncode == 2, proc.stderr
     assert re.fullmatch(r"sfw-gym map: error: \S*missing\.csv: no such file\n", proc.stderr), (
         proc.stderr

@@ -30,8 +30,14 @@ def test_tiny_run_writes_table_curves_and_trajectories(tmp_path):
         pair = [r for r in recs if r["episode"] == i]
         assert {r["seed"] for r in pair} == {5 + i}
         assert len({r["floorplan"] for r in pair}) == 1
-    for name in ("results.csv", "results.md", "coverage_vs_steps.png", "iou_vs_path.png",
-                 "episodes.jsonl", "config.json"):  # fmt: skip
+    for name in (
+        "results.csv",
+        "results.md",
+        "coverage_vs_steps.png",
+        "iou_vs_path.png",
+        "episodes.jsonl",
+        "config.json",
+    ):
         assert (tmp_path / name).stat().st_size > 0, name
     assert len(list((tmp_path / "trajectories").glob("*.png"))) == 2
     assert len(list((tmp_path / "episodes").glob("*.npz"))) == 4
@@ -42,12 +48,24 @@ def test_tiny_run_writes_table_curves_and_trajectories(tmp_path):
     md = (tmp_path / "results.md").read_text()
     assert "| frontier | 2 |" in md and "±" in md
     rec = recs[0]
-    for key in ("coverage", "map_iou", "k_accuracy", "path_length_m", "collisions",
-                "steps_to_coverage_50", "steps_to_coverage_90", "zone_band_unknown",
-                "stop_reason", "curve"):  # fmt: skip
+    for key in (
+        "coverage",
+        "map_iou",
+        "k_accuracy",
+        "path_length_m",
+        "collisions",
+        "steps_to_coverage_50",
+        "steps_to_coverage_90",
+        "zone_band_unknown",
+        "stop_reason",
+        "curve",
+    ):
         assert key in rec, key
-    assert rec["steps"] == 40 and rec["stop_reason"] in ("max_steps", "no_frontiers",
-                                                         "all_blacklisted")  # fmt: skip
+    assert rec["steps"] == 40 and rec["stop_reason"] in (
+        "max_steps",
+        "no_frontiers",
+        "all_blacklisted",
+    )
 
 
 def test_interrupted_run_resumes_without_redoing_episodes(tmp_path, monkeypatch):
@@ -88,8 +106,9 @@ def test_parallel_workers_match_the_serial_run(tmp_path):
     serial = ev.evaluate(["random"], 2, seed=1, out=tmp_path / "a", **TINY)
     parallel = ev.evaluate(["random"], 2, seed=1, out=tmp_path / "b", **{**TINY, "workers": 2})
     key = lambda r: r["episode"]  # noqa: E731
-    for a, b in zip(sorted(serial["records"], key=key), sorted(parallel["records"], key=key),
-                    strict=True):  # fmt: skip
+    for a, b in zip(
+        sorted(serial["records"], key=key), sorted(parallel["records"], key=key), strict=True
+    ):
         assert a["coverage"] == b["coverage"] and a["curve"] == b["curve"]
 
 
@@ -99,8 +118,9 @@ def test_floorplan_folder_cycles_and_gif(tmp_path):
     plans = tmp_path / "plans"
     for s in (1, 2):
         generate_floorplan(s, area_m2=45.0).save(plans / f"plan{s}.json")
-    result = ev.evaluate(["random"], 3, seed=0, out=tmp_path / "out", floorplans=plans,
-                         gif_episodes=1, **TINY)  # fmt: skip
+    result = ev.evaluate(
+        ["random"], 3, seed=0, out=tmp_path / "out", floorplans=plans, gif_episodes=1, **TINY
+    )
     files = [r["floorplan_file"] for r in sorted(result["records"], key=lambda r: r["episode"])]
     assert [f.rsplit("/", 1)[-1] for f in files] == ["plan1.json", "plan2.json", "plan1.json"]
     gif = tmp_path / "out" / "gifs" / "random_0000.gif"
@@ -118,8 +138,13 @@ def test_bad_arguments_are_clear_errors(tmp_path):
     with pytest.raises(ConfigError, match=r"no \.json"):
         ev.evaluate(["frontier"], 1, out=tmp_path, floorplans=tmp_path, **TINY)
     with pytest.raises(ConfigError, match="potential_scale"):
-        ev.evaluate(["frontier"], 1, out=tmp_path,
-                    agent_params={"frontier": {"potential_scale": -1}}, **TINY)  # fmt: skip
+        ev.evaluate(
+            ["frontier"],
+            1,
+            out=tmp_path,
+            agent_params={"frontier": {"potential_scale": -1}},
+            **TINY,
+        )
 
 
 def test_cli_evaluate(tmp_path, capsys):
@@ -129,8 +154,9 @@ def test_cli_evaluate(tmp_path, capsys):
     assert "| random | 1 |" in capsys.readouterr().out
     assert main(["evaluate", "--agents", "bogus", "--out", str(tmp_path)]) == 2
     assert "unknown agent" in capsys.readouterr().err
-    assert main(["evaluate", "--agents", "random", "--env-kwargs", "[1]", "--out",
-                 str(tmp_path)]) == 2  # fmt: skip
+    assert (
+        main(["evaluate", "--agents", "random", "--env-kwargs", "[1]", "--out", str(tmp_path)]) == 2
+    )
 
 
 def test_mean_ci95_and_summary():

@@ -168,9 +168,16 @@ def test_cells_to_world_gives_cell_centres():
 
 @pytest.mark.parametrize(
     ("a", "expected"),
-    [(0.0, 0.0), (math.pi, -math.pi), (-math.pi, -math.pi), (1.5 * math.pi, -0.5 * math.pi),
-     (-1.5 * math.pi, 0.5 * math.pi), (2 * math.pi + 0.1, 0.1), (3.0, 3.0)],
-)  # fmt: skip
+    [
+        (0.0, 0.0),
+        (math.pi, -math.pi),
+        (-math.pi, -math.pi),
+        (1.5 * math.pi, -0.5 * math.pi),
+        (-1.5 * math.pi, 0.5 * math.pi),
+        (2 * math.pi + 0.1, 0.1),
+        (3.0, 3.0),
+    ],
+)
 def test_wrap_angle_to_minus_pi_pi(a, expected):
     assert wrap_angle(a) == pytest.approx(expected)
 
@@ -251,9 +258,18 @@ def test_pure_pursuit_stops_within_the_goal_tolerance_and_drops_the_path():
 
 @pytest.mark.parametrize(
     ("linear", "angular", "action"),
-    [(1.0, 0.0, 0), (1.0, 0.35, 0), (1.0, -0.35, 0), (1.0, 0.36, 1), (1.0, -0.36, 2),
-     (0.0, 0.1, 1), (0.0, 0.0, 2), (-0.5, -0.1, 2), (0.01, 0.0, 0)],
-)  # fmt: skip
+    [
+        (1.0, 0.0, 0),
+        (1.0, 0.35, 0),
+        (1.0, -0.35, 0),
+        (1.0, 0.36, 1),
+        (1.0, -0.36, 2),
+        (0.0, 0.1, 1),
+        (0.0, 0.0, 2),
+        (-0.5, -0.1, 2),
+        (0.01, 0.0, 0),
+    ],
+)
 def test_to_discrete_forward_inside_the_deadband_else_turn(linear, angular, action):
     assert to_discrete(linear, angular) == action
 

@@ -33,8 +33,15 @@ def waypoint_model(tmp_path_factory):
     }
     hyper.write_text(yaml.safe_dump({SMALL: block}))
     out = root / "run"
-    train_ppo(SMALL, 64, out, hyperparams_path=hyper, env_kwargs={"max_steps": 120},
-              eval_every=10**9, progress_bar=False)  # fmt: skip
+    train_ppo(
+        SMALL,
+        64,
+        out,
+        hyperparams_path=hyper,
+        env_kwargs={"max_steps": 120},
+        eval_every=10**9,
+        progress_bar=False,
+    )
     return out
 
 
@@ -82,8 +89,9 @@ def test_sampled_waypoints_are_reproducible_from_the_agent_seed(waypoint_model):
 def continuous_model(tmp_path_factory):
     """A tiny policy on the env's own continuous actions."""
     out = tmp_path_factory.mktemp("ppo_continuous")
-    train_ppo(SMALL, 32, out, n_envs=1, env_kwargs={"max_steps": 40}, eval_every=10**9,
-              progress_bar=False)  # fmt: skip
+    train_ppo(
+        SMALL, 32, out, n_envs=1, env_kwargs={"max_steps": 40}, eval_every=10**9, progress_bar=False
+    )
     return out
 
 

@@ -62,9 +62,16 @@ def test_killed_run_resumes_from_its_last_checkpoint(tmp_path):
     path, steps = latest_checkpoint(out)
     target = steps + 128
     summary = train_ppo(
-        "SfW-ExploreSmall-v0", target, out, n_envs=1, env_kwargs=TINY, checkpoint_every=64,
-        eval_every=10**9, resume=True, progress_bar=False,
-    )  # fmt: skip
+        "SfW-ExploreSmall-v0",
+        target,
+        out,
+        n_envs=1,
+        env_kwargs=TINY,
+        checkpoint_every=64,
+        eval_every=10**9,
+        resume=True,
+        progress_bar=False,
+    )
     assert summary["resumed_from"] == str(path)
     assert target <= summary["steps"] < target + 128  # continued, not restarted from 0
     assert latest_checkpoint(out)[1] == summary["steps"]

@@ -166,8 +166,12 @@ def test_a_reading_at_the_sensitivity_is_heard(open_hall):
     p = np.array([15.0, 5.0])
     mean = probe.mean_rssi(p)[0, 0]
     # shift the transmit power so that the mean at p is -90.2 dBm: the reading rounds to -90
-    cfg = RadioConfig(tx_power_dbm=base.tx_power_dbm - (mean + 90.2), shadowing_sigma_db=0.0,
-                      noise_sigma_db=0.0, sensitivity_dbm=-90.0)  # fmt: skip
+    cfg = RadioConfig(
+        tx_power_dbm=base.tx_power_dbm - (mean + 90.2),
+        shadowing_sigma_db=0.0,
+        noise_sigma_db=0.0,
+        sensitivity_dbm=-90.0,
+    )
     model = RadioModel(open_hall, [[1.0, 5.0]], cfg, np.random.default_rng(0))
     assert model.measure(p).tolist() == [-90]
 
@@ -214,9 +218,15 @@ def test_router_outside_message(two_rooms):
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"frequency_ghz": 0.0}, r"^RadioConfig\.frequency_ghz must be a finite number > 0, got 0\.0$"),
+        (
+            {"frequency_ghz": 0.0},
+            r"^RadioConfig\.frequency_ghz must be a finite number > 0, got 0\.0$",
+        ),
         ({"frequency_ghz": True}, r"^RadioConfig\.frequency_ghz must be a finite number"),
-        ({"path_loss_d0_db": math.inf}, r"^RadioConfig\.path_loss_d0_db must be None or a finite number, got inf"),
+        (
+            {"path_loss_d0_db": math.inf},
+            r"^RadioConfig\.path_loss_d0_db must be None or a finite number, got inf",
+        ),
         ({"wall_loss_db": [10.0]}, r"^RadioConfig\.wall_loss_db must map material names to"),
         ({"wall_loss_db": "generic"}, r"^RadioConfig\.wall_loss_db must map material names to"),
     ],
@@ -231,7 +241,9 @@ def test_wall_losses_need_every_material_once_and_non_negative_numbers():
     with pytest.raises(ConfigError, match=r"missing \[\], unknown \['steel'\]"):
         RadioConfig(wall_loss_db=losses | {"steel": 20.0})
     for bad in (-1.0, math.nan, "10"):
-        with pytest.raises(ConfigError, match=r"^RadioConfig\.wall_loss_db\['glass'\] must be a finite number >= 0"):
+        with pytest.raises(
+            ConfigError, match=r"^RadioConfig\.wall_loss_db\['glass'\] must be a finite number >= 0"
+        ):
             RadioConfig(wall_loss_db=losses | {"glass": bad})
     ok = RadioConfig(wall_loss_db=losses | {"glass": 0, "wood": 0.5})  # zero and small are fine
     assert ok.wall_loss_db["glass"] == 0.0 and ok.wall_loss_db["wood"] == 0.5
@@ -257,7 +269,9 @@ def test_presets_defaults_overrides_and_messages():
         RadioConfig.preset(band="6")
     with pytest.raises(ConfigError, match=r"^radio: unknown key 'colour'; valid keys"):
         RadioConfig.preset(colour="red")
-    with pytest.raises(ConfigError, match=r"unknown key 'noise_sigma'; did you mean 'noise_sigma_db'"):
+    with pytest.raises(
+        ConfigError, match=r"unknown key 'noise_sigma'; did you mean 'noise_sigma_db'"
+    ):
         RadioConfig.preset(noise_sigma=1.0)
 
 
