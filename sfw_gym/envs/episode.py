@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 
+from sfw_gym.core.constants import U8_FREE
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.mapping import GridSpec
 from sfw_gym.world import (
@@ -122,7 +123,7 @@ def _start_pose(
                 f"start_pose {pose[:2].tolist()} is not in the free space of {plan.name!r}"
             )
         return float(pose[0]), float(pose[1]), float(pose[2])
-    clearance = ndimage.distance_transform_edt(truth == 255) * resolution_m
+    clearance = ndimage.distance_transform_edt(truth == U8_FREE) * resolution_m
     rows, cols = np.nonzero(clearance >= radius_m + START_CLEARANCE_MARGIN_M + resolution_m)
     if len(rows) == 0:
         raise ConfigError(f"floorplan {plan.name!r} has no spot wide enough for the robot")

@@ -11,9 +11,9 @@ import math
 import numpy as np
 from gymnasium import spaces
 
+from sfw_gym.core.constants import U8_UNKNOWN
 from sfw_gym.mapping import GridSpec
 
-UNKNOWN_U8 = 127
 #: RSSI is normalised as (rssi − floor) / span into [0, 1].
 RSSI_FLOOR_DBM, RSSI_SPAN_DB = -100.0, 80.0
 #: Channels of the global "map" image.
@@ -68,7 +68,7 @@ class ObservationBuilder:
         for x, y in routers_xy:
             r, c = self.pixel_of(x, y)
             self._routers[max(r - 1, 0) : r + 2, max(c - 1, 0) : c + 2] = 255
-        self._padded = np.full((rows + crop_px, cols + crop_px), UNKNOWN_U8, np.uint8)
+        self._padded = np.full((rows + crop_px, cols + crop_px), U8_UNKNOWN, np.uint8)
         self._routers_xy = np.asarray(routers_xy, np.float64)
 
     def pixel_of(self, x: float, y: float) -> tuple[int, int]:
@@ -95,7 +95,7 @@ class ObservationBuilder:
         """The observation dict for the current belief and readings."""
         x, y, theta = odometry_pose
         belief = belief_u8.ravel().take(self._flat_index)
-        belief[self._pad] = UNKNOWN_U8
+        belief[self._pad] = U8_UNKNOWN
         robot = self._trajectory.copy()
         r, c = self.pixel_of(x, y)
         robot[max(r - 1, 0) : r + 2, max(c - 1, 0) : c + 2] = ROBOT_U8

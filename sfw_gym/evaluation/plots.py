@@ -113,27 +113,45 @@ def plot_trajectories(
         res, (ox, oy) = float(first["resolution"]), first["origin"]
         extent = (ox, ox + w * res, oy, oy + h * res)
         n = 1 + len(data)
-        fig, axes = plt.subplots(1, n, figsize=(3.2 * n * max(w / h, 0.5), 3.6), squeeze=False)
+        aspect = w / h
+        ncols = n if aspect <= 1.2 else math.ceil(n / 2)  # wide plans: two rows, README width
+        nrows = math.ceil(n / ncols)
+        panel_w = max(2.0, 2.6 * min(aspect, 1.6))  # inches: titles fit even on tall plans
+        panel_h = panel_w / max(aspect, 0.6) + 0.5
+        fig, axes = plt.subplots(
+            nrows,
+            ncols,
+            figsize=(panel_w * ncols, panel_h * nrows + 0.6),
+            squeeze=False,
+            layout="constrained",
+        )
+        axes = axes.reshape(1, -1)
+        for spare in axes[0, n:]:
+            spare.set_axis_off()
         ax = axes[0, 0]
         ax.imshow(first["truth"], cmap="gray", origin="lower", extent=extent, vmin=0, vmax=255)
         for name, d in data.items():
             t = d["trajectory"]
             ax.plot(t[:, 0], t[:, 1], color=colours[name], lw=0.7, label=name)
-        ax.scatter(*first["routers"].T, marker="^", color="red", s=30, zorder=5)
-        ax.set_title(f"episode {episode}: {recs[next(iter(data))]['floorplan']}", fontsize=8)
-        ax.legend(fontsize=6, loc="upper right")
-        for ax, (name, d) in zip(axes[0, 1:], data.items(), strict=True):
+        ax.scatter(*first["routers"].T, marker="^", color="red", s=30, zorder=5, label="router")
+        ax.set_title("true plan\nall paths", fontsize=8)
+        fig.legend(
+            *ax.get_legend_handles_labels(), loc="outside lower center", ncol=n + 1, fontsize=8
+        )
+        for ax, (name, d) in zip(axes[0, 1:n], data.items(), strict=True):
             ax.imshow(d["belief"], cmap="gray", origin="lower", extent=extent, vmin=0, vmax=255)
             t = d["trajectory"]
             ax.plot(t[:, 0], t[:, 1], color=colours[name], lw=0.5)
             r = recs[name]
-            ax.set_title(
-                f"{name}: cov {r.get('coverage', 0):.2f}, IoU {r.get('map_iou', 0):.2f}",
-                fontsize=8,
-            )
-        for ax in axes[0]:
+            scores = f"coverage {r.get('coverage', 0):.2f}, free-IoU {r.get('free_iou', 0):.2f}"
+            ax.set_title(f"{name}\n{scores}", fontsize=8)
+        for ax in axes[0, :n]:
             ax.set_xticks([])
             ax.set_yticks([])
+        fig.suptitle(
+            f"episode {episode}: {recs[next(iter(data))]['floorplan']} (final belief maps)",
+            fontsize=10,
+        )
         plan = recs[next(iter(data))]["floorplan"][:24].replace("/", "_")
         written.append(_save_figure(fig, out / "trajectories" / f"{episode:04d}_{plan}.png"))
     return written

@@ -16,6 +16,7 @@ from shapely.geometry import Polygon
 from shapely.validation import explain_validity
 
 from sfw_gym.core.atomic import write_text_atomic
+from sfw_gym.core.constants import U8_FREE, U8_UNKNOWN, U8_WALL
 from sfw_gym.core.errors import FloorplanError
 from sfw_gym.world.wall_crossing import DEFAULT_MIN_PIECE_M, cross_walls, cross_walls_parallel
 
@@ -178,9 +179,9 @@ class Floorplan:
         wall = inside & ~free
         free = free.reshape(rows, sub, cols, sub).any(axis=(1, 3))
         wall = wall.reshape(rows, sub, cols, sub).any(axis=(1, 3))
-        grid = np.full((rows, cols), 127, dtype=np.uint8)
-        grid[free] = 255
-        grid[wall] = 0
+        grid = np.full((rows, cols), U8_UNKNOWN, dtype=np.uint8)
+        grid[free] = U8_FREE
+        grid[wall] = U8_WALL
         return grid, (xmin, ymin)
 
     # ----------------------------------------------------------------------------------- files

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from sfw_gym.core.atomic import atomic_path
+from sfw_gym.core.constants import U8_FREE
 from sfw_gym.world.floorplan import Floorplan
 from sfw_gym.world.radio import RadioModel
 
@@ -30,7 +31,7 @@ def draw_world(
     ys, xs = np.mgrid[0:rows, 0:cols]
     centres = np.stack([x0 + (xs + 0.5) * resolution_m, y0 + (ys + 0.5) * resolution_m], -1)
     centres = centres.reshape(-1, 2)
-    free = grid.reshape(-1) == 255
+    free = grid.reshape(-1) == U8_FREE
     rssi = np.full((len(centres), radio.n_routers), np.nan)
     k = np.full((len(centres), radio.n_routers), np.nan)
     rssi[free] = radio.mean_rssi(centres[free])
