@@ -66,6 +66,10 @@ def k_from_thresholds(feature, thresholds, n_thr):
     return k
 
 
+#: Where the mapper's kernel finds the thresholds in :meth:`KEstimator._kernel_args`.
+KERNEL_ARG_THRESHOLDS, KERNEL_ARG_N_THR = 15, 16
+
+
 @njit(cache=True)
 def add_samples(
     rssi,
@@ -335,8 +339,9 @@ class KEstimator:
 
     # -- state shared with the mapper's compiled kernel ------------------------------------
     def _kernel_args(self) -> tuple[Any, ...]:
+        """The estimator's state, in the order :func:`add_samples` takes it."""
         cfg = self.config
-        return (
+        args = (
             cfg.k_estimator == "distance_aware",
             float(cfg.path_loss_exponent),
             float(cfg.min_distance_m),
@@ -360,6 +365,11 @@ class KEstimator:
             self._novel,
             max(2, cfg.refit_min_samples // 2),
         )
+        assert (
+            args[KERNEL_ARG_THRESHOLDS] is self._thresholds
+            and args[KERNEL_ARG_N_THR] is self._n_thr
+        )
+        return args
 
     def _check(self, name: str, values) -> np.ndarray:
         a = np.asarray(values, dtype=np.float64)

@@ -56,7 +56,13 @@ from sfw_gym.core.constants import U8_UNKNOWN
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.mapping.config import MapperConfig
 from sfw_gym.mapping.grid import CLASS_FREE, CLASS_UNKNOWN, GridSpec, u8_class
-from sfw_gym.mapping.k_estimation import KEstimator, add_samples, k_from_thresholds
+from sfw_gym.mapping.k_estimation import (
+    KERNEL_ARG_N_THR,
+    KERNEL_ARG_THRESHOLDS,
+    KEstimator,
+    add_samples,
+    k_from_thresholds,
+)
 from sfw_gym.mapping.raycast import ray_buffer_size, traverse_grid
 
 _LN2 = math.log(2.0)
@@ -365,30 +371,8 @@ def _update_kernel(
     for r in range(rssi.shape[0]):
         if not np.isfinite(rssi[r]):
             return np.nan, False
-    (
-        kest_da,
-        kest_n,
-        kest_dmin,
-        kest_gap,
-        kest_cal,
-        kest_reset,
-        ring,
-        ring_pos,
-        ring_count,
-        fit_buf,
-        fit_n,
-        fit_stride,
-        n_seen,
-        n_fit_seen,
-        next_refit,
-        thresholds,
-        n_thr,
-        fitted,
-        prior,
-        fit_range,
-        novel,
-        novel_needed,
-    ) = kest
+    thresholds = kest[KERNEL_ARG_THRESHOLDS]
+    n_thr = kest[KERNEL_ARG_N_THR]
     lo, _, u8, cls, classified, _, _ = maps
     touched, old_cls, changed, state = track
     rows, cols, t0, t1 = ray
@@ -403,34 +387,7 @@ def _update_kernel(
     state[_S_N_CHANGED] = 0.0
     for r in range(n_r):
         dist_buf[r] = res * np.sqrt((gx - routers_g[r, 0]) ** 2 + (gy - routers_g[r, 1]) ** 2)
-    due = add_samples(
-        rssi,
-        dist_buf,
-        kest_da,
-        kest_n,
-        kest_dmin,
-        kest_gap,
-        kest_cal,
-        kest_reset,
-        ring,
-        ring_pos,
-        ring_count,
-        fit_buf,
-        fit_n,
-        fit_stride,
-        n_seen,
-        n_fit_seen,
-        next_refit,
-        thresholds,
-        n_thr,
-        fitted,
-        prior,
-        fit_range,
-        novel,
-        novel_needed,
-        feature,
-        k_out,
-    )
+    due = add_samples(rssi, dist_buf, *kest, feature, k_out)
     gain = 0.0
     # Rule 1: footprint free; a bump marks the contact cell ahead occupied.
     rad = params[_P_RADIUS] / res
