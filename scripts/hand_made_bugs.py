@@ -71,8 +71,8 @@ CASES = [
     (
         "greedy.candidates",
         "sfw_gym/agents/greedy.py",
-        "score.tolist(), strict=True))",
-        "score[::-1].tolist(), strict=True))",
+        "zip(cells.tolist(), score.tolist(), strict=True)",
+        "zip(cells.tolist(), score[::-1].tolist(), strict=True)",
         "tests/agents/test_agent_behaviour.py tests/agents/test_agent_rules.py -k greedy",
     ),
     (
@@ -84,7 +84,7 @@ CASES = [
     ),
     (
         "driver.discrete-forward",
-        "sfw_gym/envs/waypoint.py",
+        "sfw_gym/navigation/waypoints.py",
         "bumped and self._drove_forward:",
         "bumped:",
         "tests/envs/test_rewards.py -k waypoint",

@@ -34,7 +34,7 @@ def checked(convert: Callable, ok: Callable, what: str) -> Callable:
 positive_int = checked(int, lambda v: v >= 1, "an integer >= 1")
 non_negative_int = checked(int, lambda v: v >= 0, "an integer >= 0")
 seed_int = checked(int, lambda v: 0 <= v < 2**32, "a seed in [0, 2**32)")
-positive_float = checked(float, lambda v: True, "a finite number > 0")
+positive_float = checked(float, lambda v: math.isfinite(v) and v > 0, "a finite number > 0")
 non_negative_float = checked(float, lambda v: math.isfinite(v) and v >= 0, "a finite number >= 0")
 folder = checked(str, lambda v: not Path(v).exists() or Path(v).is_dir(), "a folder, not a file")
 

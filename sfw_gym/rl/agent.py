@@ -157,7 +157,7 @@ class PPOAgent(Agent):
         if not self._obs_checked:
             self._check_obs(obs)
         if self.waypoints is None:
-            action, _ = self.model.predict(obs, deterministic=False)
+            action, _ = self.model.predict(obs, deterministic=self.deterministic)
             linear, angular = np.clip(np.asarray(action, np.float64).ravel()[:2], -1.0, 1.0)
             return float(linear), float(angular)
         command = self.driver.command(view.odometry_pose, view.bumped)
