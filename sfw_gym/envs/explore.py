@@ -11,6 +11,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from sfw_gym.core.buffers import AppendOnlyArray
 from sfw_gym.core.config import unknown_key_error
 from sfw_gym.core.constants import DISCRETE_ACTION_NAMES, DISCRETE_ACTIONS, NOT_HEARD_DBM
 from sfw_gym.core.errors import ConfigError
@@ -220,7 +221,9 @@ class SfWExploreEnv(gym.Env):
         self.k_correct = 0
         self.k_total = 0
         self.steps_to = {0.5: -1, 0.9: -1}
-        self.rssi_history: list[np.ndarray] = []
+        self.rssi_history = AppendOnlyArray(len(s.radio.routers), np.int32)
+        self._routers_view = np.array(s.radio.routers, np.float64)
+        self._routers_view.flags.writeable = False
         self.trajectory: list[tuple[float, float]] = []
         self.odometry_trajectory: list[tuple[float, float]] = []
         self.last_gain_bits = 0.0
@@ -338,19 +341,23 @@ class SfWExploreEnv(gym.Env):
 
     # ------------------------------------------------------------------------------ robot's view
     def robot_view(self) -> RobotView:
-        """What the robot knows (fresh arrays), for agents and planners: never the ground truth."""
+        """What the robot knows, for agents and planners: never the ground truth.
+
+        O(1): the arrays are read-only views of the env's own, valid until the next ``step`` or
+        ``reset`` (copy what you keep).
+        """
         s = self.scene
         if s is None:
             raise gym.error.ResetNeeded("call reset() before robot_view()")
         cfg = self.robot_config
         odom_x, odom_y, odom_theta = s.robot.odometry_pose
         return RobotView(
-            belief_u8=self.mapper.occupancy_u8.copy(),
-            probability=self.mapper.probability,
+            belief_u8=self.mapper.occupancy_u8,
+            log_odds=self.mapper.log_odds,
             grid=self.grid,
             odometry_pose=(float(odom_x), float(odom_y), float(odom_theta)),
-            routers_xy=np.array(s.radio.routers),
-            rssi_history=np.array(self.rssi_history),
+            routers_xy=self._routers_view,
+            rssi_history=self.rssi_history.view,
             bumped=bool(s.robot.bumped),
             radius_m=cfg.radius_m,
             max_linear_speed_m_s=cfg.max_linear_speed_m_s,

@@ -14,9 +14,12 @@ from sfw_gym.mapping.grid import GridSpec
 class RobotView:
     """What the robot knows at one step (``SfWExploreEnv.robot_view()``).
 
+    The arrays are read-only views of the env's state, valid until its next ``step`` or ``reset``:
+    a view costs O(1), whatever the map size or episode length. Copy what you keep.
+
     Attributes:
-        belief_u8: A copy of the belief map (0 wall, 255 free, 127 unknown), ``[row, col]``.
-        probability: P(occupied) per cell.
+        belief_u8: The belief map (0 wall, 255 free, 127 unknown), ``[row, col]``.
+        log_odds: Log-odds of "occupied" per cell (float32); :attr:`probability` from it.
         grid: The map's geometry.
         odometry_pose: ``(x, y, θ)`` from odometry (m, rad), not the true pose.
         routers_xy: ``(R, 2)`` router positions (the robot knows its routers).
@@ -28,7 +31,7 @@ class RobotView:
     """
 
     belief_u8: np.ndarray
-    probability: np.ndarray
+    log_odds: np.ndarray
     grid: GridSpec
     odometry_pose: tuple[float, float, float]
     routers_xy: np.ndarray
@@ -39,6 +42,11 @@ class RobotView:
     max_angular_speed_rad_s: float
     control_period_s: float
     action_type: str
+
+    @property
+    def probability(self) -> np.ndarray:
+        """P(occupied) per cell, float32 (computed on each access)."""
+        return (1.0 / (1.0 + np.exp(-self.log_odds.astype(np.float64)))).astype(np.float32)
 
     @property
     def xy(self) -> np.ndarray:

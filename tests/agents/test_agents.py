@@ -134,7 +134,7 @@ class FakeEnv:
     def robot_view(self) -> RobotView:
         return RobotView(
             belief_u8=self.belief.copy(),
-            probability=np.where(self.belief == W, 0.9, 0.5).astype(np.float32),
+            log_odds=np.where(self.belief == W, 2.2, 0.0).astype(np.float32),
             grid=self.grid,
             odometry_pose=tuple(self.pose),
             routers_xy=self.routers.copy(),

@@ -80,6 +80,25 @@ def test_robot_view_holds_no_ground_truth():
     assert view.rssi_history.shape == (31, 2)
 
 
+def test_robot_view_is_read_only_views_not_copies():
+    """robot_view() costs O(1): it shares the env's arrays (read-only), whatever the episode length."""
+    env = gym.make("SfW-ExploreSmall-v0", max_steps=1100)
+    env.reset(seed=0)
+    drive(env, 1050)  # past the history buffer's first growth (1,024 rows)
+    assert env.unwrapped.steps > 1024
+    u = env.unwrapped
+    view = u.robot_view()
+    assert np.shares_memory(view.belief_u8, u.mapper.occupancy_u8)
+    assert np.shares_memory(view.log_odds, u.mapper.log_odds)
+    for array in (view.belief_u8, view.log_odds, view.rssi_history, view.routers_xy):
+        assert not array.flags.writeable
+    assert view.rssi_history.shape == (u.steps + 1, u.n_routers)
+    assert view.probability == pytest.approx(u.mapper.probability)
+    kept = view.rssi_history.copy()
+    drive(env, 5)
+    assert np.array_equal(view.rssi_history, kept)  # appends never write into an earlier view
+
+
 def test_discrete_actions_move_or_turn():
     env = gym.make("SfW-ExploreDiscrete-v0")
     env.reset(seed=3, options={"floorplan": 3})
