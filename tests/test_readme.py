@@ -32,5 +32,5 @@ def test_readme_imports_resolve(index):
 def test_readme_quick_start_runs():
     """The first block (make, reset, step, the info keys, robot_view) runs as written."""
     namespace: dict = {}
-    exec(compile(BLOCKS[0], "README.md", "exec"), namespace)  # noqa: S102
+    exec(compile(BLOCKS[0], "README.md", "exec"), namespace)
     assert namespace["info"]["coverage"] >= 0.0

@@ -81,7 +81,7 @@ def test_robot_view_holds_no_ground_truth():
 
 
 def test_robot_view_is_read_only_views_not_copies():
-    """robot_view() costs O(1): it shares the env's arrays (read-only), whatever the episode length."""
+    """robot_view() is O(1): read-only views of the env's arrays, whatever the episode length."""
     env = gym.make("SfW-ExploreSmall-v0", max_steps=1100)
     env.reset(seed=0)
     drive(env, 1050)  # past the history buffer's first growth (1,024 rows)
