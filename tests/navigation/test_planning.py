@@ -382,3 +382,31 @@ def test_a_bearing_equal_to_the_turn_threshold_still_drives():
     pp.set_path(np.array([[0.0, 0.0], [2.0, 0.0]]))
     linear, angular = pp.command((0.0, 0.0, -1.0))  # bearing to the carrot: +1 rad
     assert linear == pytest.approx(math.cos(1.0)) and angular == 1.0
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_cost_field_matches_scikit_image_mcp_and_its_paths_add_up(seed):
+    """The compiled Dijkstra gives MCP_Geometric's costs; each traced path costs exactly that."""
+    from skimage.graph import MCP_Geometric
+
+    rng = np.random.default_rng(seed)
+    shape = (30 + 7 * seed, 45)
+    cost = np.where(rng.random(shape) < 0.25, np.inf, 1.0 + 3.0 * rng.random(shape))
+    start = (shape[0] // 2, shape[1] // 3)
+    cost[start] = 1.0
+    field = cost_field(cost, start, resolution_m=0.1)
+    reference, _ = MCP_Geometric(cost, fully_connected=True).find_costs([start])
+    reachable = np.isfinite(reference)
+    assert np.array_equal(field.reachable(), reachable)
+    assert field.cumulative[reachable] == pytest.approx(0.1 * reference[reachable], rel=1e-12)
+    goals = np.argwhere(reachable)[rng.choice(reachable.sum(), 20)]
+    for goal in map(tuple, goals):
+        path = field.path(goal)
+        assert tuple(path[0]) == start and tuple(path[-1]) == goal
+        steps = np.diff(path, axis=0)
+        assert np.abs(steps).max(initial=0) <= 1 and (np.abs(steps).sum(axis=1) > 0).all()
+        length = np.where(np.abs(steps).sum(axis=1) == 2, np.sqrt(2.0), 1.0)
+        mean_cost = 0.5 * (cost[tuple(path[:-1].T)] + cost[tuple(path[1:].T)])
+        assert 0.1 * float((length * mean_cost).sum()) == pytest.approx(field.cumulative[goal])
+    blocked = tuple(np.argwhere(~reachable)[0])
+    assert len(field.path(blocked)) == 0
