@@ -1,4 +1,7 @@
-"""``sfw-gym bench``: env steps/s and reset time beside CartPole-v1 (and MiniGrid), same run."""
+"""``sfw-gym bench``: env steps/s and reset time beside CartPole-v1 (and MiniGrid), same run;
+with ``--agents``, agent episode times beside random actions on the same plans and seeds, the
+cost of :func:`~sfw_gym.navigation.candidates.candidate_goals`, and how an agent episode's time
+grows with its length."""
 
 from __future__ import annotations
 
@@ -8,6 +11,7 @@ import resource
 import statistics
 import time
 from dataclasses import dataclass
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -106,11 +110,176 @@ def run_bench(env_id: str, steps: int, resets: int, memory_steps: int = 0) -> li
     return lines
 
 
-def main_bench(env_id: str, steps: int, resets: int, memory_steps: int) -> int:
+def time_agent_episode(agent: str, env_id: str, seed: int, **env_kwargs) -> tuple[float, int]:
+    """Seconds and steps of one episode of ``agent`` (``"random"``: sampled actions) on
+    ``env_id`` reset with ``seed``; env construction and reset are not timed."""
+    from sfw_gym.agents import make_agent
+
+    env = gym.make(env_id, **env_kwargs)
+    obs, _ = env.reset(seed=seed)
+    start = time.perf_counter()
+    if agent == "random":
+        env.action_space.seed(seed)
+        act = lambda _obs: env.action_space.sample()  # noqa: E731
+    else:
+        a = make_agent(agent)
+        a.reset(env, seed=seed)
+        act = a.act
+    steps, done = 0, False
+    while not done:
+        obs, _, terminated, truncated, _ = env.step(act(obs))
+        steps += 1
+        done = terminated or truncated
+    seconds = time.perf_counter() - start
+    env.close()
+    return seconds, steps
+
+
+def run_agent_bench(agents: list[str], env_ids: list[str], seeds: list[int]) -> list[str]:
+    """Agent episodes beside random-action episodes, interleaved on the same plans and seeds."""
+    for agent in ["random", *agents]:  # warm-up: compiled kernels, the PPO model's first load
+        time_agent_episode(agent, "SfW-ExploreSmall-v0", 0)
+    lines = [
+        f"{'env':<22} {'agent':<11} {'episode s':>10} {'steps':>7} {'ms/step':>8} "
+        f"{'× random':>9} {'95% CI':>14}"
+    ]
+    for env_id in env_ids:
+        times: dict[str, list[float]] = {a: [] for a in ["random", *agents]}
+        steps: dict[str, list[int]] = {a: [] for a in times}
+        for seed in seeds:
+            for agent in times:
+                t, n = time_agent_episode(agent, env_id, seed)
+                times[agent].append(t)
+                steps[agent].append(n)
+        base = np.array(times["random"])
+        for agent, ts in times.items():
+            ratio = np.array(ts) / base
+            half = 1.96 * ratio.std(ddof=1) / np.sqrt(len(ratio)) if len(ratio) > 1 else 0.0
+            per_step = 1e3 * sum(ts) / sum(steps[agent])
+            lines.append(
+                f"{env_id:<22} {agent:<11} {np.mean(ts):>10.2f} {np.mean(steps[agent]):>7.0f} "
+                f"{per_step:>8.3f} {ratio.mean():>8.2f}x {ratio.mean() - half:>6.2f}–"
+                f"{ratio.mean() + half:.2f}"
+            )
+    lines.append(
+        f"(× random: an agent's episode time ÷ the random-action episode's on the same seed, "
+        f"mean over seeds {seeds[0]}–{seeds[-1]}; env construction and reset not timed)"
+    )
+    return lines
+
+
+def synthetic_view(size: int, seed: int = 0):
+    """A half-explored ``size``×``size`` belief of a generated plan: the truth within 45 % of
+    the map's width of the plan's centre, unknown beyond (for timing map analysis)."""
+    from sfw_gym.core.constants import U8_FREE, U8_UNKNOWN
+    from sfw_gym.mapping.grid import GridSpec
+    from sfw_gym.navigation.view import RobotView
+    from sfw_gym.world import generate_floorplan
+
+    plan = generate_floorplan(seed)
+    xmin, ymin, xmax, ymax = plan.footprint.bounds
+    truth, origin = plan.rasterize(max(xmax - xmin, ymax - ymin) / size)
+    res = max(xmax - xmin, ymax - ymin) / size
+    belief = np.full((size, size), U8_UNKNOWN, np.uint8)
+    h, w = min(size, truth.shape[0]), min(size, truth.shape[1])
+    belief[:h, :w] = truth[:h, :w]
+    rows, cols = np.mgrid[0:size, 0:size]
+    free = np.argwhere(belief == U8_FREE)
+    centre = free[len(free) // 2]
+    belief[np.hypot(rows - centre[0], cols - centre[1]) > 0.45 * size] = U8_UNKNOWN
+    grid = GridSpec(origin, res, (size, size))
+    xy = grid.cell_to_world(centre)
+    log_odds = np.where(belief == U8_UNKNOWN, 0.0, np.where(belief == U8_FREE, -3.0, 3.0))
+    return RobotView(
+        belief_u8=belief,
+        log_odds=log_odds.astype(np.float32),
+        grid=grid,
+        odometry_pose=(float(xy[0]), float(xy[1]), 0.0),
+        routers_xy=np.array([xy, xy + 1.0]),
+        rssi_history=np.full((1, 2), -50, np.int32),
+        odometry_trajectory=np.array([xy]),
+        bumped=False,
+        radius_m=0.17,
+        max_linear_speed_m_s=0.5,
+        max_angular_speed_rad_s=1.5,
+        control_period_s=0.2,
+        action_type="continuous",
+    )
+
+
+def run_candidate_bench(sizes: tuple[int, ...] = (64, 256), calls: int = 30) -> list[str]:
+    """Median and p95 of one candidate-goal menu (K = 32, its shortest-path field included):
+    ``candidate_goals(view)`` from scratch, and a :class:`GoalFinder` kept across calls as the
+    agents keep it (the router model and the distance to walls cached)."""
+    from sfw_gym.navigation.candidates import GoalFinder, candidate_goals
+    from sfw_gym.navigation.planning import cost_field
+
+    def kept(finder: GoalFinder, view: Any) -> Any:
+        paths = cost_field(finder.costs(view), view.cell, view.grid.resolution_m)
+        return finder.find(view, paths, max_candidates=32)
+
+    lines = [f"{'belief grid':<12} {'call':<22} {'candidates':>10} {'median ms':>10} {'p95 ms':>8}"]
+    for size in sizes:
+        view = synthetic_view(size)
+        finder = GoalFinder()
+        finder.reset(view)
+        for label, call in (
+            ("candidate_goals(view)", lambda v: candidate_goals(v, max_candidates=32)),
+            ("GoalFinder, kept", lambda v, f=finder: kept(f, v)),
+        ):
+            menu = call(view)  # warm-up (compilation, caches)
+            ms = []
+            for _ in range(calls):
+                start = time.perf_counter()
+                call(view)
+                ms.append(1e3 * (time.perf_counter() - start))
+            lines.append(
+                f"{f'{size}×{size}':<12} {label:<22} {len(menu):>10} {np.median(ms):>10.2f} "
+                f"{np.percentile(ms, 95):>8.2f}"
+            )
+    return lines
+
+
+def run_length_bench(agent: str, seed: int = 0, lengths: tuple[int, ...] = (3000, 30000)):
+    """``agent``'s time per step on ``SfW-ExploreFull-v0`` at episode lengths ``lengths`` (the
+    coverage target off, so each episode runs its whole budget)."""
+    lines = [f"{'steps':>7} {'episode s':>10} {'ms/step':>8}"]
+    for n in lengths:
+        t, steps = time_agent_episode(
+            agent,
+            "SfW-ExploreFull-v0",
+            seed,
+            max_steps=n,
+            steps_per_m2=1e5,
+            reward={"coverage_target": 1.0},
+        )
+        lines.append(f"{steps:>7} {t:>10.2f} {1e3 * t / steps:>8.3f}")
+    return lines
+
+
+def main_bench(
+    env_id: str,
+    steps: int,
+    resets: int,
+    memory_steps: int,
+    agents: list[str] | None = None,
+    episodes: int = 3,
+) -> int:
     """Entry of ``sfw-gym bench``."""
     import sfw_gym  # noqa: F401  (registration)
 
     np.set_printoptions(precision=3)
     for line in run_bench(env_id, steps, resets, memory_steps):
         print(line)
+    if agents:
+        seeds = list(range(2_000_000, 2_000_000 + episodes))
+        print()
+        for line in run_agent_bench(agents, [env_id, "SfW-ExploreFull-v0"], seeds):
+            print(line, flush=True)
+        print("\ncandidate_goals(view) per call, shortest-path field included:")
+        for line in run_candidate_bench():
+            print(line)
+        print(f"\n{agents[0]} on SfW-ExploreFull-v0, seed 0, by episode length:")
+        for line in run_length_bench(agents[0]):
+            print(line)
     return 0

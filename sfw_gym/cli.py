@@ -122,7 +122,10 @@ def _cmd_map(args: argparse.Namespace) -> int:
 def _cmd_bench(args: argparse.Namespace) -> int:
     from sfw_gym.bench import main_bench
 
-    return main_bench(args.env, args.steps, args.resets, args.memory_steps)
+    agents = [a for a in args.agents.split(",") if a] if args.agents else None
+    return main_bench(
+        args.env, args.steps, args.resets, args.memory_steps, agents, args.agent_episodes
+    )
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
@@ -297,6 +300,15 @@ def build_parser() -> argparse.ArgumentParser:
         type=non_negative_int,
         default=0,
         help="also report RSS before/after this many steps (e.g. 100000)",
+    )
+    bench.add_argument(
+        "--agents",
+        default="",
+        help="also time these agents' episodes beside random actions (e.g. frontier,ppo), "
+        "candidate_goals, and episode time by length",
+    )
+    bench.add_argument(
+        "--agent-episodes", type=positive_int, default=3, help="seeds per env for --agents"
     )
     bench.set_defaults(func=_cmd_bench)
 

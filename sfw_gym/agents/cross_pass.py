@@ -116,10 +116,10 @@ class CrossPassAgent(FrontierAgent):
                 return goal
         return super()._choose_goal(view, paths)
 
-    def _utility(self, view: RobotView, f: Any, path_m: float) -> float:
-        size = f.size
+    def _utility(self, view: RobotView, cluster: np.ndarray, path_m: float) -> float:
+        size = len(cluster)
         if self.band is not None and self.band_bonus > 0:
-            size += self.band_bonus * int(self.band[f.cells[:, 0], f.cells[:, 1]].sum())
+            size += self.band_bonus * int(self.band[cluster[:, 0], cluster[:, 1]].sum())
         res = view.grid.resolution_m
         return self.gain_scale * size * res - self.potential_scale * path_m
 

@@ -47,25 +47,15 @@ from scipy import ndimage
 
 from sfw_gym.agents.base import Agent, RobotView
 from sfw_gym.core.config import check
-from sfw_gym.navigation.frontiers import (
-    EIGHT_CONNECTED,
-    Frontier,
-    find_frontiers,
-    frontier_mask,
-    hidden_rooms,
-)
+from sfw_gym.core.constants import U8_WALL_MAX
+from sfw_gym.navigation.candidates import CandidateSettings, GoalFinder
 from sfw_gym.navigation.planning import (
     CostField,
     PurePursuit,
     belief_classes,
     cost_field,
-    disk_cells,
-    disk_offsets,
-    free_start,
-    mark_contact,
     mark_disk,
     simplify_path,
-    traversal_costs,
 )
 
 
@@ -101,6 +91,8 @@ class FrontierAgent(Agent):
             blacklisted.
         blacklist_radius_m: Frontier cells this close to a blacklisted goal are skipped.
         replan_every_steps: Re-pick the goal at least this often, as the map changes.
+        min_replan_steps: A resolved frontier target triggers a replan only this many steps
+            after the last one (other events replan at once).
         unknown_cost: Planner cost of an unknown cell (a free one costs 1).
         bump_exclusion_m: Frontier cells this close to a bump are not goals (walls).
         lookahead_m: Pure-pursuit carrot distance.
@@ -141,6 +133,7 @@ class FrontierAgent(Agent):
         progress_timeout_steps: int = 30,
         blacklist_radius_m: float = 0.3,
         replan_every_steps: int = 5,
+        min_replan_steps: int = 1,
         unknown_cost: float = 1.5,
         bump_exclusion_m: float = 0.3,
         lookahead_m: float = 0.4,
@@ -171,6 +164,7 @@ class FrontierAgent(Agent):
         self.replan_every_steps = check(
             "replan_every_steps", replan_every_steps, integer=True, ge=1
         )
+        self.min_replan_steps = check("min_replan_steps", min_replan_steps, integer=True, ge=1)
         self.backoff_steps = check("backoff_steps", backoff_steps, integer=True, ge=0)
         self.max_bumps_per_goal = check(
             "max_bumps_per_goal", max_bumps_per_goal, integer=True, ge=1
@@ -196,21 +190,17 @@ class FrontierAgent(Agent):
     # -- episode ---------------------------------------------------------------------------------
     def _on_reset(self, view: RobotView) -> None:
         res = view.grid.resolution_m
-        shape = view.grid.shape
-        self.visited = np.zeros(shape, bool)  # within the robot's radius of its path
-        # Step until which a cell is no goal: failed goals; walled-off frontier clusters.
-        self.blacklisted_until = np.zeros(shape, np.int64)
-        self.unreachable_until = np.zeros(shape, np.int64)
-        self.bumps = np.zeros(shape, bool)  # contact regions
+        self.visited = np.zeros(view.grid.shape, bool)  # within the robot's radius of its path
+        self.finder = GoalFinder(self._candidate_settings())
+        self.finder.reset(view)
         self._res = res
         self._visit_radius_cells = view.radius_m / res
-        # A goal cell resolves a target when the robot stops within the follower's tolerance of
-        # its centre and the target's centre is within the robot's radius of the robot's centre.
-        tolerance_m = 0.6 * res
-        self._reach_offsets = disk_offsets(max((view.radius_m - tolerance_m) / res, 0.5))
         self.goal: Goal | None = None
-        self.follower = PurePursuit(lookahead_m=self.lookahead_m, goal_tolerance_m=tolerance_m)
+        self.follower = PurePursuit(
+            lookahead_m=self.lookahead_m, goal_tolerance_m=self.finder.goal_tolerance_m
+        )
         self._since_plan = 0
+        self._path_cells: tuple[np.ndarray, np.ndarray] = (np.zeros(0, int), np.zeros(0, int))
         self._backoff = 0
         self._slides = 0
         self._last_xy = view.xy
@@ -218,9 +208,21 @@ class FrontierAgent(Agent):
         self.n_blacklisted = 0
         self.n_goals = 0
         self.n_bumps = 0
+        self.n_plans = 0
         self.candidates: list[tuple[tuple[int, int], float]] = []
 
+    def _candidate_settings(self) -> CandidateSettings:
+        return CandidateSettings(
+            unknown_cost=self.unknown_cost,
+            min_frontier_size_m=self.min_frontier_size_m,
+            bump_exclusion_m=self.bump_exclusion_m,
+            min_unknown_region_m2=self.min_unknown_region_m2,
+            turn_cost_m_per_rad=self.turn_cost_m_per_rad,
+            min_hidden_room_depth_m=self.min_hidden_room_depth_m,
+        )
+
     def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
+        self.finder.set_step(self.steps)
         mark_disk(self.visited, view.cell, self._visit_radius_cells)
         # A bump that stopped the robot driving forward: remember a wall ahead, back off
         # (continuous) and replan. Contact while turning or reversing, or while sliding along
@@ -294,12 +296,30 @@ class FrontierAgent(Agent):
             self.follower.set_path(np.zeros((0, 2)))
 
     def _needs_plan(self, view: RobotView, bumped: bool) -> bool:
+        """Replan on events: no goal or path, a bump, the path blocked by a new wall, the
+        frontier target resolved (at most every ``min_replan_steps``); else every
+        ``replan_every_steps`` as the map changes."""
         goal = self.goal
-        if goal is None or bumped or self._since_plan >= self.replan_every_steps:
+        if goal is None or bumped or not self.follower.has_path:
             return True
-        if not self.follower.has_path:
+        if self._since_plan >= self.replan_every_steps:
             return True
-        return goal.kind == "frontier" and not self._still_unknown(view, goal.target)
+        if self._path_blocked(view):
+            return True
+        return (
+            goal.kind == "frontier"
+            and self._since_plan >= self.min_replan_steps
+            and not self._still_unknown(view, goal.target)
+        )
+
+    def _path_blocked(self, view: RobotView) -> bool:
+        """Whether a cell of the current path has become a believed wall or a bump."""
+        rows, cols = self._path_cells
+        if not len(rows):
+            return False
+        return bool(
+            (view.belief_u8[rows, cols] <= U8_WALL_MAX).any() or self.finder.bumps[rows, cols].any()
+        )
 
     @staticmethod
     def _still_unknown(view: RobotView, cell: tuple[int, int]) -> bool:
@@ -311,45 +331,50 @@ class FrontierAgent(Agent):
         """Blacklist the cells within ``blacklist_radius_m`` of the goal's target."""
         radius_m = self.escape_blacklist_radius_m if goal.kind == "escape" else None
         res_cells = (radius_m or self.blacklist_radius_m) / self._res
-        rows, cols = disk_cells(self.blacklisted_until.shape, goal.target, max(res_cells, 0.5))
-        until = self.steps + self.blacklist_ttl_steps
-        self.blacklisted_until[rows, cols] = np.maximum(self.blacklisted_until[rows, cols], until)
+        self.finder.blacklist(
+            goal.target, max(res_cells, 0.5), self.steps + self.blacklist_ttl_steps
+        )
         self.n_blacklisted += 1
         self.goal = None
 
     def _mark_bump(self, view: RobotView) -> None:
         """Remember a wall where the bumper fired."""
-        mark_contact(self.bumps, view.grid, view.odometry_pose, view.radius_m)
+        self.finder.mark_bump(view)
         self.n_bumps += 1
+
+    @property
+    def bumps(self) -> np.ndarray:
+        """Contact regions (where the bumper fired), ``[row, col]``."""
+        return self.finder.bumps
+
+    @property
+    def unreachable_until(self) -> np.ndarray:
+        """Step until which each cell is a walled-off frontier cell."""
+        return self.finder.unreachable_until
 
     @property
     def blacklisted(self) -> np.ndarray:
         """Cells blacklisted now (failed goals, walled-off frontiers), ``[row, col]``."""
-        return (self.blacklisted_until > self.steps) | self.unreachable
+        return self.finder.failed | self.finder.unreachable
 
     @property
     def unreachable(self) -> np.ndarray:
         """Frontier cells that the planner found walled off (blacklisted for a while)."""
-        return self.unreachable_until > self.steps
+        return self.finder.unreachable
+
+    @property
+    def _reach_offsets(self) -> np.ndarray:
+        return self.finder.reach_offsets
 
     # -- planning --------------------------------------------------------------------------------
     def _costs(self, view: RobotView, relaxed: bool = False) -> np.ndarray:
         """Planner costs; ``relaxed``: believed walls and bumps cost ``escape_wall_cost``."""
-        res, radius = view.grid.resolution_m, view.radius_m
-        if not relaxed:
-            cost = traversal_costs(
-                view.belief_u8, res, radius, unknown_cost=self.unknown_cost, blocked=self.bumps
-            )
-        else:
-            _, walls, _ = belief_classes(view.belief_u8)
-            cost = traversal_costs(view.belief_u8, res, radius, unknown_cost=self.unknown_cost)
-            cost[walls] = self.escape_wall_cost
-            cost[self.bumps] = 4 * self.escape_wall_cost
-        return free_start(cost, view.cell)
+        return self.finder.costs(view, self.escape_wall_cost if relaxed else None)
 
     def _plan(self, view: RobotView) -> None:
         """Pick a goal and a path to it (or fall back to sweeping); re-path a committed goal."""
         self._since_plan = 0
+        self.n_plans += 1
         goal = self.goal
         relaxed = goal is not None and goal.kind == "escape"
         paths = cost_field(self._costs(view, relaxed), view.cell, view.grid.resolution_m)
@@ -390,14 +415,11 @@ class FrontierAgent(Agent):
     ) -> Goal | None:
         """The cheapest frontier cell or hidden room's deepest cell (not a failed goal; only
         hidden rooms with ``rooms_only``) on a map whose walls merely cost."""
-        failed = self.blacklisted_until > self.steps
-        mask = np.zeros_like(failed) if rooms_only else frontier_mask(view.belief_u8, failed)
-        min_depth = max(self.min_hidden_room_depth_m / view.grid.resolution_m, 1.0)
-        depth = np.where(failed, 0.0, hidden_rooms(view.belief_u8, min_depth))
-        if depth.any():
-            labels, n = ndimage.label(depth > 0, structure=EIGHT_CONNECTED)
-            deepest = ndimage.maximum_position(depth, labels, range(1, n + 1))
-            mask[tuple(np.array(deepest).T)] = True
+        mask = np.zeros(view.grid.shape, bool)
+        if not rooms_only:
+            mask |= self.finder.frontier(view) & ~self.finder.failed
+        rooms, _, _ = self.finder.hidden_room_targets(view)
+        mask[rooms[:, 0], rooms[:, 1]] = True
         approach = np.where(mask, self._approach(paths), np.inf)
         if not np.isfinite(approach).any():
             return None
@@ -419,91 +441,62 @@ class FrontierAgent(Agent):
             goal.bumps = prev.bumps
         else:
             self.n_goals += 1
+            self.finder.note_tried(goal.target, max(self.blacklist_radius_m / self._res, 0.5))
         self.goal = goal
         cells = paths.path(goal.cell)
+        # Cells that were passable when planned (the start may be inside an inflated wall).
+        passable = view.belief_u8[cells[:, 0], cells[:, 1]] > U8_WALL_MAX
+        self._path_cells = (cells[passable, 0], cells[passable, 1])
         xy = view.grid.cell_to_world(cells) if len(cells) else view.xy[None]
         self.follower.set_path(simplify_path(xy, 0.2))
 
     def _approach(self, paths: CostField) -> np.ndarray:
         """Per cell: the cheapest path cost to a cell whose footprint covers it."""
-        cum = paths.cumulative
-        h, w = cum.shape
-        out = np.full_like(cum, np.inf)
-        for dr, dc in self._reach_offsets:
-            src = cum[max(dr, 0) : h + min(dr, 0), max(dc, 0) : w + min(dc, 0)]
-            dst = out[max(-dr, 0) : h + min(-dr, 0), max(-dc, 0) : w + min(-dc, 0)]
-            np.minimum(dst, src, out=dst)
-        return out
+        return self.finder.approach(paths)
 
     def _approach_cell(self, paths: CostField, target: tuple[int, int]) -> tuple[int, int]:
         """The cheapest reachable cell whose footprint covers ``target``."""
-        h, w = paths.cumulative.shape
-        cells = np.asarray(target) + self._reach_offsets
-        ok = (cells[:, 0] >= 0) & (cells[:, 0] < h) & (cells[:, 1] >= 0) & (cells[:, 1] < w)
-        cells = cells[ok]
-        i = int(np.argmin(paths.cumulative[cells[:, 0], cells[:, 1]]))
-        return int(cells[i, 0]), int(cells[i, 1])
+        return self.finder.approach_cell(paths, target)
 
     def _frontier_exclusion(self, view: RobotView) -> np.ndarray:
-        """Cells that are not frontier goals: near a bump (walls), blacklisted, or in a small
-        unknown pocket inside known space (it will be resolved in passing)."""
-        res = view.grid.resolution_m
-        near_bump = ndimage.binary_dilation(
-            self.bumps, iterations=max(1, round(self.bump_exclusion_m / res))
-        )
-        exclude = near_bump | self.blacklisted
-        if self.min_unknown_region_m2 > 0:
-            _, _, unknown = belief_classes(view.belief_u8)
-            labels, n = ndimage.label(unknown, structure=EIGHT_CONNECTED)
-            if n:
-                area = np.bincount(labels.ravel(), minlength=n + 1) * res * res
-                area[0] = np.inf
-                exclude |= area[labels] < self.min_unknown_region_m2
-        return exclude
+        """Cells that are not frontier goals (see :meth:`GoalFinder.exclusion`)."""
+        return self.finder.exclusion(view)
 
     def _choose_goal(self, view: RobotView, paths: CostField) -> Goal | None:
+        """The frontier cluster of best utility on the finder's menu (explore_lite)."""
         self.candidates = []
-        res = view.grid.resolution_m
-        min_cells = max(1, round(self.min_frontier_size_m / res))
-        if not frontier_mask(view.belief_u8).any():
+        if not self.finder.frontier(view).any():
             self._stop("no_frontiers")
             return None
-        exclude = self._frontier_exclusion(view)
-        approach = self._approach(paths) + self._turn_penalty(view)
-        best: tuple[float, Frontier, tuple[int, int]] | None = None
-        for f in find_frontiers(view.belief_u8, min_cells, exclude=exclude):
-            cost = approach[f.cells[:, 0], f.cells[:, 1]]
-            if not np.isfinite(cost).any():  # walled off on the belief map: blacklisted a while
-                self.unreachable_until[f.cells[:, 0], f.cells[:, 1]] = (
-                    self.steps + self.unreachable_ttl_steps
+        menu = self.finder.find(
+            view, paths, sources=("frontier",), features=("path_cost_m", "heading_change_rad")
+        )
+        cost = menu.feature("path_cost_m") + self.turn_cost_m_per_rad * menu.feature(
+            "heading_change_rad"
+        )
+        best: tuple[float, int] | None = None
+        for i in range(len(menu)):
+            if not menu.valid[i]:  # walled off on the belief map: blacklisted a while
+                self.finder.mark_unreachable(
+                    menu.clusters[i], self.steps + self.unreachable_ttl_steps
                 )
                 self.n_blacklisted += 1
                 continue
-            i = int(np.argmin(cost))
-            u = self._utility(view, f, float(cost[i]))
-            cell = (int(f.cells[i, 0]), int(f.cells[i, 1]))
-            self.candidates.append((cell, u))
+            u = self._utility(view, menu.clusters[i], float(cost[i]))
+            self.candidates.append(((int(menu.target_rc[i, 0]), int(menu.target_rc[i, 1])), u))
             if best is None or u > best[0]:
-                best = (u, f, cell)
+                best = (u, i)
         if best is None:
             self._stop("all_blacklisted")
             return None
-        _, f, target = best
+        i = best[1]
         self._resume()
-        return Goal(self._approach_cell(paths, target), target, "frontier")
+        target = (int(menu.target_rc[i, 0]), int(menu.target_rc[i, 1]))
+        return Goal((int(menu.goal_rc[i, 0]), int(menu.goal_rc[i, 1])), target, "frontier")
 
-    def _turn_penalty(self, view: RobotView) -> np.ndarray:
-        """Metres charged per radian the robot must turn to face a cell (smooth sweeps)."""
-        if self.turn_cost_m_per_rad <= 0:
-            return np.zeros(view.grid.shape)
-        xs, ys = view.grid.cell_centres()
-        x, y, th = view.odometry_pose
-        bearing = np.arctan2(ys - y, xs - x) - th
-        bearing = np.abs((bearing + np.pi) % (2 * np.pi) - np.pi)
-        return self.turn_cost_m_per_rad * bearing
-
-    def _utility(self, view: RobotView, f: Frontier, path_m: float) -> float:
-        size_m = f.size * view.grid.resolution_m
+    def _utility(self, view: RobotView, cluster: np.ndarray, path_m: float) -> float:
+        """explore_lite's utility of a frontier cluster (its ``(N, 2)`` cells) at ``path_m``."""
+        size_m = len(cluster) * view.grid.resolution_m
         return self.gain_scale * size_m - self.potential_scale * path_m
 
     def _sweep_goal(self, view: RobotView, paths: CostField) -> Goal | None:

@@ -21,7 +21,7 @@ class AppendOnlyArray:
         self._data = np.empty((max(1, capacity), width), dtype)
         self._n = 0
 
-    def append(self, row: np.ndarray) -> None:
+    def append(self, row: np.ndarray | tuple[float, ...]) -> None:
         """Add one row (anything that broadcasts to ``(width,)``)."""
         if self._n == len(self._data):
             grown = np.empty((2 * len(self._data), self._data.shape[1]), self._data.dtype)

@@ -225,7 +225,7 @@ class SfWExploreEnv(gym.Env):
         self._routers_view = np.array(s.radio.routers, np.float64)
         self._routers_view.flags.writeable = False
         self.trajectory: list[tuple[float, float]] = []
-        self.odometry_trajectory: list[tuple[float, float]] = []
+        self.odometry_trajectory = AppendOnlyArray(2, np.float64)
         self.last_gain_bits = 0.0
         self.last_rays: np.ndarray = np.zeros(0, np.int64)
         obs = self._sense_and_map(bumped=False)
@@ -358,6 +358,7 @@ class SfWExploreEnv(gym.Env):
             odometry_pose=(float(odom_x), float(odom_y), float(odom_theta)),
             routers_xy=self._routers_view,
             rssi_history=self.rssi_history.view,
+            odometry_trajectory=self.odometry_trajectory.view,
             bumped=bool(s.robot.bumped),
             radius_m=cfg.radius_m,
             max_linear_speed_m_s=cfg.max_linear_speed_m_s,
@@ -399,7 +400,7 @@ class SfWExploreEnv(gym.Env):
             pose=s.robot.pose,
             odometry_pose=s.robot.odometry_pose,
             trajectory=self.trajectory,
-            odometry_trajectory=self.odometry_trajectory,
+            odometry_trajectory=self.odometry_trajectory.view,
             robot_radius_m=self.robot_config.radius_m,
             size=self.render_size,
         )

@@ -35,7 +35,7 @@ def draw_frame(
     pose: Sequence[float],
     odometry_pose: Sequence[float],
     trajectory: Sequence[tuple[float, float]],
-    odometry_trajectory: Sequence[tuple[float, float]],
+    odometry_trajectory: Sequence[tuple[float, float]] | np.ndarray,
     robot_radius_m: float,
     size: tuple[int, int] | None = None,
 ) -> np.ndarray:

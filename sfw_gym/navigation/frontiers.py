@@ -61,7 +61,11 @@ def hidden_rooms(belief_u8: np.ndarray, min_depth_cells: float) -> np.ndarray:
 
 
 def find_frontiers(
-    belief_u8: np.ndarray, min_size_cells: int = 1, exclude: np.ndarray | None = None
+    belief_u8: np.ndarray,
+    min_size_cells: int = 1,
+    exclude: np.ndarray | None = None,
+    *,
+    mask: np.ndarray | None = None,
 ) -> list[Frontier]:
     """Frontier clusters of a belief map (0 wall, 255 free, 127 unknown), largest first.
 
@@ -69,11 +73,15 @@ def find_frontiers(
         belief_u8: The belief, ``[row, col]``.
         min_size_cells: Clusters smaller than this are dropped.
         exclude: Optional mask of cells that are never frontier cells.
+        mask: :func:`frontier_mask` of ``belief_u8``, if known (not modified).
 
     Returns:
         The clusters (8-connected), sorted by decreasing size.
     """
-    mask = frontier_mask(belief_u8, exclude)
+    if mask is None:
+        mask = frontier_mask(belief_u8, exclude)
+    elif exclude is not None:
+        mask = mask & ~exclude
     labels, n = ndimage.label(mask, structure=EIGHT_CONNECTED)
     if n == 0:
         return []

@@ -6,12 +6,11 @@ clear of walls. Shortest paths come from one Dijkstra search per replan from the
 cell, so that one search ranks every candidate goal. Its edge costs are those of scikit-image's
 :class:`skimage.graph.MCP_Geometric` (8-connected; a step costs the mean of its two cells' costs
 times its length, 1 or √2) and it returns the same costs (the tests check it against MCP); it is a
-compiled kernel because it runs at every replan and is 2-3× faster than MCP here.
+compiled bucket-queue kernel because it runs at every replan and is about 5× faster than MCP here.
 """
 
 from __future__ import annotations
 
-import heapq
 import math
 from dataclasses import dataclass
 from itertools import pairwise
@@ -33,6 +32,7 @@ def traversal_costs(
     clearance_m: float = 0.2,
     lethal_radius_m: float | None = None,
     blocked: np.ndarray | None = None,
+    wall_distance: np.ndarray | None = None,
 ) -> np.ndarray:
     """Per-cell traversal cost of the belief map (``inf`` = obstacle).
 
@@ -52,6 +52,8 @@ def traversal_costs(
         lethal_radius_m: Cells within this of a wall are obstacles (default: half a cell, i.e.
             only the wall cells themselves).
         blocked: Optional extra obstacle mask (e.g. where the robot bumped).
+        wall_distance: :func:`wall_distance_m` of the walls and ``blocked`` cells, if known
+            (walls change more rarely than the rest of the belief: callers may cache it).
 
     Returns:
         float64 array of the belief's shape.
@@ -61,13 +63,18 @@ def traversal_costs(
         wall = wall | blocked
     cost = np.where(unknown, float(unknown_cost), 1.0)
     if wall.any():
-        dist = ndimage.distance_transform_edt(~wall) * resolution_m
+        dist = wall_distance_m(wall, resolution_m) if wall_distance is None else wall_distance
         outer = radius_m + clearance_m
         band = dist < outer
         cost[band] += inflation_cost * np.clip((outer - dist[band]) / clearance_m, 0.0, 1.0)
         lethal = 0.5 * resolution_m if lethal_radius_m is None else lethal_radius_m
         cost[dist <= lethal] = np.inf
     return cost
+
+
+def wall_distance_m(walls: np.ndarray, resolution_m: float) -> np.ndarray:
+    """Distance (m) from every cell to the nearest cell of ``walls``."""
+    return ndimage.distance_transform_edt(~walls) * resolution_m
 
 
 def free_start(cost: np.ndarray, start_rc: tuple[int, int], radius_cells: int = 1) -> np.ndarray:
@@ -120,7 +127,11 @@ class CostField:
 
 
 def cost_field(cost: np.ndarray, start_rc: tuple[int, int], resolution_m: float) -> CostField:
-    """Dijkstra from ``start_rc`` over ``cost`` (8-connected; ``inf`` cells are obstacles)."""
+    """Dijkstra from ``start_rc`` over ``cost`` (8-connected; ``inf`` cells are obstacles; every
+    other cell costs at least 1, as :func:`traversal_costs` makes them)."""
+    finite = cost[np.isfinite(cost)]
+    if finite.size and finite.min() < 1.0:
+        raise ValueError(f"cell costs must be >= 1 (or inf), got {finite.min()}")
     h, w = cost.shape
     r, c = int(start_rc[0]), int(start_rc[1])
     r, c = min(max(r, 0), h - 1), min(max(c, 0), w - 1)
@@ -132,21 +143,44 @@ def cost_field(cost: np.ndarray, start_rc: tuple[int, int], resolution_m: float)
 
 @njit(cache=True)
 def _dijkstra_8(cost, r0, c0, cum, pred):  # pragma: no cover (compiled)
-    """Single-source Dijkstra on the 8-connected grid with MCP_Geometric's edge costs."""
+    """Single-source Dijkstra on the 8-connected grid with MCP_Geometric's edge costs.
+
+    Cells cost at least 1, so every edge does: a bucket queue of width 1 (Dial's algorithm)
+    then settles nodes in a valid order (no node in a bucket can improve another in it), which
+    gives Dijkstra's exact costs without a heap. Entries improved later stay in their bucket
+    and are skipped when popped.
+    """
     h, w = cost.shape
     cum[:] = np.inf
     pred[:] = -1
     done = np.zeros(h * w, np.bool_)
-    cum[r0, c0] = 0.0
-    heap = [(0.0, r0 * w + c0)]
     diagonal = math.sqrt(2.0)
-    while heap:
-        d, i = heapq.heappop(heap)
+    max_cost = 1.0
+    for r in range(h):
+        for c in range(w):
+            if max_cost < cost[r, c] < np.inf:
+                max_cost = cost[r, c]
+    n_buckets = int(max_cost * diagonal) + 2  # > the longest edge: the ring never wraps onto itself
+    head = np.full(n_buckets, -1, np.int64)  # per bucket, its newest entry
+    node = np.empty(8 * h * w + 1, np.int64)  # entries: the node and the bucket's next entry
+    below = np.empty(8 * h * w + 1, np.int64)
+    node[0], below[0], head[0] = r0 * w + c0, -1, 0
+    n_entries, pending, bucket = 1, 1, 0
+    cum[r0, c0] = 0.0
+    while pending > 0:
+        e = head[bucket % n_buckets]
+        if e < 0:
+            bucket += 1
+            continue
+        head[bucket % n_buckets] = below[e]
+        pending -= 1
+        i = node[e]
         if done[i]:
             continue
         done[i] = True
         r = i // w
         c = i - r * w
+        d = cum[r, c]
         here = cost[r, c]
         for dr in range(-1, 2):
             rr = r + dr
@@ -156,11 +190,15 @@ def _dijkstra_8(cost, r0, c0, cum, pred):  # pragma: no cover (compiled)
                 cc = c + dc
                 if (dr == 0 and dc == 0) or cc < 0 or cc >= w or not cost[rr, cc] < np.inf:
                     continue
+                j = rr * w + cc
                 step = 0.5 * (here + cost[rr, cc]) * (diagonal if dr != 0 and dc != 0 else 1.0)
-                if d + step < cum[rr, cc]:
+                if not done[j] and d + step < cum[rr, cc]:
                     cum[rr, cc] = d + step
-                    pred[rr * w + cc] = i
-                    heapq.heappush(heap, (d + step, rr * w + cc))
+                    pred[j] = i
+                    slot = int(d + step) % n_buckets
+                    node[n_entries], below[n_entries], head[slot] = j, head[slot], n_entries
+                    n_entries += 1
+                    pending += 1
 
 
 @njit(cache=True)

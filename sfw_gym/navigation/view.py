@@ -24,6 +24,7 @@ class RobotView:
         odometry_pose: ``(x, y, θ)`` from odometry (m, rad), not the true pose.
         routers_xy: ``(R, 2)`` router positions (the robot knows its routers).
         rssi_history: ``(T, R)`` readings so far, dBm (``NOT_HEARD_DBM`` when not heard).
+        odometry_trajectory: ``(T, 2)`` odometry positions where those readings were taken.
         bumped: Whether the last step bumped into something.
         radius_m: The robot's radius.
         max_linear_speed_m_s, max_angular_speed_rad_s, control_period_s: Its motion limits.
@@ -36,6 +37,7 @@ class RobotView:
     odometry_pose: tuple[float, float, float]
     routers_xy: np.ndarray
     rssi_history: np.ndarray
+    odometry_trajectory: np.ndarray
     bumped: bool
     radius_m: float
     max_linear_speed_m_s: float

@@ -29,9 +29,9 @@ import pytest
 
 import sfw_gym  # noqa: F401  (registers the envs)
 from sfw_gym.agents import CrossPassAgent, FrontierAgent, GreedyInfoGainAgent, make_agent
-from sfw_gym.agents.frontier import Frontier
 from sfw_gym.envs.waypoint import WaypointWrapper
 from sfw_gym.mapping import GridSpec
+from sfw_gym.navigation.frontiers import Frontier
 
 SMALL = "SfW-ExploreSmall-v0"
 BUDGET = {"max_steps": 1000}
@@ -124,7 +124,7 @@ def test_frontier_utility_is_explore_lite_size_minus_path():
     view = type("V", (), {"grid": GridSpec((0.0, 0.0), 0.1, (10, 10))})()
     f = Frontier(np.zeros((7, 2), np.int64), (0.0, 0.0))
     # 7 cells of 0.1 m: 0.7 m of frontier; 1.5 m of path
-    assert agent._utility(view, f, 1.5) == pytest.approx(2.0 * 0.7 - 3.0 * 1.5)
+    assert agent._utility(view, f.cells, 1.5) == pytest.approx(2.0 * 0.7 - 3.0 * 1.5)
 
 
 def test_cross_pass_utility_counts_band_cells_one_plus_bonus_times():
@@ -133,9 +133,9 @@ def test_cross_pass_utility_counts_band_cells_one_plus_bonus_times():
     agent.band = np.zeros((10, 10), bool)
     agent.band[0, :3] = True
     f = Frontier(np.array([[0, c] for c in range(5)]), (0.0, 2.0))  # 3 of 5 cells in the band
-    assert agent._utility(view, f, 1.0) == pytest.approx((5 + 2.0 * 3) * 0.1 - 3.0 * 1.0)
+    assert agent._utility(view, f.cells, 1.0) == pytest.approx((5 + 2.0 * 3) * 0.1 - 3.0 * 1.0)
     agent.band_bonus = 0.0
-    assert agent._utility(view, f, 1.0) == pytest.approx(5 * 0.1 - 3.0)
+    assert agent._utility(view, f.cells, 1.0) == pytest.approx(5 * 0.1 - 3.0)
 
 
 def test_greedy_score_is_expected_gain_per_metre_of_path():

@@ -143,7 +143,7 @@ def test_greedy_subsamples_its_candidates_evenly():
 
 
 def test_greedy_zone_model_uses_the_readings_and_refits_every_zones_every_steps(monkeypatch):
-    import sfw_gym.agents.greedy as greedy
+    import sfw_gym.navigation.candidates as candidates  # the greedy agent's menu refits the model
 
     calls = []
 
@@ -151,8 +151,8 @@ def test_greedy_zone_model_uses_the_readings_and_refits_every_zones_every_steps(
         calls.append((len(xy), None if rssi is None else len(rssi)))
         return real(grid, routers, xy, rssi, **kwargs)
 
-    real = greedy.router_scores
-    monkeypatch.setattr(greedy, "router_scores", spy)
+    real = candidates.router_scores
+    monkeypatch.setattr(candidates, "router_scores", spy)
     b = np.full((30, 30), F, np.uint8)
     b[:, 15:] = U
     env = FakeEnv(b, pose=(0.5, 0.5, 0.0))

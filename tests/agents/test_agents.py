@@ -130,6 +130,7 @@ class FakeEnv:
         self.frozen = frozen
         self.unwrapped = self
         self.t = 0
+        self.path = [self.pose[:2].copy()]
 
     def robot_view(self) -> RobotView:
         return RobotView(
@@ -139,6 +140,7 @@ class FakeEnv:
             odometry_pose=tuple(self.pose),
             routers_xy=self.routers.copy(),
             rssi_history=np.tile(self._rssi(), (self.t + 1, 1)),
+            odometry_trajectory=np.array(self.path),
             bumped=False,
             radius_m=0.17,
             max_linear_speed_m_s=0.5,
@@ -153,11 +155,11 @@ class FakeEnv:
 
     def step(self, action) -> None:
         self.t += 1
-        if self.frozen:
-            return
-        lin, ang = np.clip(action, -1, 1)
-        self.pose[2] = wrap_angle(self.pose[2] + 0.3 * ang)
-        self.pose[:2] += 0.1 * lin * np.array([np.cos(self.pose[2]), np.sin(self.pose[2])])
+        if not self.frozen:
+            lin, ang = np.clip(action, -1, 1)
+            self.pose[2] = wrap_angle(self.pose[2] + 0.3 * ang)
+            self.pose[:2] += 0.1 * lin * np.array([np.cos(self.pose[2]), np.sin(self.pose[2])])
+        self.path.append(self.pose[:2].copy())
 
 
 def _walled_room_with_unreachable_frontier() -> np.ndarray:

@@ -410,3 +410,10 @@ def test_cost_field_matches_scikit_image_mcp_and_its_paths_add_up(seed):
         assert 0.1 * float((length * mean_cost).sum()) == pytest.approx(field.cumulative[goal])
     blocked = tuple(np.argwhere(~reachable)[0])
     assert len(field.path(blocked)) == 0
+
+
+def test_cost_field_refuses_cells_cheaper_than_one():
+    cost = np.ones((5, 5))
+    cost[2, 2] = 0.5
+    with pytest.raises(ValueError, match="cell costs must be >= 1"):
+        cost_field(cost, (0, 0), 0.1)

@@ -1,0 +1,565 @@
+"""Candidate goals: one menu of places worth driving to, shared by every exploring agent.
+
+:func:`candidate_goals` returns, for the current belief, up to K goals with a reachable path on the
+belief map, a feature vector (:data:`FEATURES`, units in the names) and a validity mask. The
+candidates come from three sources (:data:`SOURCES`):
+
+- ``frontier``: one per frontier cluster (explore_lite): the cluster cell that is cheapest to
+  resolve, counting the path to a cell whose footprint covers it and the turn towards it;
+- ``hidden_room``: the deepest cell of each room-deep unknown pocket inside the explored extent
+  (a room whose doorway the map closed has no frontier);
+- ``info_gain``: frontier cells (an even subsample) scored by the bits the mapper would gain with
+  the robot there (next-best-view).
+
+:class:`GoalFinder` is the stateful form that agents keep for an episode: it remembers bumps,
+failed and unreachable goals and how often a place was tried, and it caches what changes slowly
+(frontier cells are updated only where the belief changed since the last call; the distance to
+walls only when the walls change). One shortest-path field (:func:`cost_field`) per replan
+serves every candidate.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+from numba import njit
+from scipy import ndimage
+
+from sfw_gym.core.config import Config, setting
+from sfw_gym.core.constants import NOT_HEARD_DBM, U8_FREE_MIN, U8_WALL_MAX
+from sfw_gym.mapping.grid import belief_classes
+from sfw_gym.navigation.frontiers import (
+    EIGHT_CONNECTED,
+    find_frontiers,
+    frontier_mask,
+    hidden_rooms,
+)
+from sfw_gym.navigation.planning import (
+    CostField,
+    cost_field,
+    disk_cells,
+    disk_offsets,
+    free_start,
+    mark_contact,
+    traversal_costs,
+    wall_distance_m,
+)
+from sfw_gym.navigation.radio_zones import router_scores
+from sfw_gym.navigation.view import RobotView
+
+#: Columns of :attr:`CandidateGoals.features`, units in the names.
+FEATURES = (
+    "path_cost_m",  # planner cost of the path to the goal cell (metres on free cells; inf: none)
+    "distance_m",  # straight line from the robot to the target
+    "cluster_size_m",  # frontier cluster length (cells × resolution); 0 for other sources
+    "expected_gain_bits",  # entropy of the cells the mapper would update with the robot there
+    "unknown_area_m2",  # unknown area within near_radius_m of the target
+    "heading_change_rad",  # |bearing to the target − heading|, in [0, π]
+    "times_tried",  # goals chosen near this target so far in the episode
+    "times_blacklisted",  # goals given up near this target so far
+    "is_hidden_room",  # 1.0 for a hidden-room target, else 0.0
+    "strongest_rssi_dbm",  # strongest router heard within near_radius_m (NOT_HEARD_DBM: never)
+)
+SOURCES = ("frontier", "hidden_room", "info_gain")
+_F = {name: i for i, name in enumerate(FEATURES)}
+_LN2 = float(np.log(2.0))
+
+
+@dataclass(frozen=True)
+class CandidateSettings(Config):
+    """How candidates are found (the defaults are :class:`~sfw_gym.agents.FrontierAgent`'s)."""
+
+    prefix: ClassVar[str | None] = ""
+    unknown_cost: float = setting(1.5, ge=1.0)
+    min_frontier_size_m: float = setting(0.3, ge=0.0)
+    bump_exclusion_m: float = setting(0.3, ge=0.0)
+    min_unknown_region_m2: float = setting(0.5, ge=0.0)
+    turn_cost_m_per_rad: float = setting(0.3, ge=0.0)
+    min_hidden_room_depth_m: float = setting(0.5, ge=0.0)
+    info_gain_samples: int = setting(300, integer=True, ge=1)
+    near_radius_m: float = setting(1.0, gt=0.0)
+    zones_every_steps: int = setting(25, integer=True, ge=1)
+
+
+@dataclass(frozen=True)
+class CandidateGoals:
+    """A menu of goals (K rows). Deterministic for the same view and memory.
+
+    Attributes:
+        target_rc: ``(K, 2)`` the cell each candidate means to resolve.
+        goal_rc: ``(K, 2)`` where the robot drives: the cheapest reachable cell whose footprint
+            covers the target (the target itself when none is reachable).
+        source: ``(K,)`` index into :data:`SOURCES`.
+        features: ``(K, len(FEATURES))`` float64, columns named by :data:`FEATURES`.
+        valid: ``(K,)`` whether the goal is reachable on the belief map.
+        clusters: Per candidate, the ``(N, 2)`` cells of its frontier cluster (empty otherwise).
+        paths: The shortest-path field the costs come from; ``paths.path(goal_rc[i])``.
+        walled_off_rc: ``(M, 2)`` frontier cells (not excluded) that no path reaches.
+    """
+
+    target_rc: np.ndarray
+    goal_rc: np.ndarray
+    source: np.ndarray
+    features: np.ndarray
+    valid: np.ndarray
+    clusters: tuple[np.ndarray, ...]
+    paths: CostField
+    walled_off_rc: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.target_rc)
+
+    def feature(self, name: str) -> np.ndarray:
+        """The column ``name`` of :attr:`features`."""
+        return self.features[:, _F[name]]
+
+    def of(self, source: str) -> np.ndarray:
+        """Indices of the candidates from ``source``."""
+        return np.flatnonzero(self.source == SOURCES.index(source))
+
+    def path(self, i: int) -> np.ndarray:
+        """``(N, 2)`` cells from the robot to candidate ``i``'s goal cell (empty if invalid)."""
+        return self.paths.path(tuple(self.goal_rc[i]))
+
+
+def candidate_goals(view: RobotView, max_candidates: int = 32, **settings) -> CandidateGoals:
+    """Up to ``max_candidates`` goals for ``view``'s belief (a fresh :class:`GoalFinder`).
+
+    Slots go to the sources in turn: frontier clusters (best explore_lite utility first) up to
+    three quarters, hidden rooms (cheapest first) up to an eighth, the rest to information-gain
+    points (most bits per metre first); slots a source leaves empty go to the others.
+
+    Args:
+        view: What the robot knows.
+        max_candidates: K.
+        **settings: Fields of :class:`CandidateSettings`.
+    """
+    finder = GoalFinder(CandidateSettings.from_dict(settings, "candidate_goals"))
+    finder.reset(view)
+    paths = cost_field(finder.costs(view), view.cell, view.grid.resolution_m)
+    return finder.find(view, paths, max_candidates=max_candidates)
+
+
+class GoalFinder:
+    """Candidate goals for one episode, with the memory and caches that make them cheap.
+
+    Memory (``[row, col]`` grids, written by the agent through the methods below): ``bumps``
+    (contact regions), ``failed_until`` and ``unreachable_until`` (step until which a cell is
+    no goal), ``times_tried``, ``times_blacklisted``.
+    """
+
+    def __init__(self, settings: CandidateSettings | None = None) -> None:
+        self.settings = settings or CandidateSettings()
+
+    # -- episode -----------------------------------------------------------------------------
+    def reset(self, view: RobotView) -> None:
+        """Forget everything: a new episode starts from ``view``."""
+        grid = view.grid
+        shape, res = grid.shape, grid.resolution_m
+        self.bumps = np.zeros(shape, bool)
+        self.failed_until = np.zeros(shape, np.int64)
+        self.unreachable_until = np.zeros(shape, np.int64)
+        self.times_tried = np.zeros(shape, np.int32)
+        self.times_blacklisted = np.zeros(shape, np.int32)
+        # A goal cell resolves a target when the robot stops within the follower's tolerance of
+        # its centre and the target's centre is within the robot's radius of the robot's centre.
+        self.goal_tolerance_m = 0.6 * res
+        self.reach_offsets = disk_offsets(max((view.radius_m - self.goal_tolerance_m) / res, 0.5))
+        self._near_offsets = disk_offsets(self.settings.near_radius_m / res)
+        self._centres = grid.cell_centres()
+        self._belief = np.array(view.belief_u8, np.uint8)
+        self._frontier = frontier_mask(self._belief)
+        self._walls_seen: np.ndarray | None = None
+        self._wall_distance = np.zeros(shape)
+        self._near_bump = np.zeros(shape, bool)
+        self._heard = np.full(shape, float(NOT_HEARD_DBM))
+        self._n_heard = 0
+        self._zone: np.ndarray | None = None
+        self._zone_step = -(10**9)
+        self.step = 0
+
+    def set_step(self, step: int) -> None:
+        """The agent's step count (the clock of the ``*_until`` memories)."""
+        self.step = int(step)
+
+    # -- memory ------------------------------------------------------------------------------
+    def mark_bump(self, view: RobotView) -> None:
+        """Remember a wall where the bumper fired."""
+        mark_contact(self.bumps, view.grid, view.odometry_pose, view.radius_m)
+        res = view.grid.resolution_m
+        self._near_bump = ndimage.binary_dilation(
+            self.bumps, iterations=max(1, round(self.settings.bump_exclusion_m / res))
+        )
+
+    def note_tried(self, target: tuple[int, int], radius_cells: float) -> None:
+        """Count a goal chosen at ``target`` (for ``times_tried``)."""
+        self.times_tried[disk_cells(self.times_tried.shape, target, radius_cells)] += 1
+
+    def blacklist(self, target: tuple[int, int], radius_cells: float, until_step: int) -> None:
+        """No goal within ``radius_cells`` of ``target`` until ``until_step``."""
+        cells = disk_cells(self.failed_until.shape, target, radius_cells)
+        self.failed_until[cells] = np.maximum(self.failed_until[cells], until_step)
+        self.times_blacklisted[cells] += 1
+
+    def mark_unreachable(self, cells: np.ndarray, until_step: int) -> None:
+        """The ``(N, 2)`` cells are walled off on the map: no goals until ``until_step``."""
+        self.unreachable_until[cells[:, 0], cells[:, 1]] = until_step
+
+    @property
+    def failed(self) -> np.ndarray:
+        """Cells near a goal given up, now."""
+        return self.failed_until > self.step
+
+    @property
+    def unreachable(self) -> np.ndarray:
+        """Frontier cells found walled off, now."""
+        return self.unreachable_until > self.step
+
+    # -- map analysis ------------------------------------------------------------------------
+    def frontier(self, view: RobotView) -> np.ndarray:
+        """Frontier cells of ``view``'s belief (read-only; updated where the belief changed)."""
+        changed = np.flatnonzero(self._belief.ravel() != view.belief_u8.ravel())
+        if len(changed):
+            _update_frontier(view.belief_u8, self._belief, changed, self._frontier)
+        return self._frontier
+
+    def costs(self, view: RobotView, escape_wall_cost: float | None = None) -> np.ndarray:
+        """Planner costs with the robot's cell passable. With ``escape_wall_cost``, believed walls
+        cost that much per cell (bumps 4×) instead of blocking: the map's walls are doubted."""
+        _, walls, _ = belief_classes(view.belief_u8)
+        res, radius = view.grid.resolution_m, view.radius_m
+        if escape_wall_cost is None:
+            blocked = walls | self.bumps
+            if self._walls_seen is None or not np.array_equal(blocked, self._walls_seen):
+                self._walls_seen = blocked
+                self._wall_distance = wall_distance_m(blocked, res)
+            cost = traversal_costs(
+                view.belief_u8,
+                res,
+                radius,
+                unknown_cost=self.settings.unknown_cost,
+                blocked=self.bumps,
+                wall_distance=self._wall_distance,
+            )
+        else:
+            cost = traversal_costs(
+                view.belief_u8, res, radius, unknown_cost=self.settings.unknown_cost
+            )
+            cost[walls] = escape_wall_cost
+            cost[self.bumps] = 4 * escape_wall_cost
+        return free_start(cost, view.cell)
+
+    def approach(self, paths: CostField) -> np.ndarray:
+        """Per cell: the cheapest path cost to a cell whose footprint covers it."""
+        cum = paths.cumulative
+        h, w = cum.shape
+        out = np.full_like(cum, np.inf)
+        for dr, dc in self.reach_offsets:
+            src = cum[max(dr, 0) : h + min(dr, 0), max(dc, 0) : w + min(dc, 0)]
+            dst = out[max(-dr, 0) : h + min(-dr, 0), max(-dc, 0) : w + min(-dc, 0)]
+            np.minimum(dst, src, out=dst)
+        return out
+
+    def approach_cell(self, paths: CostField, target: tuple[int, int]) -> tuple[int, int]:
+        """The cheapest reachable cell whose footprint covers ``target``."""
+        h, w = paths.cumulative.shape
+        cells = np.asarray(target) + self.reach_offsets
+        ok = (cells[:, 0] >= 0) & (cells[:, 0] < h) & (cells[:, 1] >= 0) & (cells[:, 1] < w)
+        cells = cells[ok]
+        i = int(np.argmin(paths.cumulative[cells[:, 0], cells[:, 1]]))
+        return int(cells[i, 0]), int(cells[i, 1])
+
+    def approach_cells(self, paths: CostField, targets: np.ndarray) -> np.ndarray:
+        """:meth:`approach_cell` of each of ``targets`` ``(N, 2)`` (the target where none is
+        reachable)."""
+        cum = paths.cumulative
+        h, w = cum.shape
+        cells = targets[:, None, :] + self.reach_offsets[None, :, :]
+        inside = (cells[..., 0] >= 0) & (cells[..., 0] < h) & (cells[..., 1] >= 0)
+        inside &= cells[..., 1] < w
+        cost = np.where(
+            inside, cum[cells[..., 0].clip(0, h - 1), cells[..., 1].clip(0, w - 1)], np.inf
+        )
+        best = np.argmin(cost, axis=1)
+        out = cells[np.arange(len(targets)), best]
+        unreachable = ~np.isfinite(cost[np.arange(len(targets)), best])
+        out[unreachable] = targets[unreachable]
+        return out.astype(np.int64)
+
+    def heading_change(self, view: RobotView, cells: np.ndarray) -> np.ndarray:
+        """|bearing from the robot to each cell − heading|, radians in [0, π]."""
+        xs, ys = self._centres
+        x, y, th = view.odometry_pose
+        r, c = cells[:, 0], cells[:, 1]
+        bearing = np.arctan2(ys[r, c] - y, xs[r, c] - x) - th
+        return np.abs((bearing + np.pi) % (2 * np.pi) - np.pi)
+
+    def exclusion(self, view: RobotView) -> np.ndarray:
+        """Cells that are no frontier goals: near a bump (walls), failed or walled off, or in a
+        small unknown pocket inside known space (it will be resolved in passing)."""
+        exclude = self._near_bump | self.failed | self.unreachable
+        if self.settings.min_unknown_region_m2 > 0:
+            res = view.grid.resolution_m
+            _, _, unknown = belief_classes(view.belief_u8)
+            labels, n = ndimage.label(unknown, structure=EIGHT_CONNECTED)
+            if n:
+                area = np.bincount(labels.ravel(), minlength=n + 1) * res * res
+                area[0] = np.inf
+                exclude |= area[labels] < self.settings.min_unknown_region_m2
+        return exclude
+
+    def strongest_router(self, view: RobotView) -> np.ndarray:
+        """Per cell, the router predicted strongest there (refit every ``zones_every_steps``)."""
+        if self._zone is None or self.step - self._zone_step >= self.settings.zones_every_steps:
+            traj, hist = view.odometry_trajectory, view.rssi_history
+            n = min(len(traj), len(hist))
+            scores = router_scores(view.grid, view.routers_xy, traj[-n:], hist[-n:])
+            self._zone = np.argmax(scores, axis=0)
+            self._zone_step = self.step
+        return self._zone
+
+    def expected_gain(self, view: RobotView, cells: np.ndarray) -> np.ndarray:
+        """Bits the mapper would gain with the robot at each of ``cells`` ``(N, 2)``: the entropy
+        of the unknown cells on the ray from the router predicted strongest there, plus that of
+        the unknown cells in the robot's footprint."""
+        grid = view.grid
+        h, w = grid.shape
+        bits = _unknown_bits(view)
+        routers = np.asarray(view.routers_xy, np.float64)
+        zone = self.strongest_router(view)
+        ends = grid.cell_to_world(cells)
+        starts = routers[zone[cells[:, 0], cells[:, 1]]]
+        length = np.linalg.norm(ends - starts, axis=1)
+        n = max(2, int(np.ceil(length.max(initial=0.0) / (0.5 * grid.resolution_m))) + 1)
+        t = np.linspace(0.0, 1.0, n)
+        pts = starts[:, None, :] + (ends - starts)[:, None, :] * t[None, :, None]
+        rc = grid.world_to_cell(pts)
+        flat = np.clip(rc[..., 0], 0, h - 1) * w + np.clip(rc[..., 1], 0, w - 1)
+        # Count each cell once per ray: sort the flat indices per row, keep the first of a run.
+        flat.sort(axis=1)
+        first = np.ones_like(flat, bool)
+        first[:, 1:] = flat[:, 1:] != flat[:, :-1]
+        gain = (bits.ravel()[flat] * first).sum(axis=1)
+        return gain + self._disk_sum(bits, cells, self.reach_offsets)
+
+    def _disk_sum(self, values: np.ndarray, cells: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+        """Per cell, the sum of ``values`` over ``cells + offsets`` inside the grid."""
+        h, w = values.shape
+        r = cells[:, None, 0] + offsets[None, :, 0]
+        c = cells[:, None, 1] + offsets[None, :, 1]
+        inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+        return (values[r.clip(0, h - 1), c.clip(0, w - 1)] * inside).sum(axis=1)
+
+    def _strongest_heard_near(self, view: RobotView, cells: np.ndarray) -> np.ndarray:
+        """The strongest RSSI heard within ``near_radius_m`` of each cell (dBm)."""
+        traj, hist = view.odometry_trajectory, view.rssi_history
+        n = min(len(traj), len(hist))
+        if n > self._n_heard:  # fold in the readings since the last call
+            rc = view.grid.world_to_cell(traj[self._n_heard : n])
+            h, w = self._heard.shape
+            ok = (rc[:, 0] >= 0) & (rc[:, 0] < h) & (rc[:, 1] >= 0) & (rc[:, 1] < w)
+            strongest = hist[self._n_heard : n].max(axis=1, initial=NOT_HEARD_DBM)
+            np.maximum.at(self._heard, (rc[ok, 0], rc[ok, 1]), strongest[ok])
+            self._n_heard = n
+        h, w = self._heard.shape
+        r = cells[:, None, 0] + self._near_offsets[None, :, 0]
+        c = cells[:, None, 1] + self._near_offsets[None, :, 1]
+        inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+        near = np.where(inside, self._heard[r.clip(0, h - 1), c.clip(0, w - 1)], NOT_HEARD_DBM)
+        return near.max(axis=1, initial=float(NOT_HEARD_DBM))
+
+    # -- the menu ----------------------------------------------------------------------------
+    def find(
+        self,
+        view: RobotView,
+        paths: CostField,
+        *,
+        max_candidates: int | None = None,
+        sources: tuple[str, ...] = SOURCES,
+        features: tuple[str, ...] = FEATURES,
+    ) -> CandidateGoals:
+        """The candidates of ``sources`` for ``view`` on ``paths``: all of them with
+        ``max_candidates=None``, else the quotas of :func:`candidate_goals`. Only the columns
+        named in ``features`` are computed (the others are NaN): agents ask for what they use."""
+        for given, known in ((sources, SOURCES), (features, FEATURES)):
+            unknown_names = set(given) - set(known)
+            if unknown_names:
+                raise ValueError(f"unknown names {sorted(unknown_names)}; known: {known}")
+        res = view.grid.resolution_m
+        approach = self.approach(paths)
+        frontier = self.frontier(view)
+        open_frontier = frontier & ~self.exclusion(view)
+        walled_off_rc = np.argwhere(open_frontier & ~np.isfinite(approach))
+        targets: list[np.ndarray] = [np.zeros((0, 2), np.int64)]
+        source: list[np.ndarray] = []
+        sizes: list[np.ndarray] = []
+        clusters: list[np.ndarray] = []
+        for name in sources:
+            if name == "frontier":
+                cells, size, cl = self._frontier_targets(view, approach, open_frontier)
+            elif name == "hidden_room":
+                cells, size, cl = self.hidden_room_targets(view)
+            else:
+                cells = np.argwhere(open_frontier & np.isfinite(approach))
+                k = self.settings.info_gain_samples
+                if len(cells) > k:
+                    cells = cells[np.linspace(0, len(cells) - 1, k).astype(int)]
+                size, cl = np.zeros(len(cells)), []
+            targets.append(cells.reshape(-1, 2))
+            source.append(np.full(len(cells), SOURCES.index(name), np.int64))
+            sizes.append(size)
+            clusters += cl or [np.zeros((0, 2), np.int64)] * len(cells)
+        target_rc = np.concatenate(targets).astype(np.int64)
+        src = np.concatenate([np.zeros(0, np.int64), *source])
+        size_m = np.concatenate([np.zeros(0), *sizes]) * res
+        path_cost = approach[target_rc[:, 0], target_rc[:, 1]]
+        gain = np.full(len(target_rc), np.nan)
+        info = src == SOURCES.index("info_gain")
+        if info.any() and (max_candidates is not None or "expected_gain_bits" in features):
+            gain[info] = self.expected_gain(view, target_rc[info])
+        keep = np.arange(len(target_rc))
+        if max_candidates is not None:
+            keep = _select(src, path_cost, size_m, gain, max_candidates)
+        target_rc, src, path_cost, size_m, gain = (
+            target_rc[keep],
+            src[keep],
+            path_cost[keep],
+            size_m[keep],
+            gain[keep],
+        )
+        r, c = target_rc[:, 0], target_rc[:, 1]
+        compute = {
+            "path_cost_m": lambda: path_cost,
+            "distance_m": lambda: np.linalg.norm(
+                view.grid.cell_to_world(target_rc) - view.xy, axis=1
+            ),
+            "cluster_size_m": lambda: size_m,
+            "expected_gain_bits": lambda: _fill(
+                gain, lambda m: self.expected_gain(view, target_rc[m])
+            ),
+            "unknown_area_m2": lambda: (
+                self._disk_sum(
+                    belief_classes(view.belief_u8)[2].astype(np.float64),
+                    target_rc,
+                    self._near_offsets,
+                )
+                * res**2
+            ),
+            "heading_change_rad": lambda: self.heading_change(view, target_rc),
+            "times_tried": lambda: self.times_tried[r, c],
+            "times_blacklisted": lambda: self.times_blacklisted[r, c],
+            "is_hidden_room": lambda: src == SOURCES.index("hidden_room"),
+            "strongest_rssi_dbm": lambda: self._strongest_heard_near(view, target_rc),
+        }
+        feats = np.full((len(target_rc), len(FEATURES)), np.nan)
+        if len(target_rc):
+            for name in features:
+                feats[:, _F[name]] = compute[name]()
+        return CandidateGoals(
+            target_rc,
+            self.approach_cells(paths, target_rc),
+            src,
+            feats,
+            np.isfinite(path_cost),
+            tuple(clusters[i] for i in keep),
+            paths,
+            walled_off_rc,
+        )
+
+    def _frontier_targets(
+        self, view: RobotView, approach: np.ndarray, open_frontier: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+        """Per frontier cluster (largest first): its cheapest cell to resolve (path + turn)."""
+        res = view.grid.resolution_m
+        min_cells = max(1, round(self.settings.min_frontier_size_m / res))
+        turn = self.settings.turn_cost_m_per_rad
+        clusters = [f.cells for f in find_frontiers(view.belief_u8, min_cells, mask=open_frontier)]
+        if not clusters:
+            return np.zeros((0, 2), np.int64), np.zeros(0), []
+        every = np.concatenate(clusters)
+        cost = approach[every[:, 0], every[:, 1]]
+        if turn > 0:
+            cost = cost + turn * self.heading_change(view, every)
+        sizes = np.array([len(c) for c in clusters])
+        ends = np.cumsum(sizes)
+        best = [b - n + int(np.argmin(cost[b - n : b])) for b, n in zip(ends, sizes, strict=True)]
+        return every[best], sizes.astype(np.float64), clusters
+
+    def hidden_room_targets(
+        self, view: RobotView
+    ) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+        """The deepest cell of each hidden room that has not failed as a goal."""
+        min_depth = max(self.settings.min_hidden_room_depth_m / view.grid.resolution_m, 1.0)
+        depth = np.where(self.failed, 0.0, hidden_rooms(view.belief_u8, min_depth))
+        if not depth.any():
+            return np.zeros((0, 2), np.int64), np.zeros(0), []
+        labels, n = ndimage.label(depth > 0, structure=EIGHT_CONNECTED)
+        deepest = np.array(ndimage.maximum_position(depth, labels, range(1, n + 1)), np.int64)
+        return deepest.reshape(-1, 2), np.zeros(len(deepest)), []
+
+
+def _select(
+    source: np.ndarray, path_cost: np.ndarray, size_m: np.ndarray, gain: np.ndarray, k: int
+) -> np.ndarray:
+    """Indices of at most ``k`` candidates by the quotas of :func:`candidate_goals` (valid
+    ones first; in their original order)."""
+    quotas = {"frontier": k - k // 4, "hidden_room": max(1, k // 8), "info_gain": k}
+    valid = np.isfinite(path_cost)
+    rank = {
+        "frontier": -(size_m - 3.0 * path_cost),
+        "hidden_room": path_cost,
+        "info_gain": -gain / (path_cost + 1.0),
+    }
+    chosen: list[int] = []
+    spare: list[int] = []
+    for name in SOURCES:
+        idx = np.flatnonzero(source == SOURCES.index(name))
+        order = idx[np.lexsort((idx, np.nan_to_num(rank[name][idx], nan=np.inf), ~valid[idx]))]
+        take = min(quotas[name], k - len(chosen))
+        chosen += order[:take].tolist()
+        spare += order[take:].tolist()
+    spare.sort(key=lambda i: (not valid[i], source[i], i))
+    chosen += spare[: k - len(chosen)]
+    return np.array(sorted(chosen), np.int64)
+
+
+def _fill(values: np.ndarray, compute) -> np.ndarray:
+    """``values`` with its NaN entries replaced by ``compute(mask_of_nans)``."""
+    missing = np.isnan(values)
+    if missing.any():
+        values = values.copy()
+        values[missing] = compute(missing)
+    return values
+
+
+def _unknown_bits(view: RobotView) -> np.ndarray:
+    """Entropy (bits) of each unknown cell of the belief; 0 for known cells."""
+    lo = np.abs(view.log_odds.astype(np.float64))
+    e = np.exp(-lo)
+    bits = (np.log1p(e) + lo * e / (1.0 + e)) / _LN2
+    _, _, unknown = belief_classes(view.belief_u8)
+    return np.where(unknown, bits, 0.0)
+
+
+@njit(cache=True)
+def _update_frontier(belief, seen, changed, frontier):  # pragma: no cover (compiled)
+    """Copy the changed cells of ``belief`` into ``seen`` and recompute ``frontier`` (unknown
+    cells 8-adjacent to a believed-free cell) around them."""
+    h, w = belief.shape
+    for i in changed:
+        seen.flat[i] = belief.flat[i]
+    for i in changed:
+        r0 = i // w
+        c0 = i - r0 * w
+        for r in range(max(r0 - 1, 0), min(r0 + 2, h)):
+            for c in range(max(c0 - 1, 0), min(c0 + 2, w)):
+                v = belief[r, c]
+                is_frontier = False
+                if U8_WALL_MAX < v < U8_FREE_MIN:
+                    for rr in range(max(r - 1, 0), min(r + 2, h)):
+                        for cc in range(max(c - 1, 0), min(c + 2, w)):
+                            if belief[rr, cc] >= U8_FREE_MIN:
+                                is_frontier = True
+                frontier[r, c] = is_frontier

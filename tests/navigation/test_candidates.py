@@ -1,0 +1,174 @@
+"""Candidate goals on hand-made belief maps: where frontiers are, never through walls, in units."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sfw_gym.core.constants import NOT_HEARD_DBM, U8_FREE, U8_UNKNOWN, U8_WALL
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.mapping.grid import GridSpec
+from sfw_gym.navigation.candidates import (
+    FEATURES,
+    SOURCES,
+    GoalFinder,
+    candidate_goals,
+)
+from sfw_gym.navigation.frontiers import frontier_mask
+from sfw_gym.navigation.planning import cost_field
+from sfw_gym.navigation.view import RobotView
+
+RES = 0.1
+
+
+def view_of(belief, xy, heading=0.0, routers=((0.05, 0.65),), rssi=-50):
+    """A RobotView on a hand-made belief (unknown cells at log-odds 0: one bit each)."""
+    belief = np.asarray(belief, np.uint8)
+    log_odds = np.where(belief == U8_WALL, 3.0, np.where(belief == U8_FREE, -3.0, 0.0))
+    routers = np.asarray(routers, np.float64)
+    return RobotView(
+        belief_u8=belief,
+        log_odds=log_odds.astype(np.float32),
+        grid=GridSpec((0.0, 0.0), RES, belief.shape),
+        odometry_pose=(float(xy[0]), float(xy[1]), float(heading)),
+        routers_xy=routers,
+        rssi_history=np.full((1, len(routers)), rssi, np.int32),
+        odometry_trajectory=np.array([xy], np.float64),
+        bumped=False,
+        radius_m=0.17,
+        max_linear_speed_m_s=0.5,
+        max_angular_speed_rad_s=1.5,
+        control_period_s=0.2,
+        action_type="continuous",
+    )
+
+
+def corridor(free_cols: int = 33, length: int = 60) -> np.ndarray:
+    """A 1.2 m wide corridor along +x (rows 1-12 free between walls), unknown beyond column
+    ``free_cols``."""
+    b = np.full((14, length), U8_UNKNOWN, np.uint8)
+    b[0, :] = U8_WALL
+    b[13, :] = U8_WALL
+    b[1:13, :free_cols] = U8_FREE
+    return b
+
+
+def test_a_goal_down_a_corridor_costs_its_length_in_metres():
+    view = view_of(corridor(), xy=(0.25, 0.65))  # column 2, the corridor's middle row 6
+    menu = candidate_goals(view, max_candidates=8)
+    frontier = menu.of("frontier")
+    assert len(frontier) == 1 and menu.valid[frontier[0]]
+    i = frontier[0]
+    assert menu.target_rc[i, 1] == 33  # the first unknown column, next to the free space
+    goal_xy = view.grid.cell_to_world(menu.goal_rc[i])
+    straight = float(np.linalg.norm(goal_xy - view.xy))
+    assert 2.9 <= straight <= 3.2  # the goal is about 3 m down the corridor
+    assert menu.feature("path_cost_m")[i] == pytest.approx(straight, abs=RES)
+    target_xy = view.grid.cell_to_world(menu.target_rc[i])
+    assert menu.feature("distance_m")[i] == pytest.approx(np.linalg.norm(target_xy - view.xy))
+    assert menu.feature("cluster_size_m")[i] == pytest.approx(12 * RES)  # 12 cells across
+    assert menu.feature("heading_change_rad")[i] < 0.1  # straight ahead
+    assert menu.feature("unknown_area_m2")[i] > 1.0  # the unknown part of a 1 m disk
+    assert menu.feature("is_hidden_room")[i] == 0.0
+    assert menu.feature("times_tried")[i] == 0 and menu.feature("times_blacklisted")[i] == 0
+    assert menu.feature("strongest_rssi_dbm")[i] == NOT_HEARD_DBM  # never within 1 m of it
+    path = menu.path(i)
+    assert tuple(path[0]) == view.cell and tuple(path[-1]) == tuple(menu.goal_rc[i])
+
+
+def test_heading_change_is_pi_for_a_target_behind():
+    view = view_of(corridor(), xy=(0.25, 0.65), heading=math.pi)
+    i = candidate_goals(view).of("frontier")[0]
+    assert candidate_goals(view).feature("heading_change_rad")[i] == pytest.approx(math.pi, abs=0.1)
+
+
+def test_candidates_sit_on_frontiers_and_every_source_is_known():
+    b = corridor()
+    menu = candidate_goals(view_of(b, xy=(0.25, 0.65)), max_candidates=16)
+    frontier = frontier_mask(b)
+    assert {SOURCES[s] for s in menu.source} <= set(SOURCES)
+    for s, (r, c) in zip(menu.source, menu.target_rc, strict=True):
+        if SOURCES[s] in ("frontier", "info_gain"):
+            assert frontier[r, c]
+    assert menu.features.shape == (len(menu), len(FEATURES))
+    assert len(menu) <= 16
+
+
+def test_no_candidate_through_a_wall():
+    """A frontier beyond a believed wall is on the menu but invalid, with no path."""
+    b = np.full((12, 30), U8_UNKNOWN, np.uint8)
+    b[0:12, 0:12] = U8_WALL
+    b[1:11, 1:11] = U8_FREE  # the robot's room, walled in
+    b[3:8, 14:17] = U8_FREE  # beyond the wall: a free patch ringed by frontier cells
+    b[2:9, 13] = U8_WALL
+    view = view_of(b, xy=(0.55, 0.55), routers=((0.15, 0.15),))
+    menu = candidate_goals(view, max_candidates=64)
+    assert len(menu.of("frontier")) >= 1
+    assert not menu.valid[menu.of("frontier")].any()
+    assert np.isinf(menu.feature("path_cost_m")[menu.of("frontier")]).all()
+    assert all(len(menu.path(i)) == 0 for i in range(len(menu)) if not menu.valid[i])
+    assert len(menu.walled_off_rc) > 0
+
+
+def test_same_view_same_menu():
+    view = view_of(corridor(), xy=(0.25, 0.65))
+    a, b = candidate_goals(view), candidate_goals(view)
+    for name in ("target_rc", "goal_rc", "source", "valid"):
+        assert np.array_equal(getattr(a, name), getattr(b, name))
+    assert np.array_equal(a.features, b.features, equal_nan=True)
+
+
+def test_expected_gain_is_the_entropy_of_the_unknown_cells_updated():
+    """Unknown cells at log-odds 0 carry one bit each: ray (10 cells) plus footprint (2)."""
+    b = np.full((10, 10), U8_FREE, np.uint8)
+    b[4, :] = U8_UNKNOWN
+    view = view_of(b, xy=(0.5, 0.5), routers=((0.05, 0.45),))
+    finder = GoalFinder()
+    finder.reset(view)
+    assert finder.expected_gain(view, np.array([[4, 9]])).tolist() == pytest.approx([12.0])
+
+
+def test_memory_counts_tries_and_blacklists_at_the_target():
+    view = view_of(corridor(), xy=(0.25, 0.65))
+    finder = GoalFinder()
+    finder.reset(view)
+    paths = cost_field(finder.costs(view), view.cell, RES)
+    target = tuple(finder.find(view, paths).target_rc[0])
+    finder.note_tried(target, 3.0)
+    finder.note_tried(target, 3.0)
+    menu = finder.find(view, paths, sources=("frontier",))
+    assert menu.feature("times_tried")[0] == 2
+    finder.blacklist(target, 3.0, until_step=100)
+    assert finder.failed[target]
+    finder.set_step(100)
+    assert not finder.failed[target]
+    assert finder.times_blacklisted[target] == 1
+
+
+def test_incremental_frontier_equals_the_full_computation():
+    rng = np.random.default_rng(0)
+    b = np.full((40, 50), U8_UNKNOWN, np.uint8)
+    view = view_of(b, xy=(1.0, 1.0))
+    finder = GoalFinder()
+    finder.reset(view)
+    for _ in range(30):  # random patches of free, wall and unknown, as rays would write them
+        r, c = rng.integers(0, 38), rng.integers(0, 48)
+        b[r : r + rng.integers(1, 6), c : c + rng.integers(1, 6)] = rng.choice(
+            [U8_FREE, U8_WALL, U8_UNKNOWN, 150, 90]
+        )
+        assert np.array_equal(finder.frontier(view_of(b, xy=(1.0, 1.0))), frontier_mask(b))
+
+
+def test_unknown_names_are_refused():
+    view = view_of(corridor(), xy=(0.25, 0.65))
+    finder = GoalFinder()
+    finder.reset(view)
+    paths = cost_field(finder.costs(view), view.cell, RES)
+    with pytest.raises(ValueError, match="unknown names"):
+        finder.find(view, paths, sources=("frontiers",))
+    with pytest.raises(ValueError, match="unknown names"):
+        finder.find(view, paths, features=("path_cost",))
+    with pytest.raises(ConfigError, match="did you mean 'unknown_cost'"):
+        candidate_goals(view, unknown_cots=2.0)
