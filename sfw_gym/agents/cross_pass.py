@@ -54,6 +54,7 @@ class CrossPassAgent(FrontierAgent):
     """
 
     name = "cross-pass"
+    _bounded_search = False
     _committed_kinds = ("pass",)
 
     def __init__(

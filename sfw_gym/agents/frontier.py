@@ -47,7 +47,7 @@ from scipy import ndimage
 
 from sfw_gym.agents.base import Agent, RobotView
 from sfw_gym.core.config import check
-from sfw_gym.core.constants import U8_WALL_MAX
+from sfw_gym.core.constants import U8_FREE_MIN, U8_WALL_MAX
 from sfw_gym.navigation.candidates import CandidateSettings, GoalFinder
 from sfw_gym.navigation.planning import (
     CostField,
@@ -80,6 +80,10 @@ class Goal:
     bumps: int = 0
 
 
+#: What :meth:`FrontierAgent._choose_goal` returns when a bounded search cannot prove its choice.
+_UNCERTAIN = Goal((-1, -1), (-1, -1), "uncertain")
+
+
 class FrontierAgent(Agent):
     """Frontier exploration with explore_lite's utility, a grid planner and pure pursuit.
 
@@ -91,8 +95,10 @@ class FrontierAgent(Agent):
             blacklisted.
         blacklist_radius_m: Frontier cells this close to a blacklisted goal are skipped.
         replan_every_steps: Re-pick the goal at least this often, as the map changes.
-        min_replan_steps: A resolved frontier target triggers a replan only this many steps
-            after the last one (other events replan at once).
+        search_radius_m: Each replan first searches paths up to this cost (m). The choice is
+            kept only if no cluster beyond could have a higher utility (a cluster at least this
+            far costs at least this much), so the goal is the one a full search would pick; else
+            the search covers the whole map.
         unknown_cost: Planner cost of an unknown cell (a free one costs 1).
         bump_exclusion_m: Frontier cells this close to a bump are not goals (walls).
         lookahead_m: Pure-pursuit carrot distance.
@@ -124,6 +130,9 @@ class FrontierAgent(Agent):
     name = "frontier"
     #: Goal kinds that periodic replanning re-paths to instead of re-choosing.
     _committed_kinds: tuple[str, ...] = ()
+    #: Whether :meth:`_choose_goal` can prove its choice on a bounded search (explore_lite's
+    #: utility falls with the path's cost; the subclasses' menus need every cost).
+    _bounded_search = True
 
     def __init__(
         self,
@@ -133,7 +142,7 @@ class FrontierAgent(Agent):
         progress_timeout_steps: int = 30,
         blacklist_radius_m: float = 0.3,
         replan_every_steps: int = 5,
-        min_replan_steps: int = 1,
+        search_radius_m: float = 4.0,
         unknown_cost: float = 1.5,
         bump_exclusion_m: float = 0.3,
         lookahead_m: float = 0.4,
@@ -164,7 +173,7 @@ class FrontierAgent(Agent):
         self.replan_every_steps = check(
             "replan_every_steps", replan_every_steps, integer=True, ge=1
         )
-        self.min_replan_steps = check("min_replan_steps", min_replan_steps, integer=True, ge=1)
+        self.search_radius_m = check("search_radius_m", search_radius_m, gt=0.0)
         self.backoff_steps = check("backoff_steps", backoff_steps, integer=True, ge=0)
         self.max_bumps_per_goal = check(
             "max_bumps_per_goal", max_bumps_per_goal, integer=True, ge=1
@@ -209,6 +218,7 @@ class FrontierAgent(Agent):
         self.n_goals = 0
         self.n_bumps = 0
         self.n_plans = 0
+        self.n_full_searches = 0
         self.candidates: list[tuple[tuple[int, int], float]] = []
 
     def _candidate_settings(self) -> CandidateSettings:
@@ -297,20 +307,13 @@ class FrontierAgent(Agent):
 
     def _needs_plan(self, view: RobotView, bumped: bool) -> bool:
         """Replan on events: no goal or path, a bump, the path blocked by a new wall, the
-        frontier target resolved (at most every ``min_replan_steps``); else every
-        ``replan_every_steps`` as the map changes."""
+        frontier target resolved; else every ``replan_every_steps`` as the map changes."""
         goal = self.goal
         if goal is None or bumped or not self.follower.has_path:
             return True
-        if self._since_plan >= self.replan_every_steps:
+        if self._since_plan >= self.replan_every_steps or self._path_blocked(view):
             return True
-        if self._path_blocked(view):
-            return True
-        return (
-            goal.kind == "frontier"
-            and self._since_plan >= self.min_replan_steps
-            and not self._still_unknown(view, goal.target)
-        )
+        return goal.kind == "frontier" and not self._still_unknown(view, goal.target)
 
     def _path_blocked(self, view: RobotView) -> bool:
         """Whether a cell of the current path has become a believed wall or a bump."""
@@ -323,8 +326,7 @@ class FrontierAgent(Agent):
 
     @staticmethod
     def _still_unknown(view: RobotView, cell: tuple[int, int]) -> bool:
-        _, _, unknown = belief_classes(view.belief_u8[cell[0], cell[1]])
-        return bool(unknown)
+        return U8_WALL_MAX < int(view.belief_u8[cell[0], cell[1]]) < U8_FREE_MIN
 
     # -- bookkeeping -----------------------------------------------------------------------------
     def _blacklist(self, goal: Goal) -> None:
@@ -377,14 +379,24 @@ class FrontierAgent(Agent):
         self.n_plans += 1
         goal = self.goal
         relaxed = goal is not None and goal.kind == "escape"
-        paths = cost_field(self._costs(view, relaxed), view.cell, view.grid.resolution_m)
-        if goal is not None and goal.kind in (*self._committed_kinds, "escape"):
+        committed = goal is not None and goal.kind in (*self._committed_kinds, "escape")
+        costs = self._costs(view, relaxed)
+        res = view.grid.resolution_m
+        bound = self.search_radius_m if self._bounded_search and not committed else np.inf
+        paths = cost_field(costs, view.cell, res, max_cost_m=bound)
+        if committed:
+            assert goal is not None
             if np.isfinite(paths.cumulative[goal.cell]):
                 self._set_goal(view, paths, goal)
                 return
             self._blacklist(goal)
         stalled = self._stalled(view)
         goal = None if stalled else self._choose_goal(view, paths)
+        if not paths.complete and (goal is None or goal is _UNCERTAIN):
+            # The bounded search could not prove its choice (or found none): search everywhere.
+            self.n_full_searches += 1
+            paths = cost_field(costs, view.cell, res)
+            goal = None if stalled else self._choose_goal(view, paths)
         if goal is None:
             # No frontier to drive to (or the map stopped growing), yet unknown space may hide
             # behind the map's walls (a doorway closed by blurred or bump-made walls). Doubt
@@ -475,7 +487,12 @@ class FrontierAgent(Agent):
             "heading_change_rad"
         )
         best: tuple[float, int] | None = None
+        beyond = -np.inf  # the best utility a cluster beyond a bounded search could have
         for i in range(len(menu)):
+            if not paths.complete and not menu.feature("path_cost_m")[i] < paths.max_cost_m:
+                u_max = self._utility(view, menu.clusters[i], paths.max_cost_m)
+                beyond = max(beyond, u_max)
+                continue
             if not menu.valid[i]:  # walled off on the belief map: blacklisted a while
                 self.finder.mark_unreachable(
                     menu.clusters[i], self.steps + self.unreachable_ttl_steps
@@ -486,6 +503,8 @@ class FrontierAgent(Agent):
             self.candidates.append(((int(menu.target_rc[i, 0]), int(menu.target_rc[i, 1])), u))
             if best is None or u > best[0]:
                 best = (u, i)
+        if (best[0] if best else -np.inf) < beyond:
+            return _UNCERTAIN  # a cluster beyond the search might be better: search everywhere
         if best is None:
             self._stop("all_blacklisted")
             return None

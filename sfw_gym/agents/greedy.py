@@ -37,6 +37,7 @@ class GreedyInfoGainAgent(FrontierAgent):
     """
 
     name = "greedy"
+    _bounded_search = False
 
     def __init__(
         self,

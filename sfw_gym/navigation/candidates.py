@@ -32,7 +32,7 @@ from sfw_gym.core.constants import NOT_HEARD_DBM, U8_FREE_MIN, U8_WALL_MAX
 from sfw_gym.mapping.grid import belief_classes
 from sfw_gym.navigation.frontiers import (
     EIGHT_CONNECTED,
-    find_frontiers,
+    cluster_cells,
     frontier_mask,
     hidden_rooms,
 )
@@ -44,6 +44,8 @@ from sfw_gym.navigation.planning import (
     free_start,
     mark_contact,
     traversal_costs,
+    update_wall_cost_term,
+    wall_cost_term,
     wall_distance_m,
 )
 from sfw_gym.navigation.radio_zones import router_scores
@@ -171,8 +173,8 @@ class GoalFinder:
         self._centres = grid.cell_centres()
         self._belief = np.array(view.belief_u8, np.uint8)
         self._frontier = frontier_mask(self._belief)
-        self._walls_seen: np.ndarray | None = None
-        self._wall_distance = np.zeros(shape)
+        self._walls_seen = np.zeros(shape, bool)
+        self._wall_term = np.zeros(shape)
         self._near_bump = np.zeros(shape, bool)
         self._heard = np.full(shape, float(NOT_HEARD_DBM))
         self._n_heard = 0
@@ -228,21 +230,22 @@ class GoalFinder:
     def costs(self, view: RobotView, escape_wall_cost: float | None = None) -> np.ndarray:
         """Planner costs with the robot's cell passable. With ``escape_wall_cost``, believed walls
         cost that much per cell (bumps 4×) instead of blocking: the map's walls are doubted."""
-        _, walls, _ = belief_classes(view.belief_u8)
+        _, walls, unknown = belief_classes(view.belief_u8)
         res, radius = view.grid.resolution_m, view.radius_m
         if escape_wall_cost is None:
+            # traversal_costs, with its wall-only term cached while the walls stay put
             blocked = walls | self.bumps
-            if self._walls_seen is None or not np.array_equal(blocked, self._walls_seen):
-                self._walls_seen = blocked
-                self._wall_distance = wall_distance_m(blocked, res)
-            cost = traversal_costs(
-                view.belief_u8,
-                res,
-                radius,
-                unknown_cost=self.settings.unknown_cost,
-                blocked=self.bumps,
-                wall_distance=self._wall_distance,
-            )
+            changed = np.flatnonzero(blocked != self._walls_seen)
+            if len(changed) > blocked.size // 20:  # many changes: one distance transform
+                self._wall_term = (
+                    wall_cost_term(wall_distance_m(blocked, res), res, radius)
+                    if blocked.any()
+                    else np.zeros(blocked.shape)
+                )
+            elif len(changed):
+                update_wall_cost_term(self._wall_term, blocked, changed, res, radius)
+            self._walls_seen = blocked
+            cost = np.where(unknown, self.settings.unknown_cost, 1.0) + self._wall_term
         else:
             cost = traversal_costs(
                 view.belief_u8, res, radius, unknown_cost=self.settings.unknown_cost
@@ -263,30 +266,23 @@ class GoalFinder:
         return out
 
     def approach_cell(self, paths: CostField, target: tuple[int, int]) -> tuple[int, int]:
-        """The cheapest reachable cell whose footprint covers ``target``."""
-        h, w = paths.cumulative.shape
-        cells = np.asarray(target) + self.reach_offsets
-        ok = (cells[:, 0] >= 0) & (cells[:, 0] < h) & (cells[:, 1] >= 0) & (cells[:, 1] < w)
-        cells = cells[ok]
-        i = int(np.argmin(paths.cumulative[cells[:, 0], cells[:, 1]]))
-        return int(cells[i, 0]), int(cells[i, 1])
+        """The cheapest reachable cell whose footprint covers ``target`` (``target`` if none)."""
+        r, c = self.approach_cells(paths, np.asarray([target]))[0]
+        return int(r), int(c)
+
+    def approach_at(self, paths: CostField, targets: np.ndarray) -> np.ndarray:
+        """:meth:`approach` at ``targets`` ``(N, 2)`` only."""
+        cells = np.asarray(targets, np.int64).reshape(-1, 2)
+        return _min_over_offsets(paths.cumulative, cells, self.reach_offsets)[0]
 
     def approach_cells(self, paths: CostField, targets: np.ndarray) -> np.ndarray:
         """:meth:`approach_cell` of each of ``targets`` ``(N, 2)`` (the target where none is
         reachable)."""
-        cum = paths.cumulative
-        h, w = cum.shape
-        cells = targets[:, None, :] + self.reach_offsets[None, :, :]
-        inside = (cells[..., 0] >= 0) & (cells[..., 0] < h) & (cells[..., 1] >= 0)
-        inside &= cells[..., 1] < w
-        cost = np.where(
-            inside, cum[cells[..., 0].clip(0, h - 1), cells[..., 1].clip(0, w - 1)], np.inf
-        )
-        best = np.argmin(cost, axis=1)
-        out = cells[np.arange(len(targets)), best]
-        unreachable = ~np.isfinite(cost[np.arange(len(targets)), best])
-        out[unreachable] = targets[unreachable]
-        return out.astype(np.int64)
+        cells = np.asarray(targets, np.int64).reshape(-1, 2)
+        cost, best = _min_over_offsets(paths.cumulative, cells, self.reach_offsets)
+        out = cells + self.reach_offsets[best]
+        out[~np.isfinite(cost)] = cells[~np.isfinite(cost)]
+        return out
 
     def heading_change(self, view: RobotView, cells: np.ndarray) -> np.ndarray:
         """|bearing from the robot to each cell − heading|, radians in [0, π]."""
@@ -296,18 +292,28 @@ class GoalFinder:
         bearing = np.arctan2(ys[r, c] - y, xs[r, c] - x) - th
         return np.abs((bearing + np.pi) % (2 * np.pi) - np.pi)
 
-    def exclusion(self, view: RobotView) -> np.ndarray:
+    def exclusion(self, view: RobotView, only: np.ndarray | None = None) -> np.ndarray:
         """Cells that are no frontier goals: near a bump (walls), failed or walled off, or in a
-        small unknown pocket inside known space (it will be resolved in passing)."""
+        small unknown pocket inside known space (it will be resolved in passing). With ``only``
+        (a mask), the pockets are looked for from those cells alone (a bounded flood fill from
+        each, much cheaper than labelling the whole map; the same answer at those cells)."""
         exclude = self._near_bump | self.failed | self.unreachable
-        if self.settings.min_unknown_region_m2 > 0:
+        min_area = self.settings.min_unknown_region_m2
+        if min_area > 0:
             res = view.grid.resolution_m
             _, _, unknown = belief_classes(view.belief_u8)
-            labels, n = ndimage.label(unknown, structure=EIGHT_CONNECTED)
-            if n:
-                area = np.bincount(labels.ravel(), minlength=n + 1) * res * res
-                area[0] = np.inf
-                exclude |= area[labels] < self.settings.min_unknown_region_m2
+            if only is not None:
+                n_big = int(np.ceil(min_area / res**2 - 1e-9))
+                while n_big * res * res < min_area:  # the smallest count that is not a pocket
+                    n_big += 1
+                seeds = np.flatnonzero(only & unknown)
+                exclude |= _small_pockets(unknown, seeds, n_big)
+            else:
+                labels, n = ndimage.label(unknown, structure=EIGHT_CONNECTED)
+                if n:
+                    area = np.bincount(labels.ravel(), minlength=n + 1) * res * res
+                    area[0] = np.inf
+                    exclude |= area[labels] < min_area
         return exclude
 
     def strongest_router(self, view: RobotView) -> np.ndarray:
@@ -388,21 +394,22 @@ class GoalFinder:
             if unknown_names:
                 raise ValueError(f"unknown names {sorted(unknown_names)}; known: {known}")
         res = view.grid.resolution_m
-        approach = self.approach(paths)
         frontier = self.frontier(view)
-        open_frontier = frontier & ~self.exclusion(view)
-        walled_off_rc = np.argwhere(open_frontier & ~np.isfinite(approach))
+        open_frontier = frontier & ~self.exclusion(view, only=frontier)
+        open_cells = np.argwhere(open_frontier)
+        reachable = np.isfinite(self.approach_at(paths, open_cells))
+        walled_off_rc = open_cells[~reachable]
         targets: list[np.ndarray] = [np.zeros((0, 2), np.int64)]
         source: list[np.ndarray] = []
         sizes: list[np.ndarray] = []
         clusters: list[np.ndarray] = []
         for name in sources:
             if name == "frontier":
-                cells, size, cl = self._frontier_targets(view, approach, open_frontier)
+                cells, size, cl = self._frontier_targets(view, paths, open_frontier)
             elif name == "hidden_room":
                 cells, size, cl = self.hidden_room_targets(view)
             else:
-                cells = np.argwhere(open_frontier & np.isfinite(approach))
+                cells = open_cells[reachable]
                 k = self.settings.info_gain_samples
                 if len(cells) > k:
                     cells = cells[np.linspace(0, len(cells) - 1, k).astype(int)]
@@ -414,7 +421,7 @@ class GoalFinder:
         target_rc = np.concatenate(targets).astype(np.int64)
         src = np.concatenate([np.zeros(0, np.int64), *source])
         size_m = np.concatenate([np.zeros(0), *sizes]) * res
-        path_cost = approach[target_rc[:, 0], target_rc[:, 1]]
+        path_cost = self.approach_at(paths, target_rc)
         gain = np.full(len(target_rc), np.nan)
         info = src == SOURCES.index("info_gain")
         if info.any() and (max_candidates is not None or "expected_gain_bits" in features):
@@ -469,17 +476,17 @@ class GoalFinder:
         )
 
     def _frontier_targets(
-        self, view: RobotView, approach: np.ndarray, open_frontier: np.ndarray
+        self, view: RobotView, paths: CostField, open_frontier: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
         """Per frontier cluster (largest first): its cheapest cell to resolve (path + turn)."""
         res = view.grid.resolution_m
         min_cells = max(1, round(self.settings.min_frontier_size_m / res))
         turn = self.settings.turn_cost_m_per_rad
-        clusters = [f.cells for f in find_frontiers(view.belief_u8, min_cells, mask=open_frontier)]
+        clusters = cluster_cells(open_frontier, min_cells)
         if not clusters:
             return np.zeros((0, 2), np.int64), np.zeros(0), []
         every = np.concatenate(clusters)
-        cost = approach[every[:, 0], every[:, 1]]
+        cost = self.approach_at(paths, every)
         if turn > 0:
             cost = cost + turn * self.heading_change(view, every)
         sizes = np.array([len(c) for c in clusters])
@@ -563,3 +570,62 @@ def _update_frontier(belief, seen, changed, frontier):  # pragma: no cover (comp
                             if belief[rr, cc] >= U8_FREE_MIN:
                                 is_frontier = True
                 frontier[r, c] = is_frontier
+
+
+@njit(cache=True)
+def _small_pockets(unknown, seeds, n_big):  # pragma: no cover (compiled)
+    """Cells of the 8-connected components of ``unknown`` with fewer than ``n_big`` cells that
+    contain a seed (flat indices). Each flood fill stops at ``n_big`` cells or at a cell known to
+    lie in a big component, so every cell is visited at most once."""
+    h, w = unknown.shape
+    state = np.zeros(h * w, np.int8)  # 0 unseen, 1 being filled, 2 small, 3 big
+    queue = np.empty(max(n_big, 1), np.int64)
+    for i0 in seeds:
+        if state[i0] != 0 or not unknown.flat[i0]:
+            continue
+        state[i0] = 1
+        queue[0] = i0
+        n, head, big = 1, 0, n_big <= 1
+        while head < n and not big:
+            i = queue[head]
+            head += 1
+            r = i // w
+            c = i - r * w
+            for rr in range(max(r - 1, 0), min(r + 2, h)):
+                for cc in range(max(c - 1, 0), min(c + 2, w)):
+                    j = rr * w + cc
+                    if not unknown[rr, cc] or state[j] == 1 or state[j] == 2:
+                        continue
+                    if state[j] == 3 or n == n_big:
+                        big = True
+                        break
+                    state[j] = 1
+                    queue[n] = j
+                    n += 1
+                if big:
+                    break
+        mark = 3 if big or n >= n_big else 2
+        for k in range(n):
+            state[queue[k]] = mark
+    out = np.zeros((h, w), np.bool_)
+    for k in range(h * w):
+        if state[k] == 2:
+            out.flat[k] = True
+    return out
+
+
+@njit(cache=True)
+def _min_over_offsets(values, cells, offsets):  # pragma: no cover (compiled)
+    """Per cell ``(N, 2)``: the minimum of ``values`` over ``cell + offsets`` inside the grid,
+    and the index of the first offset that attains it (0 where none is finite)."""
+    h, w = values.shape
+    out = np.full(len(cells), np.inf)
+    arg = np.zeros(len(cells), np.int64)
+    for i in range(len(cells)):
+        for k in range(len(offsets)):
+            r = cells[i, 0] + offsets[k, 0]
+            c = cells[i, 1] + offsets[k, 1]
+            if 0 <= r < h and 0 <= c < w and values[r, c] < out[i]:
+                out[i] = values[r, c]
+                arg[i] = k
+    return out, arg

@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 from scipy import ndimage
 
 from sfw_gym.navigation.planning import belief_classes
@@ -82,25 +83,74 @@ def find_frontiers(
         mask = frontier_mask(belief_u8, exclude)
     elif exclude is not None:
         mask = mask & ~exclude
-    labels, n = ndimage.label(mask, structure=EIGHT_CONNECTED)
-    if n == 0:
-        return []
-    rows, cols = np.nonzero(labels)
-    lab = labels[rows, cols]
-    sizes = np.bincount(lab, minlength=n + 1)
-    keep = sizes[lab] >= min_size_cells
-    rows, cols, lab = rows[keep], cols[keep], lab[keep]
-    if not len(lab):
-        return []
-    order = np.argsort(lab, kind="stable")
-    rows, cols, lab = rows[order], cols[order], lab[order]
-    starts = np.flatnonzero(np.r_[True, lab[1:] != lab[:-1]])
-    ends = np.r_[starts[1:], len(lab)]
     out = []
-    for a, b in zip(starts, ends, strict=True):
-        cells = np.stack([rows[a:b], cols[a:b]], axis=1)
-        out.append(
-            Frontier(cells, (float(rows[a:b].sum() / (b - a)), float(cols[a:b].sum() / (b - a))))
-        )
-    out.sort(key=lambda f: -f.size)
+    for cells in cluster_cells(mask, min_size_cells):
+        out.append(Frontier(cells, (float(cells[:, 0].mean()), float(cells[:, 1].mean()))))
     return out
+
+
+def cluster_cells(mask: np.ndarray, min_size_cells: int = 1) -> list[np.ndarray]:
+    """The 8-connected clusters of ``mask`` with at least ``min_size_cells`` cells, largest first
+    (ties in the order of their first cell in raster order, as :func:`scipy.ndimage.label`
+    numbers them), each as ``(N, 2)`` cells ``(row, col)`` in raster order."""
+    flat = np.flatnonzero(mask)
+    if not len(flat):
+        return []
+    order, bounds = _clusters(np.ascontiguousarray(mask), flat, int(min_size_cells))
+    cells = np.stack(np.divmod(flat[order], mask.shape[1]), axis=1)
+    return [cells[bounds[k] : bounds[k + 1]] for k in range(len(bounds) - 1)]
+
+
+@njit(cache=True)
+def _clusters(mask, flat, min_size):  # pragma: no cover (compiled)
+    """Label the cells ``flat`` (raster order) of ``mask`` by 8-connected flood fill, numbering
+    clusters by their first cell; return the cells' positions in ``flat`` grouped by cluster
+    (largest first, ties by number; raster order inside) and the groups' bounds."""
+    h, w = mask.shape
+    where = np.full(h * w, -1, np.int64)  # position of each mask cell in ``flat``
+    for k in range(len(flat)):
+        where[flat[k]] = k
+    label = np.full(len(flat), -1, np.int64)
+    queue = np.empty(len(flat), np.int64)
+    n_labels = 0
+    for k in range(len(flat)):
+        if label[k] >= 0:
+            continue
+        label[k] = n_labels
+        queue[0] = k
+        head, tail = 0, 1
+        while head < tail:
+            i = flat[queue[head]]
+            head += 1
+            r = i // w
+            c = i - r * w
+            for rr in range(max(r - 1, 0), min(r + 2, h)):
+                for cc in range(max(c - 1, 0), min(c + 2, w)):
+                    j = where[rr * w + cc]
+                    if j >= 0 and label[j] < 0:
+                        label[j] = n_labels
+                        queue[tail] = j
+                        tail += 1
+        n_labels += 1
+    size = np.zeros(n_labels, np.int64)
+    for k in range(len(flat)):
+        size[label[k]] += 1
+    by_size = np.argsort(-size, kind="mergesort")  # stable: ties keep their numbering
+    n_kept = 0
+    for m in by_size:
+        if size[m] >= min_size:
+            n_kept += 1
+    bounds = np.zeros(n_kept + 1, np.int64)
+    start = np.zeros(n_labels, np.int64)
+    for q in range(n_kept):
+        m = by_size[q]
+        bounds[q + 1] = bounds[q] + size[m]
+        start[m] = bounds[q]
+    order = np.empty(bounds[n_kept], np.int64)
+    fill = start.copy()
+    for k in range(len(flat)):  # raster order inside each cluster
+        m = label[k]
+        if size[m] >= min_size:
+            order[fill[m]] = k
+            fill[m] += 1
+    return order, bounds

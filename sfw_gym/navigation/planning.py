@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from itertools import pairwise
 
 import numpy as np
 from numba import njit
@@ -64,12 +63,90 @@ def traversal_costs(
     cost = np.where(unknown, float(unknown_cost), 1.0)
     if wall.any():
         dist = wall_distance_m(wall, resolution_m) if wall_distance is None else wall_distance
-        outer = radius_m + clearance_m
-        band = dist < outer
-        cost[band] += inflation_cost * np.clip((outer - dist[band]) / clearance_m, 0.0, 1.0)
-        lethal = 0.5 * resolution_m if lethal_radius_m is None else lethal_radius_m
-        cost[dist <= lethal] = np.inf
+        cost += wall_cost_term(
+            dist, resolution_m, radius_m, inflation_cost, clearance_m, lethal_radius_m
+        )
     return cost
+
+
+def wall_cost_term(
+    wall_distance: np.ndarray,
+    resolution_m: float,
+    radius_m: float,
+    inflation_cost: float = 8.0,
+    clearance_m: float = 0.2,
+    lethal_radius_m: float | None = None,
+) -> np.ndarray:
+    """The part of :func:`traversal_costs` that depends on the walls alone (added to the cell's
+    own cost): the inflation band, and ``inf`` within the lethal radius."""
+    outer = radius_m + clearance_m
+    term = inflation_cost * np.clip((outer - wall_distance) / clearance_m, 0.0, 1.0)
+    lethal = 0.5 * resolution_m if lethal_radius_m is None else lethal_radius_m
+    term[wall_distance <= lethal] = np.inf
+    return term
+
+
+def update_wall_cost_term(
+    term: np.ndarray,
+    walls: np.ndarray,
+    changed: np.ndarray,
+    resolution_m: float,
+    radius_m: float,
+    inflation_cost: float = 8.0,
+    clearance_m: float = 0.2,
+    lethal_radius_m: float | None = None,
+) -> None:
+    """Bring ``term`` (:func:`wall_cost_term` of an earlier ``walls``) up to date in place, where
+    the cells ``changed`` (flat indices) became or stopped being walls: only the cells within
+    the band's reach of them are recomputed, with the same formula (the same values as a full
+    recomputation)."""
+    outer = radius_m + clearance_m
+    lethal = 0.5 * resolution_m if lethal_radius_m is None else lethal_radius_m
+    reach = int(np.ceil(outer / resolution_m)) + 1
+    dr, dc = np.mgrid[-reach : reach + 1, -reach : reach + 1]
+    dist = np.sqrt((dr * dr + dc * dc).astype(np.float64)).ravel() * resolution_m
+    near = dist < outer
+    order = np.argsort(dist[near], kind="stable")  # nearest first: the first wall found is it
+    offsets = np.stack([dr.ravel()[near], dc.ravel()[near]], axis=1)[order]
+    _update_wall_term(
+        term,
+        walls,
+        changed,
+        offsets,
+        dist[near][order],
+        reach,
+        outer,
+        clearance_m,
+        inflation_cost,
+        lethal,
+    )
+
+
+@njit(cache=True)
+def _update_wall_term(
+    term, walls, changed, offsets, dist, reach, outer, clearance, inflation, lethal
+):  # pragma: no cover (compiled)
+    h, w = walls.shape
+    stamp = np.zeros(h * w, np.bool_)
+    for i in changed:
+        r0 = i // w
+        c0 = i - r0 * w
+        for r in range(max(r0 - reach, 0), min(r0 + reach + 1, h)):
+            for c in range(max(c0 - reach, 0), min(c0 + reach + 1, w)):
+                if stamp[r * w + c]:
+                    continue
+                stamp[r * w + c] = True
+                value = 0.0
+                for k in range(len(offsets)):
+                    rr = r + offsets[k, 0]
+                    cc = c + offsets[k, 1]
+                    if 0 <= rr < h and 0 <= cc < w and walls[rr, cc]:
+                        d = dist[k]
+                        value = inflation * min(max((outer - d) / clearance, 0.0), 1.0)
+                        if d <= lethal:
+                            value = np.inf
+                        break
+                term[r, c] = value
 
 
 def wall_distance_m(walls: np.ndarray, resolution_m: float) -> np.ndarray:
@@ -106,12 +183,20 @@ class CostField:
         cumulative: Path cost to each cell, in metres × cell cost (``inf`` = unreachable).
         resolution_m: Cell size, metres.
         predecessor: Flat index of each cell's predecessor on its cheapest path (-1: none).
+        max_cost_m: The search stopped beyond this cost (``inf``: it covered every cell): cells
+            that cost more are ``inf`` here whether they are reachable or not.
     """
 
     start_rc: tuple[int, int]
     cumulative: np.ndarray
     resolution_m: float
     predecessor: np.ndarray
+    max_cost_m: float = np.inf
+
+    @property
+    def complete(self) -> bool:
+        """Whether every reachable cell has its cost (the search was not bounded)."""
+        return not np.isfinite(self.max_cost_m)
 
     def reachable(self) -> np.ndarray:
         """Mask of cells with a finite path cost."""
@@ -126,40 +211,50 @@ class CostField:
         return np.stack(np.divmod(flat, w), axis=1)
 
 
-def cost_field(cost: np.ndarray, start_rc: tuple[int, int], resolution_m: float) -> CostField:
+def cost_field(
+    cost: np.ndarray,
+    start_rc: tuple[int, int],
+    resolution_m: float,
+    max_cost_m: float = np.inf,
+) -> CostField:
     """Dijkstra from ``start_rc`` over ``cost`` (8-connected; ``inf`` cells are obstacles; every
-    other cell costs at least 1, as :func:`traversal_costs` makes them)."""
-    finite = cost[np.isfinite(cost)]
-    if finite.size and finite.min() < 1.0:
-        raise ValueError(f"cell costs must be >= 1 (or inf), got {finite.min()}")
+    other cell costs at least 1, as :func:`traversal_costs` makes them). With a finite
+    ``max_cost_m`` the search stops there: cheaper cells get their exact cost, the rest ``inf``."""
     h, w = cost.shape
     r, c = int(start_rc[0]), int(start_rc[1])
     r, c = min(max(r, 0), h - 1), min(max(c, 0), w - 1)
     cum = np.empty((h, w), np.float64)
     pred = np.empty(h * w, np.int64)
-    _dijkstra_8(np.ascontiguousarray(cost, np.float64), r, c, cum, pred)
-    return CostField((r, c), cum * resolution_m, resolution_m, pred)
+    limit = max_cost_m / resolution_m if np.isfinite(max_cost_m) else np.inf
+    cheapest = _dijkstra_8(np.ascontiguousarray(cost, np.float64), r, c, cum, pred, limit)
+    if cheapest < 1.0:
+        raise ValueError(f"cell costs must be >= 1 (or inf), got {cheapest}")
+    return CostField((r, c), cum * resolution_m, resolution_m, pred, float(max_cost_m))
 
 
 @njit(cache=True)
-def _dijkstra_8(cost, r0, c0, cum, pred):  # pragma: no cover (compiled)
+def _dijkstra_8(cost, r0, c0, cum, pred, limit):  # pragma: no cover (compiled)
     """Single-source Dijkstra on the 8-connected grid with MCP_Geometric's edge costs.
 
     Cells cost at least 1, so every edge does: a bucket queue of width 1 (Dial's algorithm)
     then settles nodes in a valid order (no node in a bucket can improve another in it), which
     gives Dijkstra's exact costs without a heap. Entries improved later stay in their bucket
-    and are skipped when popped.
+    and are skipped when popped. The search stops at the first bucket beyond ``limit`` (cell
+    units); cells not settled by then are set back to ``inf``.
     """
     h, w = cost.shape
     cum[:] = np.inf
     pred[:] = -1
     done = np.zeros(h * w, np.bool_)
     diagonal = math.sqrt(2.0)
-    max_cost = 1.0
+    max_cost, min_cost = 1.0, np.inf
     for r in range(h):
         for c in range(w):
             if max_cost < cost[r, c] < np.inf:
                 max_cost = cost[r, c]
+            min_cost = min(min_cost, cost[r, c])
+    if min_cost < 1.0:
+        return min_cost  # refused by cost_field
     n_buckets = int(max_cost * diagonal) + 2  # > the longest edge: the ring never wraps onto itself
     head = np.full(n_buckets, -1, np.int64)  # per bucket, its newest entry
     node = np.empty(8 * h * w + 1, np.int64)  # entries: the node and the bucket's next entry
@@ -168,6 +263,12 @@ def _dijkstra_8(cost, r0, c0, cum, pred):  # pragma: no cover (compiled)
     n_entries, pending, bucket = 1, 1, 0
     cum[r0, c0] = 0.0
     while pending > 0:
+        if bucket > limit:
+            for k in range(h * w):
+                if not done[k]:
+                    cum.flat[k] = np.inf
+                    pred[k] = -1
+            return min_cost
         e = head[bucket % n_buckets]
         if e < 0:
             bucket += 1
@@ -199,6 +300,7 @@ def _dijkstra_8(cost, r0, c0, cum, pred):  # pragma: no cover (compiled)
                     node[n_entries], below[n_entries], head[slot] = j, head[slot], n_entries
                     n_entries += 1
                     pending += 1
+    return min_cost
 
 
 @njit(cache=True)
@@ -232,12 +334,11 @@ def densify_path(path_xy: np.ndarray, spacing_m: float) -> np.ndarray:
     """Insert points along a polyline so that neighbours lie at most ``spacing_m`` apart."""
     if len(path_xy) < 2:
         return path_xy
-    out = [path_xy[:1]]
-    for a, b in pairwise(path_xy):
-        n = max(1, int(np.ceil(np.linalg.norm(b - a) / spacing_m)))
-        t = np.arange(1, n + 1)[:, None] / n
-        out.append(a + (b - a) * t)
-    return np.concatenate(out)
+    legs = np.diff(path_xy, axis=0)
+    n = np.maximum(1, np.ceil(np.hypot(legs[:, 0], legs[:, 1]) / spacing_m).astype(np.int64))
+    leg = np.repeat(np.arange(len(legs)), n)  # the leg of each new point
+    t = (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n) + 1) / np.repeat(n, n)
+    return np.concatenate([path_xy[:1], path_xy[leg] + legs[leg] * t[:, None]])
 
 
 def cells_to_world(grid: GridSpec, cells_rc: np.ndarray) -> np.ndarray:
@@ -303,11 +404,9 @@ class PurePursuit:
         # Advance the progress index to the nearest path point (never backwards).
         window = self.path[self._progress : self._progress + 20]
         self._progress += int(np.argmin(np.linalg.norm(window - xy, axis=1)))
-        carrot = self.path[-1]
-        for p in self.path[self._progress :]:
-            if np.linalg.norm(p - xy) >= self.lookahead_m:
-                carrot = p
-                break
+        ahead = self.path[self._progress :]
+        far = np.flatnonzero(np.hypot(*(ahead - xy).T) >= self.lookahead_m)
+        carrot = ahead[far[0]] if len(far) else self.path[-1]
         bearing = wrap_angle(math.atan2(carrot[1] - xy[1], carrot[0] - xy[0]) - pose[2])
         angular = float(np.clip(self.angular_gain * bearing, -1.0, 1.0))
         if abs(bearing) > self.turn_in_place_rad:

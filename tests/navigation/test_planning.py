@@ -417,3 +417,20 @@ def test_cost_field_refuses_cells_cheaper_than_one():
     cost[2, 2] = 0.5
     with pytest.raises(ValueError, match="cell costs must be >= 1"):
         cost_field(cost, (0, 0), 0.1)
+
+
+def test_a_bounded_cost_field_is_exact_below_its_bound_and_inf_beyond():
+    rng = np.random.default_rng(1)
+    cost = np.where(rng.random((80, 90)) < 0.15, np.inf, 1.0 + 2.0 * rng.random((80, 90)))
+    cost[40, 40] = 1.0
+    full = cost_field(cost, (40, 40), 0.1)
+    part = cost_field(cost, (40, 40), 0.1, max_cost_m=1.5)
+    assert full.complete and not part.complete
+    known = np.isfinite(part.cumulative)
+    assert np.array_equal(part.cumulative[known], full.cumulative[known])  # exact where known
+    assert known[full.cumulative < 1.5].all()  # everything cheaper than the bound is known
+    assert (full.cumulative[~known] > 1.5).all()
+    goal = tuple(np.argwhere(known & (part.cumulative > 1.0))[0])
+    path = part.path(goal)
+    assert tuple(path[0]) == (40, 40) and tuple(path[-1]) == goal
+    assert known[tuple(path.T)].all()  # a settled cell's path runs through settled cells
