@@ -489,7 +489,9 @@ class FrontierAgent(Agent):
         best: tuple[float, int] | None = None
         beyond = -np.inf  # the best utility a cluster beyond a bounded search could have
         for i in range(len(menu)):
-            if not paths.complete and not menu.feature("path_cost_m")[i] < paths.max_cost_m:
+            # A cluster's cost (path + turn) is exact when it is within the search's bound: every
+            # cell beyond costs at least the bound. Else it could cost as little as the bound.
+            if not paths.complete and not cost[i] <= paths.max_cost_m:
                 u_max = self._utility(view, menu.clusters[i], paths.max_cost_m)
                 beyond = max(beyond, u_max)
                 continue

@@ -1,9 +1,18 @@
-"""Map analysis and motion on the robot's belief map: frontiers and hidden rooms, router zones,
-cost fields and paths, pure pursuit, and the waypoint driver. Reads maps, never the world.
+"""Map analysis and motion on the robot's belief map: candidate goals, frontiers and hidden
+rooms, router zones, cost fields and paths, pure pursuit, and the waypoint driver. Reads maps,
+never the world.
 """
 
 from __future__ import annotations
 
+from sfw_gym.navigation.candidates import (
+    FEATURES,
+    SOURCES,
+    CandidateGoals,
+    CandidateSettings,
+    GoalFinder,
+    candidate_goals,
+)
 from sfw_gym.navigation.frontiers import Frontier, find_frontiers, frontier_mask, hidden_rooms
 from sfw_gym.navigation.planning import (
     CostField,
@@ -23,11 +32,17 @@ from sfw_gym.navigation.waypoints import (
 
 __all__ = [
     "BLOCK_FEATURES",
+    "FEATURES",
+    "SOURCES",
+    "CandidateGoals",
+    "CandidateSettings",
     "CostField",
     "Frontier",
+    "GoalFinder",
     "PurePursuit",
     "WaypointDriver",
     "block_features",
+    "candidate_goals",
     "cost_field",
     "dominance_bands",
     "find_frontiers",

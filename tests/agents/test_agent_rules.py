@@ -231,3 +231,26 @@ def test_a_bad_value_of_any_parameter_is_an_error_naming_it(cls):
     for name in names:
         with pytest.raises(ConfigError, match=rf"^{name} must be"):
             cls(**{name: -1})
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_bounded_first_search_makes_the_same_choices_as_a_full_one(seed):
+    """The frontier agent searches paths only up to search_radius_m first, and keeps the choice
+    only when no cluster beyond could beat it: its actions equal those of an unbounded search."""
+    runs = []
+    for radius in (0.8, 1e9):
+        env = gym.make("SfW-Explore-v0", max_steps=400)
+        obs, _ = env.reset(seed=seed)
+        agent = FrontierAgent(search_radius_m=radius)
+        agent.reset(env, seed=seed)
+        actions = []
+        for _ in range(400):
+            action = agent.act(obs)
+            actions.append(action)
+            obs, _, terminated, truncated, _ = env.step(action)
+            if terminated or truncated:
+                break
+        runs.append((np.array(actions), agent.n_full_searches, agent.n_plans))
+    (bounded, full_searches, plans), (unbounded, _, _) = runs
+    assert 0 < full_searches < plans  # both ways of choosing happened
+    assert np.array_equal(bounded, unbounded)

@@ -24,7 +24,7 @@ EXPECTED = "4b04aa06bbf1e96ff123d9bb6eb158f3b3884721e7c393cce9072ae037e38163"
 #: the same for WaypointWrapper(SfW-Explore-v0), 40 waypoint steps. Re-recorded once, on purpose,
 #: in issue 12: the planner's bucket-queue Dijkstra returns the same path costs as before (tested
 #: against scikit-image's MCP) but breaks ties between equal-cost paths differently, so the
-#: driver's paths differ among equal-cost ones (was 7dd029993e49309aebc682b02834277e00fb0ac3df6504…).
+#: driver's paths differ among equal-cost ones (the digest was 7dd029993e49309a…).
 EXPECTED_WAYPOINT = "f07822584a84cdd3e68e43ccaa1960243d0113faca55b1ef5a50ede8067067cf"
 
 
