@@ -138,7 +138,7 @@ def time_agent_episode(agent: str, env_id: str, seed: int, **env_kwargs) -> tupl
 def run_agent_bench(agents: list[str], env_ids: list[str], seeds: list[int]) -> list[str]:
     """Agent episodes beside random-action episodes, interleaved on the same plans and seeds."""
     for agent in ["random", *agents]:  # warm-up: compiled kernels, the PPO model's first load
-        time_agent_episode(agent, "SfW-ExploreSmall-v0", 0)
+        time_agent_episode(agent, env_ids[0], seeds[0], max_steps=50)
     lines = [
         f"{'env':<22} {'agent':<11} {'episode s':>10} {'steps':>7} {'ms/step':>8} "
         f"{'× random':>9} {'95% CI':>14}"
@@ -189,22 +189,7 @@ def synthetic_view(size: int, seed: int = 0):
     belief[np.hypot(rows - centre[0], cols - centre[1]) > 0.45 * size] = U8_UNKNOWN
     grid = GridSpec(origin, res, (size, size))
     xy = grid.cell_to_world(centre)
-    log_odds = np.where(belief == U8_UNKNOWN, 0.0, np.where(belief == U8_FREE, -3.0, 3.0))
-    return RobotView(
-        belief_u8=belief,
-        log_odds=log_odds.astype(np.float32),
-        grid=grid,
-        odometry_pose=(float(xy[0]), float(xy[1]), 0.0),
-        routers_xy=np.array([xy, xy + 1.0]),
-        rssi_history=np.full((1, 2), -50, np.int32),
-        odometry_trajectory=np.array([xy]),
-        bumped=False,
-        radius_m=0.17,
-        max_linear_speed_m_s=0.5,
-        max_angular_speed_rad_s=1.5,
-        control_period_s=0.2,
-        action_type="continuous",
-    )
+    return RobotView.hand_made(belief, grid, (xy[0], xy[1], 0.0), np.array([xy, xy + 1.0]))
 
 
 def run_candidate_bench(sizes: tuple[int, ...] = (64, 256), calls: int = 30) -> list[str]:

@@ -97,8 +97,9 @@ class FrontierAgent(Agent):
         replan_every_steps: Re-pick the goal at least this often, as the map changes.
         search_radius_m: Each replan first searches paths up to this cost (m). The choice is
             kept only if no cluster beyond could have a higher utility (a cluster at least this
-            far costs at least this much), so the goal is the one a full search would pick; else
-            the search covers the whole map.
+            far costs at least this much), so it is the goal a full search would pick; else the
+            search covers the whole map. One difference remains: walled-off clusters are found
+            (and blacklisted for ``unreachable_ttl_steps``) only by full searches.
         unknown_cost: Planner cost of an unknown cell (a free one costs 1).
         bump_exclusion_m: Frontier cells this close to a bump are not goals (walls).
         lookahead_m: Pure-pursuit carrot distance.

@@ -7,7 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sfw_gym.mapping.grid import GridSpec
+from sfw_gym.core.constants import NOT_HEARD_DBM
+from sfw_gym.mapping.grid import GridSpec, belief_classes
+from sfw_gym.world.robot import RobotConfig
 
 
 @dataclass(frozen=True)
@@ -44,6 +46,47 @@ class RobotView:
     max_angular_speed_rad_s: float
     control_period_s: float
     action_type: str
+
+    @classmethod
+    def hand_made(
+        cls,
+        belief_u8: np.ndarray,
+        grid: GridSpec,
+        pose: tuple[float, float, float],
+        routers_xy: np.ndarray,
+        *,
+        rssi_history: np.ndarray | None = None,
+        odometry_trajectory: np.ndarray | None = None,
+        bumped: bool = False,
+        robot: RobotConfig | None = None,
+        action_type: str = "continuous",
+    ) -> RobotView:
+        """A view of a hand-made belief (tests, benchmarks, maps from elsewhere): log-odds ±3 for
+        believed free / wall cells and 0 (one bit) for unknown ones; by default one reading,
+        "not heard", taken at ``pose``; the default robot's size and limits."""
+        belief = np.asarray(belief_u8, np.uint8)
+        free, wall, _ = belief_classes(belief)
+        routers = np.asarray(routers_xy, np.float64).reshape(-1, 2)
+        robot = robot or RobotConfig()
+        if rssi_history is None:
+            rssi_history = np.full((1, len(routers)), NOT_HEARD_DBM, np.int32)
+        if odometry_trajectory is None:
+            odometry_trajectory = np.tile(np.asarray(pose[:2], np.float64), (len(rssi_history), 1))
+        return cls(
+            belief_u8=belief,
+            log_odds=np.where(wall, 3.0, np.where(free, -3.0, 0.0)).astype(np.float32),
+            grid=grid,
+            odometry_pose=(float(pose[0]), float(pose[1]), float(pose[2])),
+            routers_xy=routers,
+            rssi_history=np.asarray(rssi_history),
+            odometry_trajectory=np.asarray(odometry_trajectory, np.float64),
+            bumped=bool(bumped),
+            radius_m=robot.radius_m,
+            max_linear_speed_m_s=robot.max_linear_speed_m_s,
+            max_angular_speed_rad_s=robot.max_angular_speed_rad_s,
+            control_period_s=robot.control_period_s,
+            action_type=action_type,
+        )
 
     @property
     def probability(self) -> np.ndarray:

@@ -133,20 +133,13 @@ class FakeEnv:
         self.path = [self.pose[:2].copy()]
 
     def robot_view(self) -> RobotView:
-        return RobotView(
-            belief_u8=self.belief.copy(),
-            log_odds=np.where(self.belief == W, 2.2, 0.0).astype(np.float32),
-            grid=self.grid,
-            odometry_pose=tuple(self.pose),
-            routers_xy=self.routers.copy(),
+        return RobotView.hand_made(
+            self.belief.copy(),
+            self.grid,
+            tuple(self.pose),
+            self.routers.copy(),
             rssi_history=np.tile(self._rssi(), (self.t + 1, 1)),
             odometry_trajectory=np.array(self.path),
-            bumped=False,
-            radius_m=0.17,
-            max_linear_speed_m_s=0.5,
-            max_angular_speed_rad_s=1.5,
-            control_period_s=0.2,
-            action_type="continuous",
         )
 
     def _rssi(self) -> np.ndarray:

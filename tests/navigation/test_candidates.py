@@ -23,26 +23,10 @@ from sfw_gym.navigation.view import RobotView
 RES = 0.1
 
 
-def view_of(belief, xy, heading=0.0, routers=((0.05, 0.65),), rssi=-50):
+def view_of(belief, xy, heading=0.0, routers=((0.05, 0.65),)):
     """A RobotView on a hand-made belief (unknown cells at log-odds 0: one bit each)."""
-    belief = np.asarray(belief, np.uint8)
-    log_odds = np.where(belief == U8_WALL, 3.0, np.where(belief == U8_FREE, -3.0, 0.0))
-    routers = np.asarray(routers, np.float64)
-    return RobotView(
-        belief_u8=belief,
-        log_odds=log_odds.astype(np.float32),
-        grid=GridSpec((0.0, 0.0), RES, belief.shape),
-        odometry_pose=(float(xy[0]), float(xy[1]), float(heading)),
-        routers_xy=routers,
-        rssi_history=np.full((1, len(routers)), rssi, np.int32),
-        odometry_trajectory=np.array([xy], np.float64),
-        bumped=False,
-        radius_m=0.17,
-        max_linear_speed_m_s=0.5,
-        max_angular_speed_rad_s=1.5,
-        control_period_s=0.2,
-        action_type="continuous",
-    )
+    grid = GridSpec((0.0, 0.0), RES, np.shape(belief))
+    return RobotView.hand_made(belief, grid, (xy[0], xy[1], heading), np.asarray(routers))
 
 
 def corridor(free_cols: int = 33, length: int = 60) -> np.ndarray:
