@@ -236,7 +236,7 @@ def run_length_bench(agent: str, seed: int = 0, lengths: tuple[int, ...] = (3000
             seed,
             max_steps=n,
             steps_per_m2=1e5,
-            reward={"coverage_target": 1.0},
+            coverage_target=1.0,
         )
         lines.append(f"{steps:>7} {t:>10.2f} {1e3 * t / steps:>8.3f}")
     return lines
