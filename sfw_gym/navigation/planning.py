@@ -239,8 +239,10 @@ def _dijkstra_8(cost, r0, c0, cum, pred, limit):  # pragma: no cover (compiled)
     Cells cost at least 1, so every edge does: a bucket queue of width 1 (Dial's algorithm)
     then settles nodes in a valid order (no node in a bucket can improve another in it), which
     gives Dijkstra's exact costs without a heap. Entries improved later stay in their bucket
-    and are skipped when popped. The search stops at the first bucket beyond ``limit`` (cell
-    units); cells not settled by then are set back to ``inf``.
+    and are skipped when popped. Between equal-cost predecessors the one with the lower cost
+    wins, as in a heap-ordered Dijkstra (scikit-image's MCP): the same paths, not only the same
+    costs. The search stops at the first bucket beyond ``limit`` (cell units); cells not
+    settled by then are set back to ``inf``.
     """
     h, w = cost.shape
     cum[:] = np.inf
@@ -293,7 +295,12 @@ def _dijkstra_8(cost, r0, c0, cum, pred, limit):  # pragma: no cover (compiled)
                     continue
                 j = rr * w + cc
                 step = 0.5 * (here + cost[rr, cc]) * (diagonal if dr != 0 and dc != 0 else 1.0)
-                if not done[j] and d + step < cum[rr, cc]:
+                if done[j]:
+                    continue
+                if d + step == cum[rr, cc] and d < cum.flat[pred[j]]:
+                    pred[j] = i  # a tie: keep the predecessor a heap would settle first
+                    continue
+                if d + step < cum[rr, cc]:
                     cum[rr, cc] = d + step
                     pred[j] = i
                     slot = int(d + step) % n_buckets

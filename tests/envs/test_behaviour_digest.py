@@ -21,11 +21,8 @@ STEPS = 500
 EXPECTED = "4b04aa06bbf1e96ff123d9bb6eb158f3b3884721e7c393cce9072ae037e38163"
 
 
-#: the same for WaypointWrapper(SfW-Explore-v0), 40 waypoint steps. Re-recorded once, on purpose,
-#: in issue 12: the planner's bucket-queue Dijkstra returns the same path costs as before (tested
-#: against scikit-image's MCP) but breaks ties between equal-cost paths differently, so the
-#: driver's paths differ among equal-cost ones (the digest was 7dd029993e49309a…).
-EXPECTED_WAYPOINT = "f07822584a84cdd3e68e43ccaa1960243d0113faca55b1ef5a50ede8067067cf"
+#: the same for WaypointWrapper(SfW-Explore-v0), 40 waypoint steps.
+EXPECTED_WAYPOINT = "7dd029993e49309aebc682b02834277e00fb0ac3df65042450d8faee8f2cc1ca"
 
 
 def episode_digest(env: gym.Env, seed: int = 0, steps: int = STEPS) -> str:

@@ -434,3 +434,19 @@ def test_a_bounded_cost_field_is_exact_below_its_bound_and_inf_beyond():
     path = part.path(goal)
     assert tuple(path[0]) == (40, 40) and tuple(path[-1]) == goal
     assert known[tuple(path.T)].all()  # a settled cell's path runs through settled cells
+
+
+def test_cost_field_paths_are_mcp_paths_even_where_costs_tie():
+    """On a uniform grid most goals have many equal-cost paths; the compiled search picks the
+    one scikit-image's heap-ordered MCP picks (all but the rare ties between equal costs)."""
+    from skimage.graph import MCP_Geometric
+
+    cost = np.ones((21, 31))
+    cost[5:15, 12] = np.inf
+    start = (10, 15)
+    field = cost_field(cost, start, 0.1)
+    mcp = MCP_Geometric(cost, fully_connected=True)
+    mcp.find_costs([start])
+    goals = list(map(tuple, np.argwhere(field.reachable())))
+    same = sum(np.array_equal(field.path(g), np.asarray(mcp.traceback(g))) for g in goals)
+    assert same >= 0.99 * len(goals)
