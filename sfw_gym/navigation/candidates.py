@@ -20,6 +20,7 @@ serves every candidate.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -32,11 +33,12 @@ from sfw_gym.core.constants import NOT_HEARD_DBM, U8_FREE_MIN, U8_WALL_MAX
 from sfw_gym.mapping.grid import belief_classes
 from sfw_gym.navigation.frontiers import (
     EIGHT_CONNECTED,
-    cluster_cells,
+    clustered_cells,
     frontier_mask,
     hidden_rooms,
 )
 from sfw_gym.navigation.planning import (
+    FREE_START_COST,
     CostField,
     cost_field,
     disk_cells,
@@ -230,7 +232,7 @@ class GoalFinder:
     def costs(self, view: RobotView, escape_wall_cost: float | None = None) -> np.ndarray:
         """Planner costs with the robot's cell passable. With ``escape_wall_cost``, believed walls
         cost that much per cell (bumps 4×) instead of blocking: the map's walls are doubted."""
-        _, walls, unknown = belief_classes(view.belief_u8)
+        walls = view.belief_u8 <= U8_WALL_MAX
         res, radius = view.grid.resolution_m, view.radius_m
         if escape_wall_cost is None:
             # traversal_costs, with its wall-only term cached while the walls stay put
@@ -245,7 +247,10 @@ class GoalFinder:
             elif len(changed):
                 update_wall_cost_term(self._wall_term, blocked, changed, res, radius)
             self._walls_seen = blocked
-            cost = np.where(unknown, self.settings.unknown_cost, 1.0) + self._wall_term
+            r, c = view.cell
+            return _known_wall_costs(
+                view.belief_u8, self._wall_term, float(self.settings.unknown_cost), int(r), int(c)
+            )
         else:
             cost = traversal_costs(
                 view.belief_u8, res, radius, unknown_cost=self.settings.unknown_cost
@@ -292,29 +297,37 @@ class GoalFinder:
         bearing = np.arctan2(ys[r, c] - y, xs[r, c] - x) - th
         return np.abs((bearing + np.pi) % (2 * np.pi) - np.pi)
 
-    def exclusion(self, view: RobotView, only: np.ndarray | None = None) -> np.ndarray:
+    def exclusion(self, view: RobotView) -> np.ndarray:
         """Cells that are no frontier goals: near a bump (walls), failed or walled off, or in a
-        small unknown pocket inside known space (it will be resolved in passing). With ``only``
-        (a mask), the pockets are looked for from those cells alone (a bounded flood fill from
-        each, much cheaper than labelling the whole map; the same answer at those cells)."""
+        small unknown pocket inside known space (it will be resolved in passing)."""
         exclude = self._near_bump | self.failed | self.unreachable
         min_area = self.settings.min_unknown_region_m2
         if min_area > 0:
             res = view.grid.resolution_m
             _, _, unknown = belief_classes(view.belief_u8)
-            if only is not None:
-                n_big = int(np.ceil(min_area / res**2 - 1e-9))
-                while n_big * res * res < min_area:  # the smallest count that is not a pocket
-                    n_big += 1
-                seeds = np.flatnonzero(only & unknown)
-                exclude |= _small_pockets(unknown, seeds, n_big)
-            else:
-                labels, n = ndimage.label(unknown, structure=EIGHT_CONNECTED)
-                if n:
-                    area = np.bincount(labels.ravel(), minlength=n + 1) * res * res
-                    area[0] = np.inf
-                    exclude |= area[labels] < min_area
+            labels, n = ndimage.label(unknown, structure=EIGHT_CONNECTED)
+            if n:
+                area = np.bincount(labels.ravel(), minlength=n + 1) * res * res
+                area[0] = np.inf
+                exclude |= area[labels] < min_area
         return exclude
+
+    def excluded_at(self, view: RobotView, flat: np.ndarray) -> np.ndarray:
+        """:meth:`exclusion` at the cells ``flat`` (flat indices) only: the pockets are flood-filled
+        from those cells alone (bounded fills, much cheaper than labelling the whole map)."""
+        out = (
+            self._near_bump.ravel()[flat]
+            | (self.failed_until.ravel()[flat] > self.step)
+            | (self.unreachable_until.ravel()[flat] > self.step)
+        )
+        min_area = self.settings.min_unknown_region_m2
+        if min_area > 0:
+            res = view.grid.resolution_m
+            n_big = int(np.ceil(min_area / res**2 - 1e-9))
+            while n_big * res * res < min_area:  # the smallest count that is not a pocket
+                n_big += 1
+            out |= _small_pockets(np.ascontiguousarray(view.belief_u8), flat, n_big)
+        return out
 
     def strongest_router(self, view: RobotView) -> np.ndarray:
         """Per cell, the router predicted strongest there (refit every ``zones_every_steps``)."""
@@ -395,8 +408,11 @@ class GoalFinder:
                 raise ValueError(f"unknown names {sorted(unknown_names)}; known: {known}")
         res = view.grid.resolution_m
         frontier = self.frontier(view)
-        open_frontier = frontier & ~self.exclusion(view, only=frontier)
-        open_cells = np.argwhere(open_frontier)
+        frontier_flat = np.flatnonzero(frontier)
+        open_flat = frontier_flat[~self.excluded_at(view, frontier_flat)]
+        open_frontier = np.zeros_like(frontier)
+        open_frontier.ravel()[open_flat] = True
+        open_cells = np.stack(np.divmod(open_flat, frontier.shape[1]), axis=1)
         reachable = np.isfinite(self.approach_at(paths, open_cells))
         walled_off_rc = open_cells[~reachable]
         targets: list[np.ndarray] = [np.zeros((0, 2), np.int64)]
@@ -482,17 +498,14 @@ class GoalFinder:
         res = view.grid.resolution_m
         min_cells = max(1, round(self.settings.min_frontier_size_m / res))
         turn = self.settings.turn_cost_m_per_rad
-        clusters = cluster_cells(open_frontier, min_cells)
-        if not clusters:
+        every, bounds = clustered_cells(open_frontier, min_cells)
+        if len(bounds) == 1:
             return np.zeros((0, 2), np.int64), np.zeros(0), []
-        every = np.concatenate(clusters)
         cost = self.approach_at(paths, every)
         if turn > 0:
             cost = cost + turn * self.heading_change(view, every)
-        sizes = np.array([len(c) for c in clusters])
-        ends = np.cumsum(sizes)
-        best = [b - n + int(np.argmin(cost[b - n : b])) for b, n in zip(ends, sizes, strict=True)]
-        return every[best], sizes.astype(np.float64), clusters
+        clusters = [every[a:b] for a, b in itertools.pairwise(bounds)]
+        return every[_first_argmin_per_group(cost, bounds)], np.diff(bounds).astype(float), clusters
 
     def hidden_room_targets(
         self, view: RobotView
@@ -573,15 +586,17 @@ def _update_frontier(belief, seen, changed, frontier):  # pragma: no cover (comp
 
 
 @njit(cache=True)
-def _small_pockets(unknown, seeds, n_big):  # pragma: no cover (compiled)
-    """Cells of the 8-connected components of ``unknown`` with fewer than ``n_big`` cells that
-    contain a seed (flat indices). Each flood fill stops at ``n_big`` cells or at a cell known to
-    lie in a big component, so every cell is visited at most once."""
-    h, w = unknown.shape
+def _small_pockets(belief, seeds, n_big):  # pragma: no cover (compiled)
+    """Per seed cell (flat indices): whether it is an unknown cell of ``belief`` whose
+    8-connected unknown component has fewer than ``n_big`` cells. Each flood fill stops at
+    ``n_big`` cells or at a cell known to lie in a big component, so every cell is visited at
+    most once."""
+    h, w = belief.shape
+    b = belief.ravel()
     state = np.zeros(h * w, np.int8)  # 0 unseen, 1 being filled, 2 small, 3 big
     queue = np.empty(max(n_big, 1), np.int64)
     for i0 in seeds:
-        if state[i0] != 0 or not unknown.flat[i0]:
+        if state[i0] != 0 or not U8_WALL_MAX < b[i0] < U8_FREE_MIN:
             continue
         state[i0] = 1
         queue[0] = i0
@@ -594,7 +609,7 @@ def _small_pockets(unknown, seeds, n_big):  # pragma: no cover (compiled)
             for rr in range(max(r - 1, 0), min(r + 2, h)):
                 for cc in range(max(c - 1, 0), min(c + 2, w)):
                     j = rr * w + cc
-                    if not unknown[rr, cc] or state[j] == 1 or state[j] == 2:
+                    if not U8_WALL_MAX < b[j] < U8_FREE_MIN or state[j] == 1 or state[j] == 2:
                         continue
                     if state[j] == 3 or n == n_big:
                         big = True
@@ -607,10 +622,39 @@ def _small_pockets(unknown, seeds, n_big):  # pragma: no cover (compiled)
         mark = 3 if big or n >= n_big else 2
         for k in range(n):
             state[queue[k]] = mark
-    out = np.zeros((h, w), np.bool_)
-    for k in range(h * w):
-        if state[k] == 2:
-            out.flat[k] = True
+    out = np.zeros(len(seeds), np.bool_)
+    for k in range(len(seeds)):
+        out[k] = state[seeds[k]] == 2
+    return out
+
+
+@njit(cache=True)
+def _first_argmin_per_group(values, bounds):  # pragma: no cover (compiled)
+    """Per group ``values[bounds[k]:bounds[k + 1]]``: the index (into ``values``) of its first
+    minimum, as ``np.argmin`` picks it."""
+    out = np.empty(len(bounds) - 1, np.int64)
+    for k in range(len(bounds) - 1):
+        best = bounds[k]
+        for i in range(bounds[k] + 1, bounds[k + 1]):
+            if values[i] < values[best]:
+                best = i
+        out[k] = best
+    return out
+
+
+@njit(cache=True)
+def _known_wall_costs(belief, wall_term, unknown_cost, r0, c0):  # pragma: no cover (compiled)
+    """``free_start(where(unknown, unknown_cost, 1) + wall_term, (r0, c0))`` in one pass."""
+    h, w = belief.shape
+    out = np.empty((h, w))
+    for r in range(h):
+        for c in range(w):
+            unknown = U8_WALL_MAX < belief[r, c] < U8_FREE_MIN
+            out[r, c] = (unknown_cost if unknown else 1.0) + wall_term[r, c]
+    for r in range(max(r0 - 1, 0), min(r0 + 2, h)):
+        for c in range(max(c0 - 1, 0), min(c0 + 2, w)):
+            if not np.isfinite(out[r, c]):
+                out[r, c] = FREE_START_COST
     return out
 
 

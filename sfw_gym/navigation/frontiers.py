@@ -93,64 +93,60 @@ def cluster_cells(mask: np.ndarray, min_size_cells: int = 1) -> list[np.ndarray]
     """The 8-connected clusters of ``mask`` with at least ``min_size_cells`` cells, largest first
     (ties in the order of their first cell in raster order, as :func:`scipy.ndimage.label`
     numbers them), each as ``(N, 2)`` cells ``(row, col)`` in raster order."""
+    cells, bounds = clustered_cells(mask, min_size_cells)
+    return [cells[bounds[k] : bounds[k + 1]] for k in range(len(bounds) - 1)]
+
+
+def clustered_cells(mask: np.ndarray, min_size_cells: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`cluster_cells` as one ``(N, 2)`` array of cells and the clusters' bounds in it
+    (cluster ``k`` is ``cells[bounds[k]:bounds[k + 1]]``)."""
     flat = np.flatnonzero(mask)
     if not len(flat):
-        return []
-    order, bounds = _clusters(np.ascontiguousarray(mask), flat, int(min_size_cells))
-    cells = np.stack(np.divmod(flat[order], mask.shape[1]), axis=1)
-    return [cells[bounds[k] : bounds[k + 1]] for k in range(len(bounds) - 1)]
+        return np.zeros((0, 2), np.int64), np.zeros(1, np.int64)
+    members, bounds = _clusters(np.ascontiguousarray(mask), flat, int(min_size_cells))
+    return np.stack(np.divmod(members, mask.shape[1]), axis=1), bounds
 
 
 @njit(cache=True)
 def _clusters(mask, flat, min_size):  # pragma: no cover (compiled)
-    """Label the cells ``flat`` (raster order) of ``mask`` by 8-connected flood fill, numbering
-    clusters by their first cell; return the cells' positions in ``flat`` grouped by cluster
-    (largest first, ties by number; raster order inside) and the groups' bounds."""
+    """Flood-fill the 8-connected clusters of ``mask`` from its cells ``flat`` (raster order),
+    numbering them by their first cell; return the cells of the clusters of ``min_size`` or more
+    cells grouped by cluster (largest first, ties by number; raster order inside) and the groups'
+    bounds."""
     h, w = mask.shape
-    where = np.full(h * w, -1, np.int64)  # position of each mask cell in ``flat``
+    todo = mask.ravel().copy()  # cells not labelled yet
+    members = np.empty(len(flat), np.int64)  # cells grouped by cluster, in fill order
+    starts = np.empty(len(flat) + 1, np.int64)
+    n_labels, tail = 0, 0
     for k in range(len(flat)):
-        where[flat[k]] = k
-    label = np.full(len(flat), -1, np.int64)
-    queue = np.empty(len(flat), np.int64)
-    n_labels = 0
-    for k in range(len(flat)):
-        if label[k] >= 0:
+        if not todo[flat[k]]:
             continue
-        label[k] = n_labels
-        queue[0] = k
-        head, tail = 0, 1
+        todo[flat[k]] = False
+        starts[n_labels] = head = tail
+        members[tail] = flat[k]
+        tail += 1
         while head < tail:
-            i = flat[queue[head]]
+            i = members[head]
             head += 1
             r = i // w
             c = i - r * w
             for rr in range(max(r - 1, 0), min(r + 2, h)):
                 for cc in range(max(c - 1, 0), min(c + 2, w)):
-                    j = where[rr * w + cc]
-                    if j >= 0 and label[j] < 0:
-                        label[j] = n_labels
-                        queue[tail] = j
+                    if todo[rr * w + cc]:
+                        todo[rr * w + cc] = False
+                        members[tail] = rr * w + cc
                         tail += 1
         n_labels += 1
-    size = np.zeros(n_labels, np.int64)
-    for k in range(len(flat)):
-        size[label[k]] += 1
+    starts[n_labels] = tail
+    size = starts[1 : n_labels + 1] - starts[:n_labels]
     by_size = np.argsort(-size, kind="mergesort")  # stable: ties keep their numbering
     n_kept = 0
-    for m in by_size:
-        if size[m] >= min_size:
-            n_kept += 1
+    while n_kept < n_labels and size[by_size[n_kept]] >= min_size:
+        n_kept += 1
     bounds = np.zeros(n_kept + 1, np.int64)
-    start = np.zeros(n_labels, np.int64)
+    out = np.empty(tail, np.int64)
     for q in range(n_kept):
         m = by_size[q]
         bounds[q + 1] = bounds[q] + size[m]
-        start[m] = bounds[q]
-    order = np.empty(bounds[n_kept], np.int64)
-    fill = start.copy()
-    for k in range(len(flat)):  # raster order inside each cluster
-        m = label[k]
-        if size[m] >= min_size:
-            order[fill[m]] = k
-            fill[m] += 1
-    return order, bounds
+        out[bounds[q] : bounds[q + 1]] = np.sort(members[starts[m] : starts[m + 1]])
+    return out[: bounds[n_kept]], bounds

@@ -11,6 +11,7 @@ compiled bucket-queue kernel because it runs at every replan and is about 5× fa
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -154,6 +155,10 @@ def wall_distance_m(walls: np.ndarray, resolution_m: float) -> np.ndarray:
     return ndimage.distance_transform_edt(~walls) * resolution_m
 
 
+#: Cost of an obstacle cell next to the robot (:func:`free_start`): passable, at a price.
+FREE_START_COST = 20.0
+
+
 def free_start(cost: np.ndarray, start_rc: tuple[int, int], radius_cells: int = 1) -> np.ndarray:
     """A copy of ``cost`` with the cells around the robot made passable.
 
@@ -168,9 +173,9 @@ def free_start(cost: np.ndarray, start_rc: tuple[int, int], radius_cells: int = 
         slice(max(c - radius_cells, 0), c + radius_cells + 1),
     )
     patch = out[sl]
-    patch[~np.isfinite(patch)] = 20.0
+    patch[~np.isfinite(patch)] = FREE_START_COST
     if 0 <= r < h and 0 <= c < w and not np.isfinite(out[r, c]):
-        out[r, c] = 20.0
+        out[r, c] = FREE_START_COST
     return out
 
 
@@ -226,14 +231,15 @@ def cost_field(
     cum = np.empty((h, w), np.float64)
     pred = np.empty(h * w, np.int64)
     limit = max_cost_m / resolution_m if np.isfinite(max_cost_m) else np.inf
-    cheapest = _dijkstra_8(np.ascontiguousarray(cost, np.float64), r, c, cum, pred, limit)
+    cost = np.ascontiguousarray(cost, np.float64)
+    cheapest = _dijkstra_8(cost, r, c, cum, pred, limit, float(resolution_m))
     if cheapest < 1.0:
         raise ValueError(f"cell costs must be >= 1 (or inf), got {cheapest}")
-    return CostField((r, c), cum * resolution_m, resolution_m, pred, float(max_cost_m))
+    return CostField((r, c), cum, resolution_m, pred, float(max_cost_m))
 
 
 @njit(cache=True)
-def _dijkstra_8(cost, r0, c0, cum, pred, limit):  # pragma: no cover (compiled)
+def _dijkstra_8(cost, r0, c0, cum, pred, limit, scale):  # pragma: no cover (compiled)
     """Single-source Dijkstra on the 8-connected grid with MCP_Geometric's edge costs.
 
     Cells cost at least 1, so every edge does: a bucket queue of width 1 (Dial's algorithm)
@@ -242,7 +248,8 @@ def _dijkstra_8(cost, r0, c0, cum, pred, limit):  # pragma: no cover (compiled)
     and are skipped when popped. Between equal-cost predecessors the one with the lower cost
     wins, as in a heap-ordered Dijkstra (scikit-image's MCP): the same paths, not only the same
     costs. The search stops at the first bucket beyond ``limit`` (cell units); cells not
-    settled by then are set back to ``inf``.
+    settled by then are set back to ``inf``. Costs come out multiplied by ``scale`` (the cell
+    size: metres).
     """
     h, w = cost.shape
     cum[:] = np.inf
@@ -264,13 +271,7 @@ def _dijkstra_8(cost, r0, c0, cum, pred, limit):  # pragma: no cover (compiled)
     node[0], below[0], head[0] = r0 * w + c0, -1, 0
     n_entries, pending, bucket = 1, 1, 0
     cum[r0, c0] = 0.0
-    while pending > 0:
-        if bucket > limit:
-            for k in range(h * w):
-                if not done[k]:
-                    cum.flat[k] = np.inf
-                    pred[k] = -1
-            return min_cost
+    while pending > 0 and bucket <= limit:
         e = head[bucket % n_buckets]
         if e < 0:
             bucket += 1
@@ -307,6 +308,12 @@ def _dijkstra_8(cost, r0, c0, cum, pred, limit):  # pragma: no cover (compiled)
                     node[n_entries], below[n_entries], head[slot] = j, head[slot], n_entries
                     n_entries += 1
                     pending += 1
+    for k in range(h * w):
+        if done[k]:
+            cum.flat[k] *= scale
+        else:  # beyond the limit (or unreachable)
+            cum.flat[k] = np.inf
+            pred[k] = -1
     return min_cost
 
 
@@ -327,25 +334,54 @@ def _trace_back(pred, goal):  # pragma: no cover (compiled)
 
 def simplify_path(path_xy: np.ndarray, spacing_m: float) -> np.ndarray:
     """Thin a polyline so that consecutive points lie ``spacing_m`` or more apart (ends kept)."""
+    path_xy = np.ascontiguousarray(path_xy, np.float64)
     if len(path_xy) <= 2:
         return path_xy
-    keep = [0]
-    for i in range(1, len(path_xy) - 1):
-        if np.hypot(*(path_xy[i] - path_xy[keep[-1]])) >= spacing_m:
-            keep.append(i)
-    keep.append(len(path_xy) - 1)
-    return path_xy[keep]
+    return path_xy[_spaced_points(path_xy, float(spacing_m))]
+
+
+@njit(cache=True)
+def _spaced_points(path, spacing):  # pragma: no cover (compiled)
+    """Indices of the points of ``simplify_path``: each ``spacing`` or more from the last kept."""
+    n = len(path)
+    keep = np.empty(n, np.int64)
+    keep[0], m = 0, 1
+    for i in range(1, n - 1):
+        last = keep[m - 1]
+        if math.hypot(path[i, 0] - path[last, 0], path[i, 1] - path[last, 1]) >= spacing:
+            keep[m] = i
+            m += 1
+    keep[m] = n - 1
+    return keep[: m + 1]
 
 
 def densify_path(path_xy: np.ndarray, spacing_m: float) -> np.ndarray:
     """Insert points along a polyline so that neighbours lie at most ``spacing_m`` apart."""
+    path_xy = np.ascontiguousarray(path_xy, np.float64)
     if len(path_xy) < 2:
         return path_xy
-    legs = np.diff(path_xy, axis=0)
-    n = np.maximum(1, np.ceil(np.hypot(legs[:, 0], legs[:, 1]) / spacing_m).astype(np.int64))
-    leg = np.repeat(np.arange(len(legs)), n)  # the leg of each new point
-    t = (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n) + 1) / np.repeat(n, n)
-    return np.concatenate([path_xy[:1], path_xy[leg] + legs[leg] * t[:, None]])
+    return _densified(path_xy, float(spacing_m))
+
+
+@njit(cache=True)
+def _densified(path, spacing):  # pragma: no cover (compiled)
+    """Each leg of ``path`` cut into ``ceil(length / spacing)`` equal steps (at least one)."""
+    n_legs = len(path) - 1
+    steps = np.empty(n_legs, np.int64)
+    for i in range(n_legs):
+        length = np.hypot(path[i + 1, 0] - path[i, 0], path[i + 1, 1] - path[i, 1])
+        steps[i] = max(1, int(np.ceil(length / spacing)))
+    out = np.empty((steps.sum() + 1, 2))
+    out[0] = path[0]
+    k = 1
+    for i in range(n_legs):
+        dx, dy = path[i + 1, 0] - path[i, 0], path[i + 1, 1] - path[i, 1]
+        for j in range(steps[i]):
+            t = (j + 1) / steps[i]
+            out[k, 0] = path[i, 0] + dx * t
+            out[k, 1] = path[i, 1] + dy * t
+            k += 1
+    return out
 
 
 def cells_to_world(grid: GridSpec, cells_rc: np.ndarray) -> np.ndarray:
@@ -404,21 +440,28 @@ class PurePursuit:
         """``(linear, angular)`` fractions in [-1, 1] towards the carrot; (0, 0) at the end."""
         if not self.has_path:
             return 0.0, 0.0
-        xy = np.array(pose[:2])
-        if np.linalg.norm(self.path[-1] - xy) <= self.goal_tolerance_m:
+        x, y = float(pose[0]), float(pose[1])
+        end = self.path[-1]
+        if math.hypot(end[0] - x, end[1] - y) <= self.goal_tolerance_m:
             self.path = np.zeros((0, 2))
             return 0.0, 0.0
         # Advance the progress index to the nearest path point (never backwards).
         window = self.path[self._progress : self._progress + 20]
-        self._progress += int(np.argmin(np.linalg.norm(window - xy, axis=1)))
-        ahead = self.path[self._progress :]
-        far = np.flatnonzero(np.hypot(*(ahead - xy).T) >= self.lookahead_m)
-        carrot = ahead[far[0]] if len(far) else self.path[-1]
-        bearing = wrap_angle(math.atan2(carrot[1] - xy[1], carrot[0] - xy[0]) - pose[2])
-        angular = float(np.clip(self.angular_gain * bearing, -1.0, 1.0))
+        self._progress += int(np.argmin(np.hypot(window[:, 0] - x, window[:, 1] - y)))
+        # The carrot: the first point ahead at lookahead distance or more (looked for in chunks:
+        # it is usually within the first few points of a long path).
+        carrot = end
+        for start in range(self._progress, len(self.path), 32):
+            chunk = self.path[start : start + 32]
+            far = np.flatnonzero(np.hypot(chunk[:, 0] - x, chunk[:, 1] - y) >= self.lookahead_m)
+            if len(far):
+                carrot = chunk[far[0]]
+                break
+        bearing = wrap_angle(math.atan2(carrot[1] - y, carrot[0] - x) - pose[2])
+        angular = min(max(self.angular_gain * bearing, -1.0), 1.0)
         if abs(bearing) > self.turn_in_place_rad:
             return 0.0, math.copysign(1.0, bearing)
-        linear = float(np.clip(math.cos(bearing), 0.2, 1.0))
+        linear = min(max(math.cos(bearing), 0.2), 1.0)
         return linear, angular
 
 
@@ -438,13 +481,24 @@ def disk_offsets(radius_cells: float) -> np.ndarray:
 
 
 def disk_cells(shape: tuple[int, int], cell: tuple[int, int], radius_cells: float):
-    """``(rows, cols)`` of the cells within ``radius_cells`` of ``cell`` (clipped to ``shape``)."""
-    r, c = int(cell[0]), int(cell[1])
+    """``(rows, cols)`` of the cells within ``radius_cells`` of ``cell`` (clipped to ``shape``),
+    in raster order."""
+    dr, dc = _disk(float(radius_cells))
+    rr, cc = dr + int(cell[0]), dc + int(cell[1])
+    inside = (rr >= 0) & (rr < shape[0]) & (cc >= 0) & (cc < shape[1])
+    return rr[inside], cc[inside]
+
+
+@functools.lru_cache(maxsize=32)
+def _disk(radius_cells: float) -> tuple[np.ndarray, np.ndarray]:
+    """Row and column offsets of a disk of ``radius_cells``, raster order (read-only)."""
     k = int(np.ceil(radius_cells))
-    h, w = shape
-    rr, cc = np.mgrid[max(r - k, 0) : min(r + k + 1, h), max(c - k, 0) : min(c + k + 1, w)]
-    keep = (rr - r) ** 2 + (cc - c) ** 2 <= radius_cells * radius_cells
-    return rr[keep], cc[keep]
+    dr, dc = np.mgrid[-k : k + 1, -k : k + 1]
+    keep = dr**2 + dc**2 <= radius_cells * radius_cells
+    out = dr[keep], dc[keep]
+    for a in out:
+        a.flags.writeable = False
+    return out
 
 
 def mark_disk(mask: np.ndarray, cell: tuple[int, int], radius_cells: float) -> None:

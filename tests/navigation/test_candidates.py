@@ -13,6 +13,7 @@ from sfw_gym.mapping.grid import GridSpec
 from sfw_gym.navigation.candidates import (
     FEATURES,
     SOURCES,
+    CandidateSettings,
     GoalFinder,
     candidate_goals,
 )
@@ -143,6 +144,25 @@ def test_incremental_frontier_equals_the_full_computation():
             [U8_FREE, U8_WALL, U8_UNKNOWN, 150, 90]
         )
         assert np.array_equal(finder.frontier(view_of(b, xy=(1.0, 1.0))), frontier_mask(b))
+
+
+def test_exclusion_at_frontier_cells_equals_the_full_computation():
+    """The pocket flood fills from a few cells give what labelling the whole map gives there."""
+    rng = np.random.default_rng(1)
+    b = np.full((40, 50), U8_FREE, np.uint8)
+    for _ in range(40):  # unknown regions of every size, some walled
+        r, c = rng.integers(0, 38), rng.integers(0, 48)
+        b[r : r + rng.integers(1, 8), c : c + rng.integers(1, 8)] = rng.choice(
+            [U8_UNKNOWN, U8_WALL, 150]
+        )
+    view = view_of(b, xy=(1.0, 1.0))
+    finder = GoalFinder(CandidateSettings(min_unknown_region_m2=0.1))  # 10 cells
+    finder.reset(view)
+    finder.blacklist((20, 20), 3.0, until_step=10)
+    flat = np.flatnonzero(finder.frontier(view))
+    full = finder.exclusion(view).ravel()[flat]
+    assert full.any() and not full.all()
+    assert np.array_equal(finder.excluded_at(view, flat), full)
 
 
 def test_unknown_names_are_refused():
