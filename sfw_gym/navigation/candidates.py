@@ -283,11 +283,15 @@ class GoalFinder:
     def approach_cells(self, paths: CostField, targets: np.ndarray) -> np.ndarray:
         """:meth:`approach_cell` of each of ``targets`` ``(N, 2)`` (the target where none is
         reachable)."""
+        return self._approach(paths, targets)[1]
+
+    def _approach(self, paths: CostField, targets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`approach_at` and :meth:`approach_cells` of ``targets`` in one pass."""
         cells = np.asarray(targets, np.int64).reshape(-1, 2)
         cost, best = _min_over_offsets(paths.cumulative, cells, self.reach_offsets)
         out = cells + self.reach_offsets[best]
         out[~np.isfinite(cost)] = cells[~np.isfinite(cost)]
-        return out
+        return cost, out
 
     def heading_change(self, view: RobotView, cells: np.ndarray) -> np.ndarray:
         """|bearing from the robot to each cell − heading|, radians in [0, π]."""
@@ -413,7 +417,8 @@ class GoalFinder:
         open_frontier = np.zeros_like(frontier)
         open_frontier.ravel()[open_flat] = True
         open_cells = np.stack(np.divmod(open_flat, frontier.shape[1]), axis=1)
-        reachable = np.isfinite(self.approach_at(paths, open_cells))
+        open_cost = self.approach_at(paths, open_cells)
+        reachable = np.isfinite(open_cost)
         walled_off_rc = open_cells[~reachable]
         targets: list[np.ndarray] = [np.zeros((0, 2), np.int64)]
         source: list[np.ndarray] = []
@@ -421,7 +426,7 @@ class GoalFinder:
         clusters: list[np.ndarray] = []
         for name in sources:
             if name == "frontier":
-                cells, size, cl = self._frontier_targets(view, paths, open_frontier)
+                cells, size, cl = self._frontier_targets(view, open_frontier, open_flat, open_cost)
             elif name == "hidden_room":
                 cells, size, cl = self.hidden_room_targets(view)
             else:
@@ -437,7 +442,7 @@ class GoalFinder:
         target_rc = np.concatenate(targets).astype(np.int64)
         src = np.concatenate([np.zeros(0, np.int64), *source])
         size_m = np.concatenate([np.zeros(0), *sizes]) * res
-        path_cost = self.approach_at(paths, target_rc)
+        path_cost, goal_rc = self._approach(paths, target_rc)
         gain = np.full(len(target_rc), np.nan)
         info = src == SOURCES.index("info_gain")
         if info.any() and (max_candidates is not None or "expected_gain_bits" in features):
@@ -452,6 +457,7 @@ class GoalFinder:
             size_m[keep],
             gain[keep],
         )
+        goal_rc = goal_rc[keep]
         r, c = target_rc[:, 0], target_rc[:, 1]
         compute = {
             "path_cost_m": lambda: path_cost,
@@ -482,7 +488,7 @@ class GoalFinder:
                 feats[:, _F[name]] = compute[name]()
         return CandidateGoals(
             target_rc,
-            self.approach_cells(paths, target_rc),
+            goal_rc,
             src,
             feats,
             np.isfinite(path_cost),
@@ -492,16 +498,22 @@ class GoalFinder:
         )
 
     def _frontier_targets(
-        self, view: RobotView, paths: CostField, open_frontier: np.ndarray
+        self,
+        view: RobotView,
+        open_frontier: np.ndarray,
+        open_flat: np.ndarray,
+        open_cost: np.ndarray,
     ) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
-        """Per frontier cluster (largest first): its cheapest cell to resolve (path + turn)."""
+        """Per frontier cluster (largest first): its cheapest cell to resolve (path + turn).
+        ``open_cost``: the approach cost of each open frontier cell ``open_flat`` (sorted)."""
         res = view.grid.resolution_m
         min_cells = max(1, round(self.settings.min_frontier_size_m / res))
         turn = self.settings.turn_cost_m_per_rad
         every, bounds = clustered_cells(open_frontier, min_cells)
         if len(bounds) == 1:
             return np.zeros((0, 2), np.int64), np.zeros(0), []
-        cost = self.approach_at(paths, every)
+        every_flat = every[:, 0] * open_frontier.shape[1] + every[:, 1]
+        cost = open_cost[np.searchsorted(open_flat, every_flat)]
         if turn > 0:
             cost = cost + turn * self.heading_change(view, every)
         clusters = [every[a:b] for a, b in itertools.pairwise(bounds)]
