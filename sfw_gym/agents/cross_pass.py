@@ -117,12 +117,16 @@ class CrossPassAgent(FrontierAgent):
                 return goal
         return super()._choose_goal(view, paths)
 
-    def _utility(self, view: RobotView, cluster: np.ndarray, path_m: float) -> float:
-        size = len(cluster)
+    def _utilities(
+        self, view: RobotView, clusters: list[np.ndarray], path_m: np.ndarray
+    ) -> np.ndarray:
+        """Frontier's utility, each band cell of a cluster counting ``1 + band_bonus`` cells."""
+        size = np.array([len(c) for c in clusters], np.int64)
         if self.band is not None and self.band_bonus > 0:
-            size += self.band_bonus * int(self.band[cluster[:, 0], cluster[:, 1]].sum())
+            in_band = [int(self.band[c[:, 0], c[:, 1]].sum()) for c in clusters]
+            size = size + self.band_bonus * np.array(in_band, np.int64)
         res = view.grid.resolution_m
-        return self.gain_scale * size * res - self.potential_scale * path_m
+        return self.gain_scale * size * res - self.potential_scale * np.asarray(path_m, float)
 
     def unknown_band(self, view: RobotView) -> np.ndarray:
         """Unknown cells in the estimated border bands not yet targeted by a pass."""

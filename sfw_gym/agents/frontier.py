@@ -487,39 +487,40 @@ class FrontierAgent(Agent):
         cost = menu.feature("path_cost_m") + self.turn_cost_m_per_rad * menu.feature(
             "heading_change_rad"
         )
-        best: tuple[float, int] | None = None
-        beyond = -np.inf  # the best utility a cluster beyond a bounded search could have
-        for i in range(len(menu)):
-            # A cluster's cost (path + turn) is exact when it is within the search's bound: every
-            # cell beyond costs at least the bound. Else it could cost as little as the bound.
-            if not paths.complete and not cost[i] <= paths.max_cost_m:
-                u_max = self._utility(view, menu.clusters[i], paths.max_cost_m)
-                beyond = max(beyond, u_max)
-                continue
-            if not menu.valid[i]:  # walled off on the belief map: blacklisted a while
-                self.finder.mark_unreachable(
-                    menu.clusters[i], self.steps + self.unreachable_ttl_steps
-                )
-                self.n_blacklisted += 1
-                continue
-            u = self._utility(view, menu.clusters[i], float(cost[i]))
-            self.candidates.append(((int(menu.target_rc[i, 0]), int(menu.target_rc[i, 1])), u))
-            if best is None or u > best[0]:
-                best = (u, i)
-        if (best[0] if best else -np.inf) < beyond:
+        # A cluster's cost (path + turn) is exact when it is within the search's bound: every
+        # cell beyond costs at least the bound. Else it could cost as little as the bound.
+        exact = paths.complete | (cost <= paths.max_cost_m)
+        far = np.flatnonzero(~exact)
+        bound = np.full(len(far), paths.max_cost_m)
+        beyond = self._utilities(view, [menu.clusters[i] for i in far], bound).max(initial=-np.inf)
+        for i in np.flatnonzero(exact & ~menu.valid):  # walled off on the belief map
+            self.finder.mark_unreachable(menu.clusters[i], self.steps + self.unreachable_ttl_steps)
+            self.n_blacklisted += 1
+        ok = np.flatnonzero(exact & menu.valid)
+        u = self._utilities(view, [menu.clusters[i] for i in ok], cost[ok])
+        self.candidates = list(
+            zip(map(tuple, menu.target_rc[ok].tolist()), u.tolist(), strict=True)
+        )
+        if u.max(initial=-np.inf) < beyond:
             return _UNCERTAIN  # a cluster beyond the search might be better: search everywhere
-        if best is None:
+        if not len(ok):
             self._stop("all_blacklisted")
             return None
-        i = best[1]
+        i = int(ok[np.argmax(u)])  # the first of equal utilities
         self._resume()
         target = (int(menu.target_rc[i, 0]), int(menu.target_rc[i, 1]))
         return Goal((int(menu.goal_rc[i, 0]), int(menu.goal_rc[i, 1])), target, "frontier")
 
     def _utility(self, view: RobotView, cluster: np.ndarray, path_m: float) -> float:
         """explore_lite's utility of a frontier cluster (its ``(N, 2)`` cells) at ``path_m``."""
-        size_m = len(cluster) * view.grid.resolution_m
-        return self.gain_scale * size_m - self.potential_scale * path_m
+        return float(self._utilities(view, [cluster], np.array([path_m]))[0])
+
+    def _utilities(
+        self, view: RobotView, clusters: list[np.ndarray], path_m: np.ndarray
+    ) -> np.ndarray:
+        """:meth:`_utility` of each cluster at its ``path_m``."""
+        size_m = np.array([len(c) for c in clusters], np.int64) * view.grid.resolution_m
+        return self.gain_scale * size_m - self.potential_scale * np.asarray(path_m, np.float64)
 
     def _sweep_goal(self, view: RobotView, paths: CostField) -> Goal | None:
         """Fallback: the reachable cell farthest from the path so far (keeps the rays sweeping)."""
