@@ -172,7 +172,8 @@ class GoalFinder:
         self.goal_tolerance_m = 0.6 * res
         self.reach_offsets = disk_offsets(max((view.radius_m - self.goal_tolerance_m) / res, 0.5))
         self._near_offsets = disk_offsets(self.settings.near_radius_m / res)
-        self._centres = grid.cell_centres()
+        xs, ys = grid.cell_centres()
+        self._col_x, self._row_y = xs[0], ys[:, 0]  # cell centres: x by column, y by row
         self._belief = np.array(view.belief_u8, np.uint8)
         self._frontier = frontier_mask(self._belief)
         self._walls_seen = np.zeros(shape, bool)
@@ -295,10 +296,8 @@ class GoalFinder:
 
     def heading_change(self, view: RobotView, cells: np.ndarray) -> np.ndarray:
         """|bearing from the robot to each cell − heading|, radians in [0, π]."""
-        xs, ys = self._centres
         x, y, th = view.odometry_pose
-        r, c = cells[:, 0], cells[:, 1]
-        bearing = np.arctan2(ys[r, c] - y, xs[r, c] - x) - th
+        bearing = np.arctan2(self._row_y[cells[:, 0]] - y, self._col_x[cells[:, 1]] - x) - th
         return np.abs((bearing + np.pi) % (2 * np.pi) - np.pi)
 
     def exclusion(self, view: RobotView) -> np.ndarray:

@@ -4,6 +4,7 @@ drives the robot (agents, the waypoint driver). Never the ground truth."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -93,12 +94,14 @@ class RobotView:
         """P(occupied) per cell, float32 (computed on each access)."""
         return (1.0 / (1.0 + np.exp(-self.log_odds.astype(np.float64)))).astype(np.float32)
 
-    @property
+    @cached_property
     def xy(self) -> np.ndarray:
-        """Odometry position ``(x, y)``."""
-        return np.array(self.odometry_pose[:2], np.float64)
+        """Odometry position ``(x, y)`` (read-only)."""
+        xy = np.array(self.odometry_pose[:2], np.float64)
+        xy.flags.writeable = False
+        return xy
 
-    @property
+    @cached_property
     def cell(self) -> tuple[int, int]:
         """Grid cell ``(row, col)`` of the odometry position (clipped into the grid)."""
         r, c = self.grid.world_to_cell(self.xy)
