@@ -506,10 +506,10 @@ class FrontierAgent(Agent):
         if not len(ok):
             self._stop("all_blacklisted")
             return None
-        i = int(ok[np.argmax(u)])  # the first of equal utilities
+        best = int(ok[np.argmax(u)])  # the first of equal utilities
         self._resume()
-        target = (int(menu.target_rc[i, 0]), int(menu.target_rc[i, 1]))
-        return Goal((int(menu.goal_rc[i, 0]), int(menu.goal_rc[i, 1])), target, "frontier")
+        target = (int(menu.target_rc[best, 0]), int(menu.target_rc[best, 1]))
+        return Goal((int(menu.goal_rc[best, 0]), int(menu.goal_rc[best, 1])), target, "frontier")
 
     def _utility(self, view: RobotView, cluster: np.ndarray, path_m: float) -> float:
         """explore_lite's utility of a frontier cluster (its ``(N, 2)`` cells) at ``path_m``."""

@@ -21,6 +21,7 @@ serves every candidate.
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -33,7 +34,7 @@ from sfw_gym.core.constants import NOT_HEARD_DBM, U8_FREE_MIN, U8_WALL_MAX
 from sfw_gym.mapping.grid import belief_classes
 from sfw_gym.navigation.frontiers import (
     EIGHT_CONNECTED,
-    clustered_cells,
+    _clusters,
     frontier_mask,
     hidden_rooms,
 )
@@ -318,19 +319,25 @@ class GoalFinder:
     def excluded_at(self, view: RobotView, flat: np.ndarray) -> np.ndarray:
         """:meth:`exclusion` at the cells ``flat`` (flat indices) only: the pockets are flood-filled
         from those cells alone (bounded fills, much cheaper than labelling the whole map)."""
-        out = (
-            self._near_bump.ravel()[flat]
-            | (self.failed_until.ravel()[flat] > self.step)
-            | (self.unreachable_until.ravel()[flat] > self.step)
+        return _excluded(
+            np.ascontiguousarray(view.belief_u8),
+            np.asarray(flat, np.int64),
+            self._near_bump,
+            self.failed_until,
+            self.unreachable_until,
+            self.step,
+            self._pocket_cells(view.grid.resolution_m),
         )
+
+    def _pocket_cells(self, resolution_m: float) -> int:
+        """The fewest cells of an unknown region that is no pocket (0: no pockets excluded)."""
         min_area = self.settings.min_unknown_region_m2
-        if min_area > 0:
-            res = view.grid.resolution_m
-            n_big = int(np.ceil(min_area / res**2 - 1e-9))
-            while n_big * res * res < min_area:  # the smallest count that is not a pocket
-                n_big += 1
-            out |= _small_pockets(np.ascontiguousarray(view.belief_u8), flat, n_big)
-        return out
+        if min_area <= 0:
+            return 0
+        n_big = int(np.ceil(min_area / resolution_m**2 - 1e-9))
+        while n_big * resolution_m * resolution_m < min_area:
+            n_big += 1
+        return n_big
 
     def strongest_router(self, view: RobotView) -> np.ndarray:
         """Per cell, the router predicted strongest there (refit every ``zones_every_steps``)."""
@@ -411,12 +418,25 @@ class GoalFinder:
                 raise ValueError(f"unknown names {sorted(unknown_names)}; known: {known}")
         res = view.grid.resolution_m
         frontier = self.frontier(view)
-        frontier_flat = np.flatnonzero(frontier)
-        open_flat = frontier_flat[~self.excluded_at(view, frontier_flat)]
-        open_frontier = np.zeros_like(frontier)
-        open_frontier.ravel()[open_flat] = True
-        open_cells = np.stack(np.divmod(open_flat, frontier.shape[1]), axis=1)
-        open_cost = self.approach_at(paths, open_cells)
+        x, y, heading = view.odometry_pose
+        open_cells, open_cost, members, bounds, best = _frontier_menu(
+            np.ascontiguousarray(view.belief_u8),
+            np.flatnonzero(frontier),
+            self._near_bump,
+            self.failed_until,
+            self.unreachable_until,
+            self.step,
+            self._pocket_cells(res),
+            paths.cumulative,
+            self.reach_offsets,
+            self._row_y,
+            self._col_x,
+            float(x),
+            float(y),
+            float(heading),
+            float(self.settings.turn_cost_m_per_rad),
+            max(1, round(self.settings.min_frontier_size_m / res)),
+        )
         reachable = np.isfinite(open_cost)
         walled_off_rc = open_cells[~reachable]
         targets: list[np.ndarray] = [np.zeros((0, 2), np.int64)]
@@ -425,7 +445,9 @@ class GoalFinder:
         clusters: list[np.ndarray] = []
         for name in sources:
             if name == "frontier":
-                cells, size, cl = self._frontier_targets(view, open_frontier, open_flat, open_cost)
+                every = np.stack(np.divmod(members, frontier.shape[1]), axis=1)
+                cells, size = every[best], np.diff(bounds).astype(np.float64)
+                cl = [every[a:b] for a, b in itertools.pairwise(bounds)]
             elif name == "hidden_room":
                 cells, size, cl = self.hidden_room_targets(view)
             else:
@@ -495,28 +517,6 @@ class GoalFinder:
             paths,
             walled_off_rc,
         )
-
-    def _frontier_targets(
-        self,
-        view: RobotView,
-        open_frontier: np.ndarray,
-        open_flat: np.ndarray,
-        open_cost: np.ndarray,
-    ) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
-        """Per frontier cluster (largest first): its cheapest cell to resolve (path + turn).
-        ``open_cost``: the approach cost of each open frontier cell ``open_flat`` (sorted)."""
-        res = view.grid.resolution_m
-        min_cells = max(1, round(self.settings.min_frontier_size_m / res))
-        turn = self.settings.turn_cost_m_per_rad
-        every, bounds = clustered_cells(open_frontier, min_cells)
-        if len(bounds) == 1:
-            return np.zeros((0, 2), np.int64), np.zeros(0), []
-        every_flat = every[:, 0] * open_frontier.shape[1] + every[:, 1]
-        cost = open_cost[np.searchsorted(open_flat, every_flat)]
-        if turn > 0:
-            cost = cost + turn * self.heading_change(view, every)
-        clusters = [every[a:b] for a, b in itertools.pairwise(bounds)]
-        return every[_first_argmin_per_group(cost, bounds)], np.diff(bounds).astype(float), clusters
 
     def hidden_room_targets(
         self, view: RobotView
@@ -637,6 +637,67 @@ def _small_pockets(belief, seeds, n_big):  # pragma: no cover (compiled)
     for k in range(len(seeds)):
         out[k] = state[seeds[k]] == 2
     return out
+
+
+@njit(cache=True)
+def _excluded(
+    belief, flat, near_bump, failed_until, unreachable_until, step, n_big
+):  # pragma: no cover (compiled)
+    """Per cell ``flat``: near a bump, failed or walled off at ``step``, or (``n_big`` > 0) in an
+    unknown pocket of fewer than ``n_big`` cells."""
+    out = np.empty(len(flat), np.bool_)
+    bump, failed, walled = near_bump.ravel(), failed_until.ravel(), unreachable_until.ravel()
+    for k in range(len(flat)):
+        out[k] = bump[flat[k]] or failed[flat[k]] > step or walled[flat[k]] > step
+    if n_big > 0:
+        out |= _small_pockets(belief, flat, n_big)
+    return out
+
+
+@njit(cache=True)
+def _frontier_menu(
+    belief,
+    frontier_flat,
+    near_bump,
+    failed_until,
+    unreachable_until,
+    step,
+    n_big,
+    cum,
+    offsets,
+    row_y,
+    col_x,
+    x,
+    y,
+    heading,
+    turn,
+    min_cells,
+):  # pragma: no cover (compiled)
+    """The frontier part of a menu in one pass: the open frontier cells (not excluded),
+    ``(N, 2)``, with their approach costs on ``cum``; their clusters of ``min_cells`` or more
+    (cells flat, grouped as :func:`~sfw_gym.navigation.frontiers.cluster_cells` groups them,
+    and the groups' bounds); and per cluster the index of its cheapest cell to resolve
+    (approach + ``turn`` × heading change)."""
+    h, w = belief.shape
+    open_flat = frontier_flat[
+        ~_excluded(belief, frontier_flat, near_bump, failed_until, unreachable_until, step, n_big)
+    ]
+    cells = np.empty((len(open_flat), 2), np.int64)
+    mask = np.zeros((h, w), np.bool_)
+    for k in range(len(open_flat)):
+        cells[k, 0] = open_flat[k] // w
+        cells[k, 1] = open_flat[k] - cells[k, 0] * w
+        mask[cells[k, 0], cells[k, 1]] = True
+    open_cost = _min_over_offsets(cum, cells, offsets)[0]
+    members, bounds = _clusters(mask, open_flat, min_cells)
+    cost = open_cost[np.searchsorted(open_flat, members)]
+    if turn > 0:
+        for k in range(len(members)):
+            r = members[k] // w
+            c = members[k] - r * w
+            bearing = math.atan2(row_y[r] - y, col_x[c] - x) - heading
+            cost[k] = cost[k] + turn * abs((bearing + math.pi) % (2 * math.pi) - math.pi)
+    return cells, open_cost, members, bounds, _first_argmin_per_group(cost, bounds)
 
 
 @njit(cache=True)

@@ -93,18 +93,12 @@ def cluster_cells(mask: np.ndarray, min_size_cells: int = 1) -> list[np.ndarray]
     """The 8-connected clusters of ``mask`` with at least ``min_size_cells`` cells, largest first
     (ties in the order of their first cell in raster order, as :func:`scipy.ndimage.label`
     numbers them), each as ``(N, 2)`` cells ``(row, col)`` in raster order."""
-    cells, bounds = clustered_cells(mask, min_size_cells)
-    return [cells[bounds[k] : bounds[k + 1]] for k in range(len(bounds) - 1)]
-
-
-def clustered_cells(mask: np.ndarray, min_size_cells: int = 1) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`cluster_cells` as one ``(N, 2)`` array of cells and the clusters' bounds in it
-    (cluster ``k`` is ``cells[bounds[k]:bounds[k + 1]]``)."""
     flat = np.flatnonzero(mask)
     if not len(flat):
-        return np.zeros((0, 2), np.int64), np.zeros(1, np.int64)
+        return []
     members, bounds = _clusters(np.ascontiguousarray(mask), flat, int(min_size_cells))
-    return np.stack(np.divmod(members, mask.shape[1]), axis=1), bounds
+    cells = np.stack(np.divmod(members, mask.shape[1]), axis=1)
+    return [cells[bounds[k] : bounds[k + 1]] for k in range(len(bounds) - 1)]
 
 
 @njit(cache=True)
