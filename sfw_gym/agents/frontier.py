@@ -414,8 +414,8 @@ class FrontierAgent(Agent):
 
     def _stalled(self, view: RobotView) -> bool:
         """Whether the map grew by less than ``stall_gain_m2`` over the last ``stall_steps``."""
-        _, _, unknown = belief_classes(view.belief_u8)
-        known = unknown.size - int(np.count_nonzero(unknown))
+        b = view.belief_u8
+        known = int(np.count_nonzero(b <= U8_WALL_MAX)) + int(np.count_nonzero(b >= U8_FREE_MIN))
         self._known_log.append((self.steps, known))
         while len(self._known_log) > 1 and self._known_log[1][0] <= self.steps - self.stall_steps:
             self._known_log.pop(0)
