@@ -383,7 +383,9 @@ class FrontierAgent(Agent):
         committed = goal is not None and goal.kind in (*self._committed_kinds, "escape")
         costs = self._costs(view, relaxed)
         res = view.grid.resolution_m
-        bound = self.search_radius_m if self._bounded_search and not committed else np.inf
+        # A bounded first search, unless there is no frontier to prove a choice about.
+        bounded = self._bounded_search and not committed and self.finder.frontier(view).any()
+        bound = self.search_radius_m if bounded else np.inf
         paths = cost_field(costs, view.cell, res, max_cost_m=bound)
         if committed:
             assert goal is not None

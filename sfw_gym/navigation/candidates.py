@@ -46,7 +46,6 @@ from sfw_gym.navigation.planning import (
     disk_offsets,
     free_start,
     mark_contact,
-    traversal_costs,
     update_wall_cost_term,
     wall_cost_term,
     wall_distance_m,
@@ -177,8 +176,7 @@ class GoalFinder:
         self._col_x, self._row_y = xs[0], ys[:, 0]  # cell centres: x by column, y by row
         self._belief = np.array(view.belief_u8, np.uint8)
         self._frontier = frontier_mask(self._belief)
-        self._walls_seen = np.zeros(shape, bool)
-        self._wall_term = np.zeros(shape)
+        self._wall_terms: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._near_bump = np.zeros(shape, bool)
         self._heard = np.full(shape, float(NOT_HEARD_DBM))
         self._n_heard = 0
@@ -236,30 +234,33 @@ class GoalFinder:
         cost that much per cell (bumps 4×) instead of blocking: the map's walls are doubted."""
         walls = view.belief_u8 <= U8_WALL_MAX
         res, radius = view.grid.resolution_m, view.radius_m
-        if escape_wall_cost is None:
-            # traversal_costs, with its wall-only term cached while the walls stay put
-            blocked = walls | self.bumps
-            changed = np.flatnonzero(blocked != self._walls_seen)
-            if len(changed) > blocked.size // 20:  # many changes: one distance transform
-                self._wall_term = (
-                    wall_cost_term(wall_distance_m(blocked, res), res, radius)
-                    if blocked.any()
-                    else np.zeros(blocked.shape)
-                )
-            elif len(changed):
-                update_wall_cost_term(self._wall_term, blocked, changed, res, radius)
-            self._walls_seen = blocked
+        unknown_cost = float(self.settings.unknown_cost)
+        if escape_wall_cost is None:  # traversal_costs with walls and bumps blocking
+            term = self._wall_term("blocking", walls | self.bumps, res, radius)
             r, c = view.cell
-            return _known_wall_costs(
-                view.belief_u8, self._wall_term, float(self.settings.unknown_cost), int(r), int(c)
-            )
-        else:
-            cost = traversal_costs(
-                view.belief_u8, res, radius, unknown_cost=self.settings.unknown_cost
-            )
-            cost[walls] = escape_wall_cost
-            cost[self.bumps] = 4 * escape_wall_cost
+            return _known_wall_costs(view.belief_u8, term, unknown_cost, int(r), int(c))
+        # traversal_costs of the belief's walls, which then cost instead of blocking
+        unknown = ~walls & (view.belief_u8 < U8_FREE_MIN)
+        cost = np.where(unknown, unknown_cost, 1.0) + self._wall_term("doubted", walls, res, radius)
+        cost[walls] = escape_wall_cost
+        cost[self.bumps] = 4 * escape_wall_cost
         return free_start(cost, view.cell)
+
+    def _wall_term(self, name: str, walls: np.ndarray, res: float, radius: float) -> np.ndarray:
+        """:func:`wall_cost_term` of ``walls``, kept per ``name`` and updated only around the
+        cells that changed since the last call (one distance transform when many did)."""
+        seen, term = self._wall_terms.get(name, (np.zeros_like(walls), np.zeros(walls.shape)))
+        changed = np.flatnonzero(walls != seen)
+        if len(changed) > walls.size // 20:
+            term = (
+                wall_cost_term(wall_distance_m(walls, res), res, radius)
+                if walls.any()
+                else np.zeros(walls.shape)
+            )
+        elif len(changed):
+            update_wall_cost_term(term, walls, changed, res, radius)
+        self._wall_terms[name] = (walls, term)
+        return term
 
     def approach(self, paths: CostField) -> np.ndarray:
         """Per cell: the cheapest path cost to a cell whose footprint covers it."""
