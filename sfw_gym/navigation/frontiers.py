@@ -57,8 +57,23 @@ def hidden_rooms(belief_u8: np.ndarray, min_depth_cells: float) -> np.ndarray:
         return np.zeros(belief_u8.shape)
     inside = np.zeros(belief_u8.shape, bool)
     inside[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1] = True
-    depth = ndimage.distance_transform_edt(unknown & inside)
+    depth = _distance_to_zeros(unknown & inside)
     return np.where(depth >= min_depth_cells, depth, 0.0)
+
+
+def _distance_to_zeros(ones: np.ndarray) -> np.ndarray:
+    """``scipy.ndimage.distance_transform_edt(ones)``, computed on the bounding box of the ones
+    grown by a cell: a ring of zeros holds, for every one, a zero at least as near as any
+    beyond it (clamp that zero onto the ring)."""
+    rows, cols = np.flatnonzero(ones.any(1)), np.flatnonzero(ones.any(0))
+    out = np.zeros(ones.shape)
+    if len(rows):
+        box = (
+            slice(max(rows[0] - 1, 0), rows[-1] + 2),
+            slice(max(cols[0] - 1, 0), cols[-1] + 2),
+        )
+        out[box] = ndimage.distance_transform_edt(ones[box])
+    return out
 
 
 def find_frontiers(
