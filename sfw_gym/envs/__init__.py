@@ -24,7 +24,11 @@ ENV_IDS: dict[str, dict[str, Any]] = {
         "crop_px": 36,
         "max_steps": 300,
     },
+    # Candidate-goal actions: pick one of K goals of the navigation menu, the robot drives there.
+    "SfW-ExploreGoals-v0": {},
 }
+#: Ids whose env is not the explore env itself.
+ENTRY_POINTS: dict[str, str] = {"SfW-ExploreGoals-v0": "sfw_gym.envs.goals:SfWGoalsEnv"}
 
 
 def register_envs() -> None:
@@ -33,7 +37,7 @@ def register_envs() -> None:
         if env_id not in gym.registry:
             gym.register(
                 id=env_id,
-                entry_point=ENTRY_POINT,
+                entry_point=ENTRY_POINTS.get(env_id, ENTRY_POINT),
                 kwargs=dict(kwargs),
                 max_episode_steps=None,
                 disable_env_checker=False,
@@ -46,6 +50,10 @@ def __getattr__(name: str) -> Any:
         from sfw_gym.envs.explore import SfWExploreEnv
 
         return SfWExploreEnv
+    if name == "SfWGoalsEnv":
+        from sfw_gym.envs.goals import SfWGoalsEnv
+
+        return SfWGoalsEnv
     if name == "WaypointWrapper":
         from sfw_gym.envs.waypoint import WaypointWrapper
 

@@ -19,6 +19,9 @@ WARNING_WHITELIST = (
     # SB3's checker notes that image observations should be channel-last or -first of size ≥ 36;
     # ours are channel-first and ≥ 36: SB3 still prints a generic hint for non-square Box spaces.
     "It seems that your observation",
+    # SfW-ExploreGoals-v0's ``candidates`` is K rows of features, read row by row by a
+    # per-candidate scorer (a custom policy), not flattened.
+    "Your observation candidates has an unconventional shape",
 )
 
 

@@ -1,0 +1,211 @@
+"""Candidate-goal actions: each action picks one of K goals from the navigation menu
+(:func:`~sfw_gym.navigation.candidate_goals`) and the robot drives there.
+
+One decision spans several env steps. Its reward is what the decision bought, in bits: the map's
+information gain, minus a cost per metre driven and per step spent (a contact costs the steps it
+wastes, no separate fine), plus a bonus when the coverage target is reached; divided by
+``reward_scale_bits`` so that a good decision is worth about one.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from sfw_gym.core.config import Config, setting
+from sfw_gym.core.constants import NOT_HEARD_DBM, U8_FREE_MIN, U8_WALL_MAX
+from sfw_gym.envs.explore import SfWExploreEnv
+from sfw_gym.navigation.candidates import FEATURES, CandidateGoals, GoalFinder
+from sfw_gym.navigation.planning import PurePursuit, cost_field, simplify_path, to_discrete
+
+#: Scale of each feature column in the observation (value / scale, then clipped to [-1, 4]).
+FEATURE_SCALES: dict[str, float] = {
+    "path_cost_m": 10.0,
+    "distance_m": 10.0,
+    "cluster_size_m": 5.0,
+    "expected_gain_bits": 50.0,
+    "unknown_area_m2": math.pi,
+    "heading_change_rad": math.pi,
+    "times_tried": 5.0,
+    "times_blacklisted": 5.0,
+    "is_hidden_room": 1.0,
+    "strongest_rssi_dbm": -float(NOT_HEARD_DBM),
+}
+_SCALES = np.array([FEATURE_SCALES[name] for name in FEATURES])
+
+
+@dataclass(frozen=True)
+class GoalsConfig(Config):
+    """Decisions and their reward (bits; see the module doc)."""
+
+    prefix: ClassVar[str | None] = "goals"
+    max_candidates: int = setting(16, ge=2, le=128, integer=True)
+    max_steps_per_goal: int = setting(80, ge=1, integer=True)
+    cost_per_m_bits: float = setting(10.0, ge=0.0)
+    cost_per_step_bits: float = setting(0.5, ge=0.0)
+    goal_bonus_bits: float = setting(100.0, ge=0.0)
+    reward_scale_bits: float = setting(100.0, gt=0.0)
+
+
+class SfWGoalsEnv(gym.Env):
+    """``SfW-ExploreGoals-v0``: ``Discrete(K)`` actions over the candidate-goal menu.
+
+    The observation is the explore env's, plus ``candidates`` (``(K, F)`` features of
+    :data:`~sfw_gym.navigation.candidates.FEATURES`, each divided by its
+    :data:`FEATURE_SCALES` entry; 0 for empty slots) and ``candidate_mask`` (1 where the goal is
+    reachable). :meth:`action_masks` gives the mask to sb3-contrib's ``MaskablePPO``.
+
+    A decision drives along the candidate's path (pure pursuit) until the goal is reached, the
+    target cell is resolved, a bump, ``max_steps_per_goal`` steps, or the episode's end. A
+    masked action is no goal: the robot turns in place for one step (``info["invalid_action"]``).
+
+    Args:
+        goals: :class:`GoalsConfig` fields (dict).
+        render_mode: As the explore env's.
+        **explore_kwargs: The explore env's kwargs.
+    """
+
+    metadata = SfWExploreEnv.metadata
+
+    def __init__(
+        self,
+        goals: dict[str, Any] | None = None,
+        render_mode: str | None = None,
+        **explore_kwargs: Any,
+    ):
+        self.config = GoalsConfig.from_dict(goals, "goals")
+        self.explore = SfWExploreEnv(render_mode=render_mode, **explore_kwargs)
+        self.render_mode = render_mode
+        k = self.config.max_candidates
+        explore_space = self.explore.observation_space
+        assert isinstance(explore_space, spaces.Dict)
+        self.action_space = spaces.Discrete(k)
+        self.observation_space = spaces.Dict(
+            {
+                **explore_space.spaces,
+                "candidates": spaces.Box(-1.0, 4.0, (k, len(FEATURES)), np.float32),
+                "candidate_mask": spaces.Box(0, 1, (k,), np.int8),
+            }
+        )
+        self.finder = GoalFinder()
+        self.menu: CandidateGoals | None = None
+        self.follower = PurePursuit()
+
+    # -- gymnasium API ---------------------------------------------------------------------------
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        super().reset(seed=seed)
+        obs, info = self.explore.reset(seed=seed, options=options)
+        self.finder.reset(self.explore.robot_view())
+        # The frontier agent's follower: the goal counts as reached once the footprint covers it.
+        self.follower = PurePursuit(lookahead_m=0.4, goal_tolerance_m=self.finder.goal_tolerance_m)
+        return self._observe(obs), info
+
+    def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        if self.menu is None:
+            raise gym.error.ResetNeeded("call reset() before step()")
+        a = np.asarray(action)
+        k = self.config.max_candidates
+        if a.shape != () or a.dtype.kind not in "iu" or not 0 <= int(a) < k:
+            raise ValueError(f"goal action must be an integer in [0, {k}), got {action!r}")
+        i, menu, cfg = int(a), self.menu, self.config
+        invalid = i >= len(menu) or not menu.valid[i]
+        start_path, start_steps = self.explore.path_length_m, self.explore.steps
+        gain = 0.0
+        if invalid:
+            obs, _, terminated, truncated, info = self.explore.step(self._command(0.0, 1.0))
+            gain += info["info_gain_bits"]
+        else:
+            target = (int(menu.target_rc[i, 0]), int(menu.target_rc[i, 1]))
+            view = self.explore.robot_view()
+            cells = menu.path(i)
+            xy = view.grid.cell_to_world(cells) if len(cells) else view.xy[None]
+            self.follower.set_path(simplify_path(xy, 0.2))
+            self.finder.note_tried(target, 2.0)
+            reached = False
+            for _ in range(cfg.max_steps_per_goal):
+                linear, angular = self.follower.command(view.odometry_pose)
+                if not self.follower.has_path:
+                    reached = True
+                    break
+                before = view.xy
+                obs, _, terminated, truncated, info = self.explore.step(
+                    self._command(linear, angular)
+                )
+                gain += info["info_gain_bits"]
+                view = self.explore.robot_view()
+                if terminated or truncated or self._resolved(view, target):
+                    break
+                if view.bumped:  # as the frontier agent: a wall ahead is remembered, backed off
+                    wanted = linear * view.max_linear_speed_m_s * view.control_period_s
+                    if wanted > 0 and np.linalg.norm(view.xy - before) < 0.5 * wanted:
+                        self.finder.mark_bump(view)
+                        if view.action_type == "continuous":
+                            obs, _, terminated, truncated, info = self.explore.step(
+                                self._command(-1.0, 0.0)
+                            )
+                            gain += info["info_gain_bits"]
+                    break
+            if (reached or self.explore.steps - start_steps >= cfg.max_steps_per_goal) and (
+                not self._resolved(view, target)
+            ):  # there (or out of time) and still unknown: no goal for a while
+                self.finder.blacklist(target, 2.0, self.explore.steps + 200)
+            if self.explore.steps == start_steps:  # already there: one step turning
+                obs, _, terminated, truncated, info = self.explore.step(self._command(0.0, 1.0))
+                gain += info["info_gain_bits"]
+        metres = self.explore.path_length_m - start_path
+        steps = self.explore.steps - start_steps
+        bits = gain - cfg.cost_per_m_bits * metres - cfg.cost_per_step_bits * steps
+        if terminated:
+            bits += cfg.goal_bonus_bits
+        info = dict(info, invalid_action=invalid, decision_steps=steps, decision_m=metres)
+        return self._observe(obs), bits / cfg.reward_scale_bits, terminated, truncated, info
+
+    def action_masks(self) -> np.ndarray:
+        """Which actions pick a reachable candidate (for ``MaskablePPO``)."""
+        mask = np.zeros(self.config.max_candidates, np.bool_)
+        if self.menu is not None:
+            mask[: len(self.menu)] = self.menu.valid
+        if not mask.any():
+            mask[:] = True  # nothing reachable: any action turns in place
+        return mask
+
+    def render(self) -> Any:
+        return self.explore.render()
+
+    def close(self) -> None:
+        self.explore.close()
+
+    def robot_view(self):
+        """The explore env's :meth:`~sfw_gym.envs.explore.SfWExploreEnv.robot_view`."""
+        return self.explore.robot_view()
+
+    # -- helpers ---------------------------------------------------------------------------------
+    def _observe(self, obs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        view = self.explore.robot_view()
+        self.finder.set_step(self.explore.steps)
+        paths = cost_field(self.finder.costs(view), view.cell, view.grid.resolution_m)
+        k = self.config.max_candidates
+        self.menu = menu = self.finder.find(view, paths, max_candidates=k)
+        feats = np.zeros((k, len(FEATURES)), np.float32)
+        scaled = np.nan_to_num(menu.features / _SCALES, nan=0.0, posinf=4.0, neginf=-1.0)
+        feats[: len(menu)] = np.clip(scaled, -1.0, 4.0)
+        mask = np.zeros(k, np.int8)
+        mask[: len(menu)] = menu.valid
+        return {**obs, "candidates": feats, "candidate_mask": mask}
+
+    def _command(self, linear: float, angular: float) -> Any:
+        if self.explore.action_type == "discrete":
+            return to_discrete(linear, angular)
+        return np.array([linear, angular], np.float32)
+
+    @staticmethod
+    def _resolved(view: Any, target: tuple[int, int]) -> bool:
+        value = int(view.belief_u8[target])
+        return value <= U8_WALL_MAX or value >= U8_FREE_MIN
