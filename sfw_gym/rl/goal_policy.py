@@ -1,0 +1,121 @@
+"""A MaskablePPO policy for ``SfW-ExploreGoals-v0``: one scorer per candidate, a separate critic.
+
+The actor's logit for candidate k is a small MLP of k's features and the robot's ``state`` (the
+same MLP for every candidate: pointer-style, so what it learns about one goal holds for all);
+masked candidates get no probability (sb3-contrib's ``MaskableCategorical``). The critic is a
+separate MLP of the mean and max of the candidates' features and ``state``: no trunk is shared,
+so the value loss cannot drown the policy's gradients (the waypoint policy's failure).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import torch
+from gymnasium import spaces
+from sb3_contrib.common.maskable.policies import MaskableMultiInputActorCriticPolicy
+from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
+from torch import nn
+
+
+class GoalsInputs(BaseFeaturesExtractor):
+    """Features = ``[candidates flattened (K·F), state (S)]`` (no parameters)."""
+
+    def __init__(self, observation_space: spaces.Dict) -> None:
+        k, f = observation_space["candidates"].shape or (0, 0)
+        s = int(np.prod(observation_space["state"].shape or (0,)))
+        super().__init__(observation_space, features_dim=k * f + s)
+        self.shape = (k, f, s)
+
+    def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
+        return torch.cat([observations["candidates"].flatten(1), observations["state"]], dim=1)
+
+
+class CandidateHeads(nn.Module):
+    """``forward_actor``: a logit per candidate; ``forward_critic``: the critic's latent."""
+
+    def __init__(self, k: int, f: int, s: int, hidden: int = 64) -> None:
+        super().__init__()
+        self.k, self.f, self.s = k, f, s
+        self.latent_dim_pi, self.latent_dim_vf = k, hidden
+        self.scorer = nn.Sequential(
+            nn.Linear(f + s, hidden), nn.Tanh(), nn.Linear(hidden, hidden), nn.Tanh()
+        )
+        self.score = nn.Linear(hidden, 1)
+        self.critic = nn.Sequential(
+            nn.Linear(2 * f + s, hidden), nn.Tanh(), nn.Linear(hidden, hidden), nn.Tanh()
+        )
+
+    def _split(self, features: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        cand = features[:, : self.k * self.f].view(-1, self.k, self.f)
+        return cand, features[:, self.k * self.f :]
+
+    def forward_actor(self, features: torch.Tensor) -> torch.Tensor:
+        cand, state = self._split(features)
+        both = torch.cat([cand, state[:, None, :].expand(-1, self.k, -1)], dim=2)
+        return self.score(self.scorer(both)).squeeze(-1)
+
+    def forward_critic(self, features: torch.Tensor) -> torch.Tensor:
+        cand, state = self._split(features)
+        pooled = torch.cat([cand.mean(1), cand.max(1).values, state], dim=1)
+        return self.critic(pooled)
+
+    def forward(self, features: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        return self.forward_actor(features), self.forward_critic(features)
+
+
+class GoalsPolicy(MaskableMultiInputActorCriticPolicy):
+    """:class:`CandidateHeads` as the policy's heads; the logits are the actor's output as is."""
+
+    def __init__(self, *args: Any, hidden: int = 64, **kwargs: Any) -> None:
+        self.hidden = hidden
+        kwargs.setdefault("features_extractor_class", GoalsInputs)
+        super().__init__(*args, **kwargs)
+
+    def _build_mlp_extractor(self) -> None:
+        k, f, s = self.features_extractor.shape
+        self.mlp_extractor = CandidateHeads(k, f, s, self.hidden)
+
+    def _build(self, lr_schedule: Any) -> None:
+        super()._build(lr_schedule)
+        self.action_net = nn.Identity()  # one logit per candidate already
+        self.optimizer = self.optimizer_class(
+            self.parameters(), lr=lr_schedule(1), **self.optimizer_kwargs
+        )
+
+
+def behaviour_clone(
+    policy: GoalsPolicy,
+    observations: list[dict[str, np.ndarray]],
+    actions: np.ndarray,
+    masks: np.ndarray,
+    epochs: int = 20,
+    batch_size: int = 256,
+    lr: float = 1e-3,
+    seed: int = 0,
+) -> list[float]:
+    """Fit the actor to a teacher's ``actions`` (cross-entropy over the masked candidates);
+    returns the mean loss per epoch."""
+    gen = torch.Generator().manual_seed(seed)
+    obs = {k: torch.as_tensor(np.stack([o[k] for o in observations])) for k in observations[0]}
+    acts = torch.as_tensor(actions, dtype=torch.long)
+    mask = torch.as_tensor(masks, dtype=torch.bool)
+    actor = [*policy.mlp_extractor.scorer.parameters(), *policy.mlp_extractor.score.parameters()]
+    optimiser = torch.optim.Adam(actor, lr=lr)
+    losses = []
+    for _ in range(epochs):
+        order = torch.randperm(len(acts), generator=gen)
+        total = 0.0
+        for start in range(0, len(acts), batch_size):
+            idx = order[start : start + batch_size]
+            features = policy.extract_features({k: v[idx] for k, v in obs.items()})
+            logits = policy.mlp_extractor.forward_actor(features)
+            logits = logits.masked_fill(~mask[idx], -1e8)
+            loss = nn.functional.cross_entropy(logits, acts[idx])
+            optimiser.zero_grad()
+            loss.backward()
+            optimiser.step()
+            total += float(loss.detach()) * len(idx)
+        losses.append(total / len(acts))
+    return losses

@@ -1,0 +1,71 @@
+"""The candidate-goal policy: masked pointer logits, a critic apart, behaviour cloning."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import sfw_gym  # noqa: F401  (registration)
+from tests.envs.test_goals import SMALL, explore_lite_choice
+
+torch = pytest.importorskip("torch")
+sb3_contrib = pytest.importorskip("sb3_contrib")
+from sfw_gym.rl.goal_policy import GoalsPolicy, behaviour_clone  # noqa: E402
+
+
+def model_on(env):
+    return sb3_contrib.MaskablePPO(GoalsPolicy, env, n_steps=16, batch_size=16, seed=0)
+
+
+def as_batch(observations):
+    return {k: torch.as_tensor(np.stack([o[k] for o in observations])) for k in observations[0]}
+
+
+def teacher_decisions(seeds):
+    observations, actions, masks = [], [], []
+    for seed in seeds:
+        env = gym.make("SfW-ExploreGoals-v0", **SMALL)
+        obs, _ = env.reset(seed=seed)
+        done = False
+        while not done:
+            action = explore_lite_choice(env)
+            observations.append(obs)
+            actions.append(action)
+            masks.append(env.unwrapped.action_masks())
+            obs, _, terminated, truncated, _ = env.step(action)
+            done = terminated or truncated
+    return observations, np.array(actions), np.array(masks)
+
+
+def test_masked_candidates_get_no_probability():
+    env = gym.make("SfW-ExploreGoals-v0", **SMALL, goals={"max_candidates": 64})
+    obs, _ = env.reset(seed=0)
+    mask = env.unwrapped.action_masks()
+    assert not mask.all()
+    policy = model_on(env).policy
+    dist = policy.get_distribution(as_batch([obs]), action_masks=mask[None])
+    probs = dist.distribution.probs[0].detach().numpy()
+    assert np.all(probs[~mask] == 0.0) and probs[mask].sum() == pytest.approx(1.0)
+
+
+def test_the_value_loss_does_not_reach_the_actor():
+    env = gym.make("SfW-ExploreGoals-v0", **SMALL)
+    obs, _ = env.reset(seed=0)
+    policy = model_on(env).policy
+    policy.predict_values(as_batch([obs])).sum().backward()
+    heads = policy.mlp_extractor
+    assert all(p.grad is None for p in [*heads.scorer.parameters(), *heads.score.parameters()])
+    assert any(p.grad is not None and p.grad.abs().sum() > 0 for p in heads.critic.parameters())
+
+
+def test_behaviour_cloning_learns_the_teachers_choices():
+    observations, actions, masks = teacher_decisions(range(4))
+    held_out, actions_out, masks_out = teacher_decisions([10])
+    policy = model_on(gym.make("SfW-ExploreGoals-v0", **SMALL)).policy
+    losses = behaviour_clone(policy, observations, actions, masks, epochs=30)
+    assert losses[-1] < 0.5 * losses[0]
+    with torch.no_grad():
+        logits = policy.mlp_extractor.forward_actor(policy.extract_features(as_batch(held_out)))
+    chosen = logits.masked_fill(~torch.as_tensor(masks_out), -1e8).argmax(1).numpy()
+    assert np.mean(chosen == actions_out) >= 0.8
