@@ -48,7 +48,7 @@ from scipy import ndimage
 from sfw_gym.agents.base import Agent, RobotView
 from sfw_gym.core.config import check
 from sfw_gym.core.constants import U8_FREE_MIN, U8_WALL_MAX
-from sfw_gym.navigation.candidates import CandidateSettings, GoalFinder
+from sfw_gym.navigation.candidates import SOURCES, CandidateGoals, CandidateSettings, GoalFinder
 from sfw_gym.navigation.planning import (
     CostField,
     PurePursuit,
@@ -78,6 +78,22 @@ class Goal:
     best_remaining_m: float = np.inf
     steps_without_progress: int = 0
     bumps: int = 0
+
+
+#: explore_lite's utility of a frontier cluster: GAIN_SCALE × size (m) − POTENTIAL_SCALE × cost
+#: (m), the cost being the path plus TURN_COST_M_PER_RAD × the heading change (rad).
+GAIN_SCALE, POTENTIAL_SCALE, TURN_COST_M_PER_RAD = 1.0, 3.0, 0.3
+
+
+def explore_lite_choice(menu: CandidateGoals) -> int | None:
+    """The index of the menu's frontier candidate of best explore_lite utility (with the
+    frontier agent's default scales; None when no frontier candidate is reachable): the
+    frontier agent's choice on a K-candidate menu, the teacher of the learned explorer."""
+    f = menu.feature
+    cost = f("path_cost_m") + TURN_COST_M_PER_RAD * f("heading_change_rad")
+    utility = GAIN_SCALE * f("cluster_size_m") - POTENTIAL_SCALE * cost
+    ok = menu.valid & (menu.source == SOURCES.index("frontier"))
+    return int(np.argmax(np.where(ok, utility, -np.inf))) if ok.any() else None
 
 
 #: What :meth:`FrontierAgent._choose_goal` returns when a bounded search cannot prove its choice.
@@ -137,8 +153,8 @@ class FrontierAgent(Agent):
 
     def __init__(
         self,
-        gain_scale: float = 1.0,
-        potential_scale: float = 3.0,
+        gain_scale: float = GAIN_SCALE,
+        potential_scale: float = POTENTIAL_SCALE,
         min_frontier_size_m: float = 0.3,
         progress_timeout_steps: int = 30,
         blacklist_radius_m: float = 0.3,
@@ -148,7 +164,7 @@ class FrontierAgent(Agent):
         bump_exclusion_m: float = 0.3,
         lookahead_m: float = 0.4,
         backoff_steps: int = 1,
-        turn_cost_m_per_rad: float = 0.3,
+        turn_cost_m_per_rad: float = TURN_COST_M_PER_RAD,
         max_bumps_per_goal: int = 2,
         blacklist_ttl_steps: int = 600,
         unreachable_ttl_steps: int = 200,

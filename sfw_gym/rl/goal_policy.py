@@ -26,7 +26,7 @@ class GoalsInputs(BaseFeaturesExtractor):
         k, f = observation_space["candidates"].shape or (0, 0)
         s = int(np.prod(observation_space["state"].shape or (0,)))
         super().__init__(observation_space, features_dim=k * f + s)
-        self.shape = (k, f, s)
+        self.shape: tuple[int, int, int] = (k, f, s)
 
     def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
         return torch.cat([observations["candidates"].flatten(1), observations["state"]], dim=1)
@@ -74,13 +74,15 @@ class GoalsPolicy(MaskableMultiInputActorCriticPolicy):
         super().__init__(*args, **kwargs)
 
     def _build_mlp_extractor(self) -> None:
-        k, f, s = self.features_extractor.shape
-        self.mlp_extractor = CandidateHeads(k, f, s, self.hidden)
+        inputs = self.features_extractor
+        assert isinstance(inputs, GoalsInputs)
+        self.heads = CandidateHeads(*inputs.shape, hidden=self.hidden)
+        self.mlp_extractor = self.heads  # type: ignore[assignment]
 
     def _build(self, lr_schedule: Any) -> None:
         super()._build(lr_schedule)
         self.action_net = nn.Identity()  # one logit per candidate already
-        self.optimizer = self.optimizer_class(
+        self.optimizer = self.optimizer_class(  # type: ignore[call-arg]
             self.parameters(), lr=lr_schedule(1), **self.optimizer_kwargs
         )
 
@@ -101,7 +103,8 @@ def behaviour_clone(
     obs = {k: torch.as_tensor(np.stack([o[k] for o in observations])) for k in observations[0]}
     acts = torch.as_tensor(actions, dtype=torch.long)
     mask = torch.as_tensor(masks, dtype=torch.bool)
-    actor = [*policy.mlp_extractor.scorer.parameters(), *policy.mlp_extractor.score.parameters()]
+    heads = policy.heads
+    actor = [*heads.scorer.parameters(), *heads.score.parameters()]
     optimiser = torch.optim.Adam(actor, lr=lr)
     losses = []
     for _ in range(epochs):
@@ -110,7 +113,8 @@ def behaviour_clone(
         for start in range(0, len(acts), batch_size):
             idx = order[start : start + batch_size]
             features = policy.extract_features({k: v[idx] for k, v in obs.items()})
-            logits = policy.mlp_extractor.forward_actor(features)
+            assert isinstance(features, torch.Tensor)
+            logits = heads.forward_actor(features)
             logits = logits.masked_fill(~mask[idx], -1e8)
             loss = nn.functional.cross_entropy(logits, acts[idx])
             optimiser.zero_grad()

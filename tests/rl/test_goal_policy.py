@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import sfw_gym  # noqa: F401  (registration)
-from tests.envs.test_goals import SMALL, explore_lite_choice
+from tests.envs.test_goals import SMALL, explore_lite
 
 torch = pytest.importorskip("torch")
 sb3_contrib = pytest.importorskip("sb3_contrib")
@@ -29,7 +29,7 @@ def teacher_decisions(seeds):
         obs, _ = env.reset(seed=seed)
         done = False
         while not done:
-            action = explore_lite_choice(env)
+            action = explore_lite(env)
             observations.append(obs)
             actions.append(action)
             masks.append(env.unwrapped.action_masks())
@@ -54,7 +54,7 @@ def test_the_value_loss_does_not_reach_the_actor():
     obs, _ = env.reset(seed=0)
     policy = model_on(env).policy
     policy.predict_values(as_batch([obs])).sum().backward()
-    heads = policy.mlp_extractor
+    heads = policy.heads
     assert all(p.grad is None for p in [*heads.scorer.parameters(), *heads.score.parameters()])
     assert any(p.grad is not None and p.grad.abs().sum() > 0 for p in heads.critic.parameters())
 
@@ -66,6 +66,6 @@ def test_behaviour_cloning_learns_the_teachers_choices():
     losses = behaviour_clone(policy, observations, actions, masks, epochs=30)
     assert losses[-1] < 0.5 * losses[0]
     with torch.no_grad():
-        logits = policy.mlp_extractor.forward_actor(policy.extract_features(as_batch(held_out)))
+        logits = policy.heads.forward_actor(policy.extract_features(as_batch(held_out)))
     chosen = logits.masked_fill(~torch.as_tensor(masks_out), -1e8).argmax(1).numpy()
     assert np.mean(chosen == actions_out) >= 0.8
