@@ -131,6 +131,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 def _cmd_train(args: argparse.Namespace) -> int:
     import gymnasium as gym
 
+    from sfw_gym.core.data import default_hyperparams
     from sfw_gym.rl.training import train_ppo
 
     if ":" not in args.env:  # ("module:Env-v0" registers on import, in the workers)
@@ -138,10 +139,11 @@ def _cmd_train(args: argparse.Namespace) -> int:
     summary = train_ppo(
         args.env,
         args.timesteps,
-        args.out or f"runs/ppo/{args.env}",
+        args.out or f"runs/{args.algo}/{args.env}",
         n_envs=args.n_envs,
         seed=args.seed,
-        hyperparams_path=args.hyperparams,
+        hyperparams_path=args.hyperparams or default_hyperparams(args.algo),
+        algo=args.algo,
         checkpoint_every=args.checkpoint_every,
         eval_every=args.eval_every,
         eval_episodes=args.eval_episodes,
@@ -312,10 +314,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     bench.set_defaults(func=_cmd_bench)
 
-    from sfw_gym.core.data import DEFAULT_HYPERPARAMS
-
     train = sub.add_parser("train", help="train an agent (PPO, stable-baselines3)")
-    train.add_argument("algo", choices=["ppo"], help="the algorithm (ppo)")
+    train.add_argument(
+        "algo",
+        choices=["ppo", "ppo_mask"],
+        help="ppo, or ppo_mask (MaskablePPO, for SfW-ExploreGoals-v0)",
+    )
     train.add_argument("--env", default="SfW-Explore-v0", help="env id (default SfW-Explore-v0)")
     train.add_argument("--timesteps", type=positive_int, default=1_000_000, help="total env steps")
     train.add_argument(
@@ -325,7 +329,9 @@ def build_parser() -> argparse.ArgumentParser:
     train.add_argument(
         "--out", type=folder, default=None, help="output folder (default runs/ppo/ENV)"
     )
-    train.add_argument("--hyperparams", default=str(DEFAULT_HYPERPARAMS), help="rl-zoo YAML")
+    train.add_argument(
+        "--hyperparams", default=None, help="rl-zoo YAML (default: the shipped <algo>.yml)"
+    )
     train.add_argument("--checkpoint-every", type=positive_int, default=50_000, help="env steps")
     train.add_argument("--eval-every", type=positive_int, default=25_000, help="env steps")
     train.add_argument("--eval-episodes", type=positive_int, default=5, help="held-out episodes")

@@ -27,6 +27,13 @@ def data_path(*parts: str) -> Path:
 DEFAULT_MODEL_DIR = data_path("agents", "ppo", "SfW-Explore-v0_1")
 #: PPO hyperparameters per env id (rl-zoo format).
 DEFAULT_HYPERPARAMS = data_path("agents", "hyperparams", "ppo.yml")
+
+
+def default_hyperparams(algo: str) -> Path:
+    """rl-zoo's hyperparameter file of ``algo`` (``ppo``, ``ppo_mask``)."""
+    return data_path("agents", "hyperparams", f"{algo}.yml")
+
+
 #: The benchmarks' floorplan sets and seed splits.
 SCENARIOS = data_path("envs", "scenarios.yml")
 

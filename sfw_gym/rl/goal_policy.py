@@ -9,14 +9,18 @@ so the value loss cannot drown the policy's gradients (the waypoint policy's fai
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 import torch
 from gymnasium import spaces
 from sb3_contrib.common.maskable.policies import MaskableMultiInputActorCriticPolicy
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from torch import nn
+
+from sfw_gym.agents.frontier import explore_lite_choice
 
 
 class GoalsInputs(BaseFeaturesExtractor):
@@ -85,6 +89,30 @@ class GoalsPolicy(MaskableMultiInputActorCriticPolicy):
         self.optimizer = self.optimizer_class(  # type: ignore[call-arg]
             self.parameters(), lr=lr_schedule(1), **self.optimizer_kwargs
         )
+
+
+def teacher_decisions(
+    env_id: str, env_kwargs: dict[str, Any], seeds: Iterable[int]
+) -> tuple[list[dict[str, np.ndarray]], np.ndarray, np.ndarray]:
+    """Observations, choices and masks of the frontier agent's choice on the menu
+    (:func:`~sfw_gym.agents.frontier.explore_lite_choice`; any valid goal when it has none)
+    over one episode per seed."""
+    observations, actions, masks = [], [], []
+    for seed in seeds:
+        env = gym.make(env_id, **env_kwargs)
+        obs, _ = env.reset(seed=seed)
+        done = False
+        while not done:
+            mask = env.unwrapped.action_masks()  # type: ignore[attr-defined]
+            choice = explore_lite_choice(env.unwrapped.menu)  # type: ignore[attr-defined]
+            action = int(np.argmax(mask)) if choice is None else choice
+            observations.append(obs)
+            actions.append(action)
+            masks.append(mask)
+            obs, _, terminated, truncated, _ = env.step(action)
+            done = terminated or truncated
+        env.close()
+    return observations, np.array(actions), np.array(masks)
 
 
 def behaviour_clone(

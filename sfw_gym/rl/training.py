@@ -1,8 +1,9 @@
-"""PPO training (stable-baselines3) with checkpoints, resume, held-out evaluation and a curve.
+"""PPO training (stable-baselines3; sb3-contrib's MaskablePPO as ``ppo_mask``, optionally
+started by behaviour cloning) with checkpoints, resume, held-out evaluation and a curve.
 
 Layout of an output folder::
 
-    OUT/checkpoints/ppo_<steps>_steps.zip   every ``checkpoint_every`` env steps
+    OUT/checkpoints/<algo>_<steps>_steps.zip   every ``checkpoint_every`` env steps
     OUT/tb/                                 TensorBoard logs
     OUT/train_<start>.monitor.csv           episode return, length, floorplan (one per run segment)
     OUT/eval/evaluations.npz                held-out evaluation (EvalCallback)
@@ -35,7 +36,10 @@ MOVED_CLASSES = {
 }
 #: Evaluation episodes draw their floorplans from seeds this far from the training seeds.
 HELD_OUT_SEED_OFFSET = 1_000_000
+#: The algorithms, by rl-zoo's names.
+ALGOS = ("ppo", "ppo_mask")
 _PPO_KEYS = {
+    "target_kl",
     "n_steps",
     "batch_size",
     "n_epochs",
@@ -64,7 +68,17 @@ def load_hyperparams(env_id: str, path: str | Path = DEFAULT_HYPERPARAMS) -> dic
     if isinstance(params.get("policy_kwargs"), str):
         params["policy_kwargs"] = parse_policy_kwargs(params["policy_kwargs"])
     wrapper_specs(params.get("env_wrapper"))  # fail early on a malformed entry
-    unknown = set(params) - _PPO_KEYS - {"policy", "n_timesteps", "n_envs", "env_wrapper"}
+    unknown = (
+        set(params)
+        - _PPO_KEYS
+        - {
+            "policy",
+            "n_timesteps",
+            "n_envs",
+            "env_wrapper",
+            "behaviour_cloning",
+        }
+    )
     if unknown:
         raise ConfigError(f"{path}: unknown keys for {env_id!r}: {sorted(unknown)}")
     return params
@@ -137,11 +151,11 @@ def import_dotted(name: str) -> Any:
         raise ConfigError(f"cannot import {name!r}: {exc}") from None
 
 
-def latest_checkpoint(out_dir: Path) -> tuple[Path, int] | None:
+def latest_checkpoint(out_dir: Path, algo: str = "ppo") -> tuple[Path, int] | None:
     """The checkpoint with the most env steps in ``OUT/checkpoints``, if any."""
     found = []
-    for path in (out_dir / "checkpoints").glob("ppo_*_steps.zip"):
-        match = re.fullmatch(r"ppo_(\d+)_steps\.zip", path.name)
+    for path in (out_dir / "checkpoints").glob(f"{algo}_*_steps.zip"):
+        match = re.fullmatch(rf"{algo}_(\d+)_steps\.zip", path.name)
         if match:
             found.append((int(match.group(1)), path))
     if not found:
@@ -196,20 +210,34 @@ def train_ppo(
     resume: bool = False,
     progress_bar: bool = True,
     device: str = "auto",
+    algo: str = "ppo",
 ) -> dict[str, Any]:
     """Train (or resume training) PPO on ``env_id`` up to ``timesteps`` env steps in total.
+
+    ``algo="ppo_mask"``: sb3-contrib's MaskablePPO (the env has ``action_masks()``); a
+    ``behaviour_cloning`` block in the hyperparameters (``episodes``, ``epochs``) first fits
+    the fresh policy's actor to the frontier agent's choices on that many training episodes.
 
     With ``resume=True`` the latest checkpoint in ``OUT/checkpoints`` is loaded and training
     continues from its step count (the step counter, optimiser and rollout schedule carry on);
     without a checkpoint it starts afresh. Returns a summary (steps, wall time, paths).
     """
-    from stable_baselines3 import PPO
-    from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback, EvalCallback
+    from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
 
     import sfw_gym  # noqa: F401  (registration in this process)
 
     if timesteps < 1:
         raise ConfigError(f"timesteps must be ≥ 1, got {timesteps}")
+    if algo not in ALGOS:
+        raise ConfigError(f"unknown algo {algo!r}; known: {list(ALGOS)}")
+    Algo: Any
+    EvalCallback: Any
+    if algo == "ppo":
+        from stable_baselines3 import PPO as Algo
+        from stable_baselines3.common.callbacks import EvalCallback
+    else:
+        from sb3_contrib import MaskablePPO as Algo
+        from sb3_contrib.common.maskable.callbacks import MaskableEvalCallback as EvalCallback
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     params = load_hyperparams(env_id, hyperparams_path)
@@ -223,7 +251,7 @@ def train_ppo(
     for name, _ in wrappers:
         import_dotted(name)
 
-    previous = latest_checkpoint(out) if resume else None
+    previous = latest_checkpoint(out, algo) if resume else None
     start_steps = previous[1] if previous else 0
     if previous is not None and start_steps >= timesteps:  # already there (killed after its last
         with atomic_path(out / "model.zip") as tmp:  # checkpoint)
@@ -248,11 +276,11 @@ def train_ppo(
         )
         try:
             if previous:
-                model = PPO.load(
+                model = Algo.load(
                     previous[0], env=venv, device=device, tensorboard_log=str(out / "tb")
                 )
             else:
-                model = PPO(
+                model = Algo(
                     policy,
                     venv,
                     seed=seed,
@@ -261,12 +289,14 @@ def train_ppo(
                     tensorboard_log=str(out / "tb"),
                     **ppo_kwargs,
                 )
+                if params.get("behaviour_cloning"):
+                    _clone_teacher(model, env_id, env_kwargs, seed, params["behaviour_cloning"])
             callbacks = CallbackList(
                 [
                     CheckpointCallback(
                         max(checkpoint_every // n_envs, 1),
                         str(out / "checkpoints"),
-                        name_prefix="ppo",
+                        name_prefix=algo,
                     ),
                     EvalCallback(
                         eval_env,
@@ -285,17 +315,18 @@ def train_ppo(
                 callback=callbacks,
                 reset_num_timesteps=previous is None,
                 progress_bar=progress_bar,
-                tb_log_name="ppo",
+                tb_log_name=algo,
             )
             wall = time.perf_counter() - start
             _save_atomic(model, out / "model.zip")
             # A final checkpoint, so that a later resume starts from the end of this run.
-            _save_atomic(model, out / "checkpoints" / f"ppo_{model.num_timesteps}_steps.zip")
+            _save_atomic(model, out / "checkpoints" / f"{algo}_{model.num_timesteps}_steps.zip")
         finally:
             venv.close()
             eval_env.close()
         steps = int(model.num_timesteps)
     summary = {
+        "algo": algo,
         "env_id": env_id,
         "steps": steps,
         "resumed_from": str(previous[0]) if previous else None,
@@ -311,6 +342,20 @@ def train_ppo(
     write_text_atomic(out / "config.yml", yaml.safe_dump(summary, sort_keys=False))
     plot_training_curve(out)
     return summary
+
+
+def _clone_teacher(
+    model: Any, env_id: str, env_kwargs: dict[str, Any], seed: int, spec: dict[str, Any]
+) -> None:
+    """Behaviour cloning of the frontier agent's menu choices before PPO (training seeds)."""
+    from sfw_gym.rl.goal_policy import behaviour_clone, teacher_decisions
+
+    unknown = set(spec) - {"episodes", "epochs"}
+    if unknown:
+        raise ConfigError(f"behaviour_cloning: unknown keys {sorted(unknown)}")
+    seeds = range(seed, seed + int(spec.get("episodes", 8)))
+    observations, actions, masks = teacher_decisions(env_id, env_kwargs, seeds)
+    behaviour_clone(model.policy, observations, actions, masks, epochs=int(spec.get("epochs", 30)))
 
 
 def _monitored_seconds(out: Path) -> float:

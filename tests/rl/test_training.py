@@ -76,3 +76,52 @@ def test_killed_run_resumes_from_its_last_checkpoint(tmp_path):
     assert target <= summary["steps"] < target + 128  # continued, not restarted from 0
     assert latest_checkpoint(out)[1] == summary["steps"]
     assert (out / "model.zip").exists() and (out / "config.yml").exists()
+
+
+def test_maskable_ppo_on_candidate_goals_starts_from_the_frontier_agents_choices(tmp_path):
+    """ppo_mask: behaviour cloning before PPO (the actor already prefers the teacher's choices),
+    checkpoints under its own name, and a resumed run continues."""
+    import gymnasium as gym
+    import numpy as np
+    from sb3_contrib import MaskablePPO
+
+    from sfw_gym.agents.frontier import explore_lite_choice
+    from tests.envs.test_goals import SMALL
+
+    yml = tmp_path / "ppo_mask.yml"
+    yml.write_text(
+        "SfW-ExploreGoals-v0:\n"
+        "  policy: 'sfw_gym.rl.goal_policy.GoalsPolicy'\n"
+        "  behaviour_cloning: {episodes: 3, epochs: 30}\n"
+        "  n_steps: 32\n  batch_size: 32\n  n_epochs: 1\n  learning_rate: !!float 1e-5\n"
+    )
+    out = tmp_path / "run"
+    kwargs = dict(n_envs=1, env_kwargs=SMALL, hyperparams_path=yml, algo="ppo_mask")
+    kwargs |= dict(checkpoint_every=32, eval_every=10**9, progress_bar=False)
+    summary = train_ppo("SfW-ExploreGoals-v0", 32, out, **kwargs)
+    assert summary["algo"] == "ppo_mask" and latest_checkpoint(out, "ppo_mask")[1] == 32
+    model = MaskablePPO.load(out / "model.zip")
+    env = gym.make("SfW-ExploreGoals-v0", **SMALL)
+    agree = []
+    for seed in (20, 21):
+        obs, _ = env.reset(seed=seed)
+        for _ in range(15):
+            menu, mask = env.unwrapped.menu, env.unwrapped.action_masks()
+            action, _ = model.predict(obs, action_masks=mask, deterministic=True)
+            teacher = explore_lite_choice(menu)
+            if teacher is not None:
+                agree.append(int(action) == teacher)
+            obs, _, terminated, truncated, _ = env.step(int(action))
+            if terminated or truncated:
+                break
+    assert np.mean(agree) >= 0.7
+    resumed = train_ppo("SfW-ExploreGoals-v0", 64, out, resume=True, **kwargs)
+    assert resumed["steps"] == 64 and latest_checkpoint(out, "ppo_mask")[1] == 64
+
+
+def test_shipped_maskable_hyperparameters_load():
+    from sfw_gym.core.data import default_hyperparams
+
+    params = load_hyperparams("SfW-ExploreGoals-v0", default_hyperparams("ppo_mask"))
+    assert params["policy"] == "sfw_gym.rl.goal_policy.GoalsPolicy"
+    assert params["behaviour_cloning"]["episodes"] > 0
