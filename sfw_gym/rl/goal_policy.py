@@ -80,8 +80,14 @@ class GoalsPolicy(MaskableMultiInputActorCriticPolicy):
     def _build_mlp_extractor(self) -> None:
         inputs = self.features_extractor
         assert isinstance(inputs, GoalsInputs)
-        self.heads = CandidateHeads(*inputs.shape, hidden=self.hidden)
-        self.mlp_extractor = self.heads  # type: ignore[assignment]
+        self.mlp_extractor = CandidateHeads(*inputs.shape, hidden=self.hidden)  # type: ignore[assignment]
+
+    @property
+    def heads(self) -> CandidateHeads:
+        """The actor's and the critic's heads (SB3's ``mlp_extractor``)."""
+        heads = self.mlp_extractor
+        assert isinstance(heads, CandidateHeads)
+        return heads
 
     def _build(self, lr_schedule: Any) -> None:
         super()._build(lr_schedule)
