@@ -18,10 +18,11 @@ import numpy as np
 from gymnasium import spaces
 
 from sfw_gym.core.config import Config, setting
-from sfw_gym.core.constants import NOT_HEARD_DBM, U8_FREE_MIN, U8_WALL_MAX
+from sfw_gym.core.constants import NOT_HEARD_DBM
 from sfw_gym.envs.explore import SfWExploreEnv
 from sfw_gym.navigation.candidates import FEATURES, CandidateGoals, GoalFinder
-from sfw_gym.navigation.planning import PurePursuit, cost_field, simplify_path, to_discrete
+from sfw_gym.navigation.goal_driver import GoalDriver
+from sfw_gym.navigation.planning import cost_field, to_discrete
 
 #: Scale of each feature column in the observation (value / scale, then clipped to [-1, 4]).
 FEATURE_SCALES: dict[str, float] = {
@@ -93,8 +94,8 @@ class SfWGoalsEnv(gym.Env):
             }
         )
         self.finder = GoalFinder()
+        self.driver = GoalDriver(self.finder, self.config.max_steps_per_goal)
         self.menu: CandidateGoals | None = None
-        self.follower = PurePursuit()
 
     # -- gymnasium API ---------------------------------------------------------------------------
     def reset(
@@ -103,8 +104,7 @@ class SfWGoalsEnv(gym.Env):
         super().reset(seed=seed)
         obs, info = self.explore.reset(seed=seed, options=options)
         self.finder.reset(self.explore.robot_view())
-        # The frontier agent's follower: the goal counts as reached once the footprint covers it.
-        self.follower = PurePursuit(lookahead_m=0.4, goal_tolerance_m=self.finder.goal_tolerance_m)
+        self.driver.reset()
         return self._observe(obs), info
 
     def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
@@ -114,51 +114,17 @@ class SfWGoalsEnv(gym.Env):
         k = self.config.max_candidates
         if a.shape != () or a.dtype.kind not in "iu" or not 0 <= int(a) < k:
             raise ValueError(f"goal action must be an integer in [0, {k}), got {action!r}")
-        i, menu, cfg = int(a), self.menu, self.config
-        invalid = i >= len(menu) or not menu.valid[i]
+        cfg = self.config
         start_path, start_steps = self.explore.path_length_m, self.explore.steps
+        view = self.explore.robot_view()
+        invalid = not self.driver.start(view, self.menu, int(a))
         gain = 0.0
-        if invalid:
-            obs, _, terminated, truncated, info = self.explore.step(self._command(0.0, 1.0))
+        while (command := self.driver.command(view)) is not None:
+            obs, _, terminated, truncated, info = self.explore.step(self._command(*command))
             gain += info["info_gain_bits"]
-        else:
-            target = (int(menu.target_rc[i, 0]), int(menu.target_rc[i, 1]))
             view = self.explore.robot_view()
-            cells = menu.path(i)
-            xy = view.grid.cell_to_world(cells) if len(cells) else view.xy[None]
-            self.follower.set_path(simplify_path(xy, 0.2))
-            self.finder.note_tried(target, 2.0)
-            reached = False
-            for _ in range(cfg.max_steps_per_goal):
-                linear, angular = self.follower.command(view.odometry_pose)
-                if not self.follower.has_path:
-                    reached = True
-                    break
-                before = view.xy
-                obs, _, terminated, truncated, info = self.explore.step(
-                    self._command(linear, angular)
-                )
-                gain += info["info_gain_bits"]
-                view = self.explore.robot_view()
-                if terminated or truncated or self._resolved(view, target):
-                    break
-                if view.bumped:  # as the frontier agent: a wall ahead is remembered, backed off
-                    wanted = linear * view.max_linear_speed_m_s * view.control_period_s
-                    if wanted > 0 and np.linalg.norm(view.xy - before) < 0.5 * wanted:
-                        self.finder.mark_bump(view)
-                        if view.action_type == "continuous":
-                            obs, _, terminated, truncated, info = self.explore.step(
-                                self._command(-1.0, 0.0)
-                            )
-                            gain += info["info_gain_bits"]
-                    break
-            if (reached or self.explore.steps - start_steps >= cfg.max_steps_per_goal) and (
-                not self._resolved(view, target)
-            ):  # there (or out of time) and still unknown: no goal for a while
-                self.finder.blacklist(target, 2.0, self.explore.steps + 200)
-            if self.explore.steps == start_steps:  # already there: one step turning
-                obs, _, terminated, truncated, info = self.explore.step(self._command(0.0, 1.0))
-                gain += info["info_gain_bits"]
+            if terminated or truncated:
+                break
         metres = self.explore.path_length_m - start_path
         steps = self.explore.steps - start_steps
         bits = gain - cfg.cost_per_m_bits * metres - cfg.cost_per_step_bits * steps
@@ -169,12 +135,7 @@ class SfWGoalsEnv(gym.Env):
 
     def action_masks(self) -> np.ndarray:
         """Which actions pick a reachable candidate (for ``MaskablePPO``)."""
-        mask = np.zeros(self.config.max_candidates, np.bool_)
-        if self.menu is not None:
-            mask[: len(self.menu)] = self.menu.valid
-        if not mask.any():
-            mask[:] = True  # nothing reachable: any action turns in place
-        return mask
+        return action_masks(self.menu, self.config.max_candidates)
 
     def render(self) -> Any:
         return self.explore.render()
@@ -188,24 +149,40 @@ class SfWGoalsEnv(gym.Env):
 
     # -- helpers ---------------------------------------------------------------------------------
     def _observe(self, obs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-        view = self.explore.robot_view()
         self.finder.set_step(self.explore.steps)
-        paths = cost_field(self.finder.costs(view), view.cell, view.grid.resolution_m)
-        k = self.config.max_candidates
-        self.menu = menu = self.finder.find(view, paths, max_candidates=k)
-        feats = np.zeros((k, len(FEATURES)), np.float32)
-        scaled = np.nan_to_num(menu.features / _SCALES, nan=0.0, posinf=4.0, neginf=-1.0)
-        feats[: len(menu)] = np.clip(scaled, -1.0, 4.0)
-        mask = np.zeros(k, np.int8)
-        mask[: len(menu)] = menu.valid
-        return {**obs, "candidates": feats, "candidate_mask": mask}
+        self.menu, extra = menu_observation(
+            self.finder, self.explore.robot_view(), self.config.max_candidates
+        )
+        return {**obs, **extra}
 
     def _command(self, linear: float, angular: float) -> Any:
         if self.explore.action_type == "discrete":
             return to_discrete(linear, angular)
         return np.array([linear, angular], np.float32)
 
-    @staticmethod
-    def _resolved(view: Any, target: tuple[int, int]) -> bool:
-        value = int(view.belief_u8[target])
-        return value <= U8_WALL_MAX or value >= U8_FREE_MIN
+
+def menu_observation(
+    finder: GoalFinder, view: Any, k: int
+) -> tuple[CandidateGoals, dict[str, np.ndarray]]:
+    """The menu of at most ``k`` candidates for ``view`` (one path search) and its observation
+    entries: ``candidates`` (features / :data:`FEATURE_SCALES`, clipped; 0 for empty slots) and
+    ``candidate_mask``."""
+    paths = cost_field(finder.costs(view), view.cell, view.grid.resolution_m)
+    menu = finder.find(view, paths, max_candidates=k)
+    feats = np.zeros((k, len(FEATURES)), np.float32)
+    scaled = np.nan_to_num(menu.features / _SCALES, nan=0.0, posinf=4.0, neginf=-1.0)
+    feats[: len(menu)] = np.clip(scaled, -1.0, 4.0)
+    mask = np.zeros(k, np.int8)
+    mask[: len(menu)] = menu.valid
+    return menu, {"candidates": feats, "candidate_mask": mask}
+
+
+def action_masks(menu: CandidateGoals | None, k: int) -> np.ndarray:
+    """Which of ``k`` actions pick a reachable candidate (all of them when none does: any
+    action then turns in place)."""
+    mask = np.zeros(k, np.bool_)
+    if menu is not None:
+        mask[: len(menu)] = menu.valid
+    if not mask.any():
+        mask[:] = True
+    return mask

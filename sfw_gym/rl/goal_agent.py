@@ -1,0 +1,99 @@
+"""The candidate-goal explorer (``sfw-gym train ppo_mask`` on ``SfW-ExploreGoals-v0``) behind the
+agents' interface, on the explore env itself.
+
+Each decision builds the same menu as the goals env (:func:`~sfw_gym.envs.goals.menu_observation`),
+lets the policy pick a candidate, and drives there step by step with the same
+:class:`~sfw_gym.navigation.goal_driver.GoalDriver`, so it acts exactly as in training and runs
+through ``sfw-gym evaluate`` beside the classical agents (``--agents
+sfw_gym.rl.goal_agent:GoalsAgent --agent-params '{"sfw_gym.rl.goal_agent:GoalsAgent": {"path":
+"runs/goals"}}'``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from sfw_gym.agents.base import Agent, RobotView
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.envs.goals import GoalsConfig, action_masks, menu_observation
+from sfw_gym.navigation.candidates import GoalFinder
+from sfw_gym.navigation.goal_driver import GoalDriver
+
+
+class GoalsAgent(Agent):
+    """Acts with a MaskablePPO model over candidate goals.
+
+    Args:
+        path: A ``sfw-gym train ppo_mask`` output folder (``model.zip``, ``config.yml``) or its
+            ``model.zip``.
+        deterministic: Take the policy's most likely candidate (the default); else sample it
+            with the agent's seeded generator.
+        device: Torch device of the policy.
+        max_steps: Optional step limit of the agent.
+    """
+
+    name = "goals"
+
+    def __init__(
+        self,
+        path: str | Path,
+        deterministic: bool = True,
+        device: str = "cpu",
+        max_steps: int | None = None,
+    ) -> None:
+        from sb3_contrib import MaskablePPO
+
+        super().__init__(max_steps=max_steps)
+        folder = Path(path).parent if Path(path).suffix == ".zip" else Path(path)
+        self.path, self.deterministic, self.device = str(path), bool(deterministic), device
+        model_path, config_path = folder / "model.zip", folder / "config.yml"
+        if not model_path.is_file():
+            raise ConfigError(
+                f"GoalsAgent: {model_path} not found; train one with `sfw-gym train "
+                f"ppo_mask --env SfW-ExploreGoals-v0 --out {folder}`"
+            )
+        config: dict[str, Any] = {}
+        if config_path.is_file():
+            config = yaml.safe_load(config_path.read_text(encoding="utf-8")) or {}
+        goals = (config.get("env_kwargs") or {}).get("goals")
+        self.config = GoalsConfig.from_dict(goals, "goals")
+        self.model = MaskablePPO.load(str(model_path), device=device)
+
+    def _on_reset(self, view: RobotView) -> None:
+        self.finder = GoalFinder()
+        self.finder.reset(view)
+        self.driver = GoalDriver(self.finder, self.config.max_steps_per_goal)
+        self.driver.reset()
+        self.n_decisions = 0
+
+    def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
+        if not isinstance(obs, dict):
+            raise ConfigError("GoalsAgent.act(obs) needs the env's (Dict) observation")
+        command = self.driver.command(view) if self.n_decisions else None
+        if command is None:  # the decision is over: the policy picks the next goal
+            self.finder.set_step(self.steps)
+            k = self.config.max_candidates
+            menu, extra = menu_observation(self.finder, view, k)
+            mask = action_masks(menu, k)
+            choice = self._choose({**obs, **extra}, mask)
+            self.driver.start(view, menu, choice)
+            self.n_decisions += 1
+            command = self.driver.command(view)
+        return command if command is not None else (0.0, 1.0)
+
+    def _choose(self, obs: dict[str, np.ndarray], mask: np.ndarray) -> int:
+        if self.deterministic:
+            action, _ = self.model.predict(obs, action_masks=mask, deterministic=True)
+            return int(action)
+        import torch
+
+        policy = self.model.policy
+        with torch.no_grad():
+            tensor, _ = policy.obs_to_tensor(obs)
+            dist = policy.get_distribution(tensor, action_masks=mask[None])
+            probs = dist.distribution.probs[0].cpu().numpy().astype(np.float64)  # type: ignore[union-attr]
+        return int(self.rng.choice(len(probs), p=probs / probs.sum()))

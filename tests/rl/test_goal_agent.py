@@ -1,0 +1,51 @@
+"""The candidate-goal explorer as an agent on the explore env acts as in its training env."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import sfw_gym  # noqa: F401  (registration)
+from sfw_gym.core.errors import ConfigError
+from tests.envs.test_goals import SMALL
+
+sb3_contrib = pytest.importorskip("sb3_contrib")
+from sfw_gym.rl.goal_agent import GoalsAgent  # noqa: E402
+from sfw_gym.rl.goal_policy import GoalsPolicy  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def model_dir(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("goals")
+    env = gym.make("SfW-ExploreGoals-v0", **SMALL)
+    sb3_contrib.MaskablePPO(GoalsPolicy, env, n_steps=16, batch_size=16, seed=3).save(
+        folder / "model.zip"
+    )
+    return folder
+
+
+def test_the_agent_drives_the_explore_env_as_the_goals_env_does(model_dir):
+    model = sb3_contrib.MaskablePPO.load(model_dir / "model.zip")
+    env = gym.make("SfW-ExploreGoals-v0", **SMALL)
+    obs, _ = env.reset(seed=4)
+    for _ in range(12):
+        action, _ = model.predict(
+            obs, action_masks=env.unwrapped.action_masks(), deterministic=True
+        )
+        obs, _, terminated, truncated, info = env.step(int(action))
+        assert not (terminated or truncated)
+    steps, pose = env.unwrapped.explore.steps, info["true_pose"]
+    agent = GoalsAgent(model_dir)
+    explore = gym.make("SfW-Explore-v0", **SMALL)
+    obs, _ = explore.reset(seed=4)
+    agent.reset(explore, seed=0)
+    for _ in range(steps):
+        obs, _, _, _, info = explore.step(agent.act(obs))
+    assert agent.n_decisions == 12
+    np.testing.assert_array_equal(info["true_pose"], pose)
+
+
+def test_a_missing_model_is_named(tmp_path):
+    with pytest.raises(ConfigError, match=r"model\.zip not found; train one with `sfw-gym train"):
+        GoalsAgent(tmp_path)
