@@ -48,16 +48,22 @@ class GoalsAgent(Agent):
         from sb3_contrib import MaskablePPO
 
         super().__init__(max_steps=max_steps)
-        folder = Path(path).parent if Path(path).suffix == ".zip" else Path(path)
+        given = Path(path)
+        folder = given.parent if given.suffix == ".zip" else given
         self.path, self.deterministic, self.device = str(path), bool(deterministic), device
-        model_path, config_path = folder / "model.zip", folder / "config.yml"
+        model_path = given if given.suffix == ".zip" else folder / "model.zip"
+        # a checkpoint (OUT/checkpoints/ppo_mask_<steps>_steps.zip): the run's config is above it
+        config_path = next(
+            (p for p in (folder / "config.yml", folder.parent / "config.yml") if p.is_file()),
+            None,
+        )
         if not model_path.is_file():
             raise ConfigError(
                 f"GoalsAgent: {model_path} not found; train one with `sfw-gym train "
                 f"ppo_mask --env SfW-ExploreGoals-v0 --out {folder}`"
             )
         config: dict[str, Any] = {}
-        if config_path.is_file():
+        if config_path is not None:
             config = yaml.safe_load(config_path.read_text(encoding="utf-8")) or {}
         goals = (config.get("env_kwargs") or {}).get("goals")
         self.config = GoalsConfig.from_dict(goals, "goals")
