@@ -186,6 +186,14 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         progress=not args.no_progress,
     )
     print((Path(args.out) / "results.md").read_text(encoding="utf-8"), end="")
+    paired = Path(args.out) / "paired.md"
+    if paired.is_file():
+        print(
+            "\npaired on the same plans and seeds:",
+            paired.read_text(encoding="utf-8"),
+            sep="\n",
+            end="",
+        )
     print(f"wrote {len(result['files'])} files under {args.out}")
     return 0
 
@@ -344,7 +352,7 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument(
         "--agents",
         default="frontier,cross-pass,random",
-        help="comma-separated: frontier, cross-pass, greedy, random, ppo (default: "
+        help="comma-separated: frontier, cross-pass, greedy, random, ppo, goals (default: "
         "frontier,cross-pass,random)",
     )
     ev.add_argument(

@@ -3,7 +3,7 @@ intervals, write the results table and figures (``sfw-gym evaluate``, :func:`eva
 
 from __future__ import annotations
 
-from sfw_gym.evaluation.report import results_csv, results_markdown
+from sfw_gym.evaluation.report import paired_markdown, results_csv, results_markdown
 from sfw_gym.evaluation.runner import (
     CHECKPOINT,
     EpisodeSpec,
@@ -12,15 +12,24 @@ from sfw_gym.evaluation.runner import (
     run_episode,
     zone_band_unknown,
 )
-from sfw_gym.evaluation.stats import TABLE_METRICS, mean_ci95, summarize
+from sfw_gym.evaluation.stats import (
+    PAIRED_METRICS,
+    TABLE_METRICS,
+    mean_ci95,
+    paired_differences,
+    summarize,
+)
 
 __all__ = [
     "CHECKPOINT",
+    "PAIRED_METRICS",
     "TABLE_METRICS",
     "EpisodeSpec",
     "evaluate",
     "load_checkpoint",
     "mean_ci95",
+    "paired_differences",
+    "paired_markdown",
     "results_csv",
     "results_markdown",
     "run_episode",

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from sfw_gym.evaluation.stats import REACHED_METRICS, TABLE_METRICS
+from sfw_gym.evaluation.stats import PAIRED_METRICS, REACHED_METRICS, TABLE_METRICS
 
 
 def results_csv(rows: list[dict[str, Any]]) -> str:
@@ -37,5 +37,24 @@ def results_markdown(rows: list[dict[str, Any]]) -> str:
                 cell += f" ({n}/{row['episodes']})"
             cells.append(cell)
         cells.append(f"{row['episodes_coverage_ge_90']}/{row['episodes']}")
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def paired_markdown(rows: list[dict[str, Any]]) -> str:
+    """The paired differences as a Markdown table (mean [95 % CI])."""
+    head = ["agent − reference", "pairs"] + [label for _, label, _ in PAIRED_METRICS]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for row in rows:
+        cells = [f"{row['agent']} − {row['reference']}", str(row["pairs"])]
+        for key, _, fmt in PAIRED_METRICS:
+            mean, ci = row[f"{key}_diff"], row[f"{key}_ci95"]
+            if math.isnan(mean):
+                cells.append("–")
+            elif math.isnan(ci):
+                cells.append(fmt.format(mean))
+            else:
+                low, high = fmt.format(mean - ci), fmt.format(mean + ci)
+                cells.append(f"{fmt.format(mean)} [{low}, {high}]")
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"

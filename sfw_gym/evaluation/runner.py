@@ -37,8 +37,8 @@ from sfw_gym.core.constants import U8_FREE
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.explore import unwrap_sfw
 from sfw_gym.evaluation.plots import plot_curves, plot_trajectories
-from sfw_gym.evaluation.report import results_csv, results_markdown
-from sfw_gym.evaluation.stats import summarize
+from sfw_gym.evaluation.report import paired_markdown, results_csv, results_markdown
+from sfw_gym.evaluation.stats import paired_differences, summarize
 
 CHECKPOINT = "episodes.jsonl"
 
@@ -308,7 +308,9 @@ def evaluate(
         progress: Show a tqdm progress bar.
 
     Returns:
-        ``{"rows": summary rows, "records": episode records, "files": written paths}``.
+        ``{"rows": summary rows, "records": episode records, "files": written paths}``; with
+        more than one agent, ``paired.md`` holds every other agent's differences from the first
+        on the same plans and seeds (mean and 95 % CI).
     """
     import gymnasium as gym
 
@@ -377,6 +379,11 @@ def evaluate(
         write_text_atomic(out / "results.csv", results_csv(rows)),
         write_text_atomic(out / "results.md", results_markdown(rows)),
     ]
+    if len(agents) > 1:  # every other agent against the first, episode by episode
+        paired = paired_differences(mine, agents, reference=agents[0])
+        files.append(write_text_atomic(out / "paired.md", paired_markdown(paired)))
+    else:  # not a stale table of an earlier run in the same folder
+        (out / "paired.md").unlink(missing_ok=True)
     files += plot_curves(mine, agents, out)
     files += plot_trajectories(mine, agents, out)
     return {"rows": rows, "records": mine, "files": files}

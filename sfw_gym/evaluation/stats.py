@@ -22,6 +22,14 @@ TABLE_METRICS: tuple[tuple[str, str, str], ...] = (
     ("zone_band_unknown", "unknown zone-band cells", "{:.0f}"),
     ("zone_band_unknown_frac", "unknown zone-band fraction", "{:.3f}"),
 )
+#: Metrics of the paired table (agent − reference on the same plans and seeds).
+PAIRED_METRICS: tuple[tuple[str, str, str], ...] = (
+    ("coverage", "Δ coverage", "{:+.3f}"),
+    ("info_gain_per_m", "Δ bits/m", "{:+.1f}"),
+    ("path_length_m", "Δ path [m]", "{:+.0f}"),
+    ("free_iou", "Δ free IoU", "{:+.3f}"),
+    ("wall_precision", "Δ wall precision", "{:+.3f}"),
+)
 #: "steps to x %" metrics are averaged over the episodes that got there (count reported).
 REACHED_METRICS = ("steps_to_coverage_50", "steps_to_coverage_90")
 
@@ -58,5 +66,30 @@ def summarize(records: list[dict[str, Any]], agents: Sequence[str]) -> list[dict
         for r in recs:
             reasons[r["stop_reason"]] = reasons.get(r["stop_reason"], 0) + 1
         row["stop_reasons"] = ";".join(f"{k}:{v}" for k, v in sorted(reasons.items()))
+        rows.append(row)
+    return rows
+
+
+def paired_differences(
+    records: list[dict[str, Any]], agents: Sequence[str], reference: str
+) -> list[dict[str, Any]]:
+    """Per agent other than ``reference``: mean, 95 % CI and n of (agent − reference) for each
+    paired metric, over the episodes both ran (episode ``i``: the same plan and seed)."""
+    by_episode = {(r["agent"], r["episode"]): r for r in records}
+    rows = []
+    for name in agents:
+        if name == reference:
+            continue
+        pairs = [
+            (rec, by_episode[(reference, episode)])
+            for (agent, episode), rec in sorted(by_episode.items())
+            if agent == name and (reference, episode) in by_episode
+        ]
+        row: dict[str, Any] = {"agent": name, "reference": reference, "pairs": len(pairs)}
+        for key, _, _ in PAIRED_METRICS:
+            values = [(a.get(key), b.get(key)) for a, b in pairs]
+            diffs = [x - y for x, y in values if x is not None and y is not None]
+            mean, ci, n = mean_ci95(diffs)
+            row[f"{key}_diff"], row[f"{key}_ci95"], row[f"{key}_n"] = mean, ci, n
         rows.append(row)
     return rows

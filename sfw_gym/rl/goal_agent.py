@@ -4,9 +4,8 @@ agents' interface, on the explore env itself.
 Each decision builds the same menu as the goals env (:func:`~sfw_gym.envs.goals.menu_observation`),
 lets the policy pick a candidate, and drives there step by step with the same
 :class:`~sfw_gym.navigation.goal_driver.GoalDriver`, so it acts exactly as in training and runs
-through ``sfw-gym evaluate`` beside the classical agents (``--agents
-sfw_gym.rl.goal_agent:GoalsAgent --agent-params '{"sfw_gym.rl.goal_agent:GoalsAgent": {"path":
-"runs/goals"}}'``).
+through ``sfw-gym evaluate`` beside the classical agents (``--agents frontier,goals``; a model of
+one's own with ``--agent-params '{"goals": {"path": "runs/goals"}}'``).
 """
 
 from __future__ import annotations
@@ -18,6 +17,7 @@ import numpy as np
 import yaml
 
 from sfw_gym.agents.base import Agent, RobotView
+from sfw_gym.core.data import DEFAULT_GOALS_MODEL_DIR
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.goals import GoalsConfig, action_masks, menu_observation
 from sfw_gym.navigation.candidates import GoalFinder
@@ -28,8 +28,8 @@ class GoalsAgent(Agent):
     """Acts with a MaskablePPO model over candidate goals.
 
     Args:
-        path: A ``sfw-gym train ppo_mask`` output folder (``model.zip``, ``config.yml``) or its
-            ``model.zip``.
+        path: A ``sfw-gym train ppo_mask`` output folder (``model.zip``, ``config.yml``) or a
+            ``.zip`` in it or in its ``checkpoints``; by default the shipped model.
         deterministic: Take the policy's most likely candidate (the default); else sample it
             with the agent's seeded generator.
         device: Torch device of the policy.
@@ -40,7 +40,7 @@ class GoalsAgent(Agent):
 
     def __init__(
         self,
-        path: str | Path,
+        path: str | Path = DEFAULT_GOALS_MODEL_DIR,
         deterministic: bool = True,
         device: str = "cpu",
         max_steps: int | None = None,

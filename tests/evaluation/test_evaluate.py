@@ -47,6 +47,8 @@ def test_tiny_run_writes_table_curves_and_trajectories(tmp_path):
     assert float(rows[0]["coverage_mean"]) > 0
     md = (tmp_path / "results.md").read_text()
     assert "| frontier | 2 |" in md and "±" in md
+    paired = (tmp_path / "paired.md").read_text()
+    assert "| random − frontier | 2 |" in paired
     rec = recs[0]
     for key in (
         "coverage",
@@ -172,6 +174,23 @@ def test_mean_ci95_and_summary():
     assert row["steps_to_coverage_90_mean"] == 100 and row["steps_to_coverage_90_n"] == 1
     assert row["episodes_coverage_ge_90"] == 1 and row["stop_reasons"] == "x:1;y:1"
     assert "(1/2)" in ev.results_markdown([row])
+
+
+def test_paired_differences_pair_episodes_not_agents_means():
+    recs = [
+        {"agent": "f", "episode": 0, "coverage": 0.5, "info_gain_per_m": 20.0},
+        {"agent": "f", "episode": 1, "coverage": 0.9, "info_gain_per_m": 30.0},
+        {"agent": "g", "episode": 1, "coverage": 0.8, "info_gain_per_m": 33.0},
+        {"agent": "g", "episode": 0, "coverage": 0.6, "info_gain_per_m": None},
+        {"agent": "g", "episode": 2, "coverage": 1.0, "info_gain_per_m": 99.0},  # unpaired
+    ]
+    (row,) = ev.paired_differences(recs, ["f", "g"], reference="f")
+    assert (row["agent"], row["reference"], row["pairs"]) == ("g", "f", 2)
+    assert row["coverage_diff"] == pytest.approx(0.0) and row["coverage_n"] == 2
+    # differences +0.1 and -0.1: the interval is t(0.975, 1) * sd / sqrt(2)
+    assert row["coverage_ci95"] == pytest.approx(12.7062 * math.sqrt(0.02) / math.sqrt(2), rel=1e-4)
+    assert row["info_gain_per_m_diff"] == pytest.approx(3.0) and row["info_gain_per_m_n"] == 1
+    assert "| g − f | 2 | +0.000 [" in ev.paired_markdown([row])
 
 
 def test_zone_band_metric_counts_unknown_cells_near_the_true_zone_border():
