@@ -17,6 +17,7 @@ import numpy as np
 import torch
 from gymnasium import spaces
 from sb3_contrib.common.maskable.policies import MaskableMultiInputActorCriticPolicy
+from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from torch import nn
 
@@ -89,12 +90,45 @@ class GoalsPolicy(MaskableMultiInputActorCriticPolicy):
         assert isinstance(heads, CandidateHeads)
         return heads
 
+    def parameter_groups(self) -> dict[str, list[nn.Parameter]]:
+        """The actor's and the critic's parameters (disjoint: the policy loss reaches only the
+        first, the value loss only the second)."""
+        heads = self.heads
+        return {
+            "actor": [*heads.scorer.parameters(), *heads.score.parameters()],
+            "critic": [*heads.critic.parameters(), *self.value_net.parameters()],
+        }
+
     def _build(self, lr_schedule: Any) -> None:
         super()._build(lr_schedule)
         self.action_net = nn.Identity()  # one logit per candidate already
         self.optimizer = self.optimizer_class(  # type: ignore[call-arg]
             self.parameters(), lr=lr_schedule(1), **self.optimizer_kwargs
         )
+
+
+class HeadGradientNorms(BaseCallback):
+    """Logs the gradient norm of each of the policy's :meth:`~GoalsPolicy.parameter_groups`
+    after every PPO update (its last minibatch's, after SB3 clips the whole policy's norm to
+    ``max_grad_norm``, which keeps their ratio) as ``train/grad_norm_<group>``;
+    ``history`` keeps them."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.history: list[dict[str, float]] = []
+
+    def _on_rollout_start(self) -> None:  # the update of the previous rollout has just ended
+        norms = {}
+        for name, params in self.model.policy.parameter_groups().items():  # type: ignore[operator]
+            grads = [p.grad.detach().flatten() for p in params if p.grad is not None]
+            if grads:
+                norms[name] = float(torch.cat(grads).norm())
+                self.logger.record(f"train/grad_norm_{name}", norms[name])
+        if norms:
+            self.history.append(norms)
+
+    def _on_step(self) -> bool:
+        return True
 
 
 def teacher_decisions(
@@ -138,8 +172,7 @@ def behaviour_clone(
     acts = torch.as_tensor(actions, dtype=torch.long)
     mask = torch.as_tensor(masks, dtype=torch.bool)
     heads = policy.heads
-    actor = [*heads.scorer.parameters(), *heads.score.parameters()]
-    optimiser = torch.optim.Adam(actor, lr=lr)
+    optimiser = torch.optim.Adam(policy.parameter_groups()["actor"], lr=lr)
     losses = []
     for _ in range(epochs):
         order = torch.randperm(len(acts), generator=gen)

@@ -291,8 +291,14 @@ def train_ppo(
                 )
                 if params.get("behaviour_cloning"):
                     _clone_teacher(model, env_id, env_kwargs, seed, params["behaviour_cloning"])
+            grad_norms = []  # logged per head where the policy has separate heads
+            if hasattr(model.policy, "parameter_groups"):
+                from sfw_gym.rl.goal_policy import HeadGradientNorms
+
+                grad_norms.append(HeadGradientNorms())
             callbacks = CallbackList(
                 [
+                    *grad_norms,
                     CheckpointCallback(
                         max(checkpoint_every // n_envs, 1),
                         str(out / "checkpoints"),
@@ -373,8 +379,9 @@ def _save_atomic(model: Any, path: Path) -> None:
         model.save(tmp)
 
 
-def plot_training_curve(out_dir: str | Path) -> Path | None:
-    """Episode return (training, smoothed) and held-out evaluation return vs agent steps → PNG."""
+def plot_training_curve(out_dir: str | Path, levels: dict[str, float] | None = None) -> Path | None:
+    """Episode return (training, smoothed) and held-out evaluation return vs agent steps → PNG;
+    ``levels``: other policies' mean held-out return, drawn as horizontal lines."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -416,8 +423,10 @@ def plot_training_curve(out_dir: str | Path) -> Path | None:
             fmt="o-",
             label="held-out seeds",
         )
-    ax.set_xlabel("agent steps (waypoints with WaypointWrapper)")
-    ax.set_ylabel("episode return (≈ m² mapped)")
+    for (name, level), style in zip((levels or {}).items(), ("--", ":", "-."), strict=False):
+        ax.axhline(level, color="k", linestyle=style, linewidth=1, label=name)
+    ax.set_xlabel("agent steps (waypoints with WaypointWrapper; goal decisions with ppo_mask)")
+    ax.set_ylabel("episode return")
     ax.legend()
     ax.grid(alpha=0.3)
     fig.tight_layout()

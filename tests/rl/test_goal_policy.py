@@ -11,7 +11,7 @@ from tests.envs.test_goals import SMALL, explore_lite
 
 torch = pytest.importorskip("torch")
 sb3_contrib = pytest.importorskip("sb3_contrib")
-from sfw_gym.rl.goal_policy import GoalsPolicy, behaviour_clone  # noqa: E402
+from sfw_gym.rl.goal_policy import GoalsPolicy, HeadGradientNorms, behaviour_clone  # noqa: E402
 
 
 def model_on(env):
@@ -57,6 +57,15 @@ def test_the_value_loss_does_not_reach_the_actor():
     heads = policy.heads
     assert all(p.grad is None for p in [*heads.scorer.parameters(), *heads.score.parameters()])
     assert any(p.grad is not None and p.grad.abs().sum() > 0 for p in heads.critic.parameters())
+
+
+def test_each_heads_gradient_norm_is_logged_after_every_update():
+    model = model_on(gym.make("SfW-ExploreGoals-v0", **SMALL))
+    callback = HeadGradientNorms()
+    model.learn(48, callback=callback)  # three rollouts of 16: two updates before the third
+    assert len(callback.history) == 2
+    for norms in callback.history:
+        assert set(norms) == {"actor", "critic"} and min(norms.values()) > 0
 
 
 def test_behaviour_cloning_learns_the_teachers_choices():
