@@ -3,8 +3,9 @@
 :class:`GoalDriver` turns "go to candidate i of this menu" into one ``(linear, angular)`` command
 per step, as the frontier agent drives to its goals: pure pursuit along the candidate's path with
 the finder's goal tolerance; the decision ends when the target cell is resolved, at a bump (a
-wall ahead is remembered and backed off), when the goal is reached (a target still unknown
-then is blacklisted a while), or after ``max_steps``. Shared by ``SfW-ExploreGoals-v0`` (one env
+wall ahead is remembered and backed off; every third slide along a wall since the last back-off
+backs off too), when the goal is reached (a target still unknown then is blacklisted a while),
+or after ``max_steps``. Shared by ``SfW-ExploreGoals-v0`` (one env
 step per command) and the learned agent that drives ``SfW-Explore-v0`` the same way.
 """
 
@@ -44,6 +45,7 @@ class GoalDriver:
         self.max_steps = max_steps
         self.blacklist_radius_cells = blacklist_radius_cells
         self.blacklist_steps = blacklist_steps
+        self._slides = 0  # slides along a wall since the last back-off
         self.follower = PurePursuit()
         self._queue: list[tuple[float, float]] = []
         self._driving = False
@@ -55,6 +57,7 @@ class GoalDriver:
         """A new episode (call after the finder's reset): the frontier agent's follower."""
         self.follower = PurePursuit(lookahead_m=0.4, goal_tolerance_m=self.finder.goal_tolerance_m)
         self._queue, self._driving = [], False
+        self._slides = 0
 
     def start(self, view: RobotView, menu: CandidateGoals, i: int) -> bool:
         """Drive to candidate ``i`` of ``menu``; False (and one step turning in place) when it is
@@ -84,10 +87,14 @@ class GoalDriver:
                 return self._finish(view, reached=False)
             if view.bumped:
                 wanted = linear * view.max_linear_speed_m_s * view.control_period_s
-                if wanted > 0 and np.linalg.norm(view.xy - before) < 0.5 * wanted:
-                    self.finder.mark_bump(view)  # a wall ahead: remembered, backed off
-                    if view.action_type == "continuous":
-                        self._queue.append(BACK_OFF)
+                ahead = wanted > 0 and np.linalg.norm(view.xy - before) < 0.5 * wanted
+                self._slides = 0 if ahead else self._slides + 1
+                if ahead:  # a wall ahead: remembered
+                    self.finder.mark_bump(view)
+                # back off from a wall ahead, and at every third slide along one
+                if (ahead or self._slides >= 3) and view.action_type == "continuous":
+                    self._slides = 0
+                    self._queue.append(BACK_OFF)
                 return self._finish(view, reached=False)
             if self.steps >= self.max_steps:
                 return self._finish(view, reached=False)
