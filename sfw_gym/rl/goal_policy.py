@@ -27,6 +27,9 @@ from sfw_gym.agents.frontier import explore_lite_choice
 class GoalsInputs(BaseFeaturesExtractor):
     """Features = ``[candidates flattened (K·F), state (S)]`` (no parameters)."""
 
+    #: The observation entries it reads.
+    keys = ("candidates", "state")
+
     def __init__(self, observation_space: spaces.Dict) -> None:
         k, f = observation_space["candidates"].shape or (0, 0)
         s = int(np.prod(observation_space["state"].shape or (0,)))
@@ -132,11 +135,15 @@ class HeadGradientNorms(BaseCallback):
 
 
 def teacher_decisions(
-    env_id: str, env_kwargs: dict[str, Any], seeds: Iterable[int]
+    env_id: str,
+    env_kwargs: dict[str, Any],
+    seeds: Iterable[int],
+    learner: GoalsPolicy | None = None,
 ) -> tuple[list[dict[str, np.ndarray]], np.ndarray, np.ndarray]:
     """Observations, choices and masks of the frontier agent's choice on the menu
     (:func:`~sfw_gym.agents.frontier.explore_lite_choice`; any valid goal when it has none)
-    over one episode per seed."""
+    over one episode per seed. The teacher drives, or the ``learner`` (its most likely choice)
+    does: DAgger's states, labelled with the teacher's choices."""
     observations, actions, masks = [], [], []
     for seed in seeds:
         env = gym.make(env_id, **env_kwargs)
@@ -149,6 +156,9 @@ def teacher_decisions(
             observations.append(obs)
             actions.append(action)
             masks.append(mask)
+            if learner is not None:
+                taken, _ = learner.predict(obs, deterministic=True, action_masks=mask)
+                action = int(taken)
             obs, _, terminated, truncated, _ = env.step(action)
             done = terminated or truncated
         env.close()
@@ -168,7 +178,7 @@ def behaviour_clone(
     """Fit the actor to a teacher's ``actions`` (cross-entropy over the masked candidates);
     returns the mean loss per epoch."""
     gen = torch.Generator().manual_seed(seed)
-    obs = {k: torch.as_tensor(np.stack([o[k] for o in observations])) for k in observations[0]}
+    obs = {k: torch.as_tensor(np.stack([o[k] for o in observations])) for k in GoalsInputs.keys}
     acts = torch.as_tensor(actions, dtype=torch.long)
     mask = torch.as_tensor(masks, dtype=torch.bool)
     heads = policy.heads

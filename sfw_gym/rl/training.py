@@ -353,15 +353,24 @@ def train_ppo(
 def _clone_teacher(
     model: Any, env_id: str, env_kwargs: dict[str, Any], seed: int, spec: dict[str, Any]
 ) -> None:
-    """Behaviour cloning of the frontier agent's menu choices before PPO (training seeds)."""
+    """Behaviour cloning of the frontier agent's menu choices before PPO (training seeds):
+    ``episodes`` driven by the teacher, then ``dagger_rounds`` rounds of ``dagger_episodes``
+    driven by the cloned policy and labelled by the teacher (DAgger), refitting on all."""
     from sfw_gym.rl.goal_policy import behaviour_clone, teacher_decisions
 
-    unknown = set(spec) - {"episodes", "epochs"}
+    unknown = set(spec) - {"episodes", "epochs", "dagger_rounds", "dagger_episodes"}
     if unknown:
         raise ConfigError(f"behaviour_cloning: unknown keys {sorted(unknown)}")
-    seeds = range(seed, seed + int(spec.get("episodes", 8)))
-    observations, actions, masks = teacher_decisions(env_id, env_kwargs, seeds)
-    behaviour_clone(model.policy, observations, actions, masks, epochs=int(spec.get("epochs", 30)))
+    epochs, first = int(spec.get("epochs", 30)), int(spec.get("episodes", 8))
+    per_round = int(spec.get("dagger_episodes", 4))
+    observations, actions, masks = teacher_decisions(env_id, env_kwargs, range(seed, seed + first))
+    behaviour_clone(model.policy, observations, actions, masks, epochs=epochs)
+    for i in range(int(spec.get("dagger_rounds", 0))):
+        start = seed + first + i * per_round
+        more = teacher_decisions(env_id, env_kwargs, range(start, start + per_round), model.policy)
+        observations += more[0]
+        actions, masks = np.concatenate([actions, more[1]]), np.concatenate([masks, more[2]])
+        behaviour_clone(model.policy, observations, actions, masks, epochs=epochs)
 
 
 def _monitored_seconds(out: Path) -> float:

@@ -78,3 +78,26 @@ def test_behaviour_cloning_learns_the_teachers_choices():
         logits = policy.heads.forward_actor(policy.extract_features(as_batch(held_out)))
     chosen = logits.masked_fill(~torch.as_tensor(masks_out), -1e8).argmax(1).numpy()
     assert np.mean(chosen == actions_out) >= 0.8
+
+
+def test_dagger_labels_the_learners_states_with_the_teachers_choices():
+    from sfw_gym.rl import goal_policy
+
+    policy = model_on(gym.make("SfW-ExploreGoals-v0", **SMALL)).policy  # untrained
+    _, taught, _ = goal_policy.teacher_decisions("SfW-ExploreGoals-v0", SMALL, [3])
+    np.testing.assert_array_equal(taught, teacher_decisions([3])[1])
+    observations, labels, _ = goal_policy.teacher_decisions(
+        "SfW-ExploreGoals-v0", SMALL, [3], learner=policy
+    )
+    env = gym.make("SfW-ExploreGoals-v0", **SMALL)  # replay: the learner drives
+    obs, _ = env.reset(seed=3)
+    taken = []
+    for recorded, label in zip(observations, labels, strict=True):
+        np.testing.assert_array_equal(obs["candidates"], recorded["candidates"])
+        assert label == explore_lite(env)
+        action, _ = policy.predict(
+            obs, deterministic=True, action_masks=env.unwrapped.action_masks()
+        )
+        taken.append(int(action))
+        obs, *_ = env.step(int(action))
+    assert np.mean(np.array(taken) != labels) > 0.2  # other states than the teacher's own
