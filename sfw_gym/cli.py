@@ -149,6 +149,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
         eval_episodes=args.eval_episodes,
         resume=args.resume,
         progress_bar=not args.no_progress,
+        num_threads=args.num_threads or None,
     )
     print(
         f"trained {args.env} to "
@@ -343,6 +344,12 @@ def build_parser() -> argparse.ArgumentParser:
     train.add_argument("--checkpoint-every", type=positive_int, default=50_000, help="env steps")
     train.add_argument("--eval-every", type=positive_int, default=25_000, help="env steps")
     train.add_argument("--eval-episodes", type=positive_int, default=5, help="held-out episodes")
+    train.add_argument(
+        "--num-threads",
+        type=non_negative_int,
+        default=1,
+        help="PyTorch CPU threads (default 1: small networks; 0: PyTorch's default)",
+    )
     train.add_argument("--resume", action="store_true", help="continue from the last checkpoint")
     train.add_argument("--no-progress", action="store_true", help="no progress bar")
     train.set_defaults(func=_cmd_train)

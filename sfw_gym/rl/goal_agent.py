@@ -33,6 +33,9 @@ class GoalsAgent(Agent):
         deterministic: Take the policy's most likely candidate (the default); else sample it
             with the agent's seeded generator.
         device: Torch device of the policy.
+        num_threads: PyTorch's CPU threads, set for the process (None: leave them): one is
+            fastest for this small network, several contend for the cores with the envs (a
+            decision took 5× longer with two threads on a busy 2-core machine).
         max_steps: Optional step limit of the agent.
     """
 
@@ -43,14 +46,20 @@ class GoalsAgent(Agent):
         path: str | Path = DEFAULT_GOALS_MODEL_DIR,
         deterministic: bool = True,
         device: str = "cpu",
+        num_threads: int | None = 1,
         max_steps: int | None = None,
     ) -> None:
+        import torch
         from sb3_contrib import MaskablePPO
+
+        if num_threads is not None:
+            torch.set_num_threads(num_threads)
 
         super().__init__(max_steps=max_steps)
         given = Path(path)
         folder = given.parent if given.suffix == ".zip" else given
         self.path, self.deterministic, self.device = str(path), bool(deterministic), device
+        self.num_threads = num_threads
         model_path = given if given.suffix == ".zip" else folder / "model.zip"
         # a checkpoint (OUT/checkpoints/ppo_mask_<steps>_steps.zip): the run's config is above it
         config_path = next(

@@ -211,6 +211,7 @@ def train_ppo(
     progress_bar: bool = True,
     device: str = "auto",
     algo: str = "ppo",
+    num_threads: int | None = 1,
 ) -> dict[str, Any]:
     """Train (or resume training) PPO on ``env_id`` up to ``timesteps`` env steps in total.
 
@@ -221,11 +222,19 @@ def train_ppo(
     With ``resume=True`` the latest checkpoint in ``OUT/checkpoints`` is loaded and training
     continues from its step count (the step counter, optimiser and rollout schedule carry on);
     without a checkpoint it starts afresh. Returns a summary (steps, wall time, paths).
+
+    ``num_threads``: PyTorch's CPU threads in this process (rl-zoo's ``--num-threads``; None:
+    PyTorch's default). One suits these small networks: more contend with the env workers for
+    the cores (a policy 5× slower measured on a busy 2-core machine).
     """
     from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
 
     import sfw_gym  # noqa: F401  (registration in this process)
 
+    if num_threads is not None:
+        import torch
+
+        torch.set_num_threads(num_threads)
     if timesteps < 1:
         raise ConfigError(f"timesteps must be ≥ 1, got {timesteps}")
     if algo not in ALGOS:
