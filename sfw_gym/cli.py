@@ -227,7 +227,7 @@ def build_parser() -> argparse.ArgumentParser:
     from sfw_gym.world.radio import BANDS, PRESETS
 
     demo = sub.add_parser(
-        "demo", help="frontier, cross-pass and the pretrained PPO on fresh plans → sfw-report/"
+        "demo", help="frontier, cross-pass and the pretrained policies on fresh plans → sfw-report/"
     )
     demo.add_argument(
         "--out", type=folder, default="sfw-report", help="report folder (default sfw-report)"

@@ -1,6 +1,7 @@
-"""``sfw-gym demo``: frontier, cross-pass and the pretrained PPO on a few fresh plans → a report.
+"""``sfw-gym demo``: frontier, cross-pass and the two pretrained policies (the learned
+candidate-goal explorer and the PPO waypoint policy) on a few fresh plans → a report.
 
-Everything comes with the package: procedural floorplans, the default radio, the shipped policy.
+Everything comes with the package: procedural floorplans, the default radio, the shipped policies.
 The report folder holds ``index.md`` (what ran, the results table, the figures), the evaluation's
 table and curves, trajectory overlays per floorplan and one GIF per agent.
 """
@@ -15,7 +16,7 @@ from sfw_gym.core.atomic import write_text_atomic
 from sfw_gym.core.data import scenario
 from sfw_gym.evaluation import evaluate
 
-DEMO_AGENTS = ("frontier", "cross-pass", "ppo")
+DEMO_AGENTS = ("frontier", "cross-pass", "goals", "ppo")
 DEMO_ENV = "SfW-Explore-v0"  # the shipped policy's env
 #: Floorplan seeds far from those the shipped policy was trained on (its training resets used
 #: seeds 0-3 and their RNG streams; its held-out evaluation 1,000,000+): envs/scenarios.yml.
@@ -66,8 +67,9 @@ def _index_markdown(
         "# sfw_gym demo: WiFi-only exploration",
         "",
         f"`{DEMO_ENV}` (default radio, two routers, 3,000-step budget): frontier exploration, "
-        "frontier with cross-connecting passes, and the pretrained PPO waypoint policy "
-        f"(`{policy}`) on the same procedural floorplans, start poses and "
+        "frontier with cross-connecting passes, the learned candidate-goal explorer (`goals`: "
+        "MaskablePPO choosing among the navigation menu's goals) and the pretrained PPO "
+        f"waypoint policy (`{policy}`) on the same procedural floorplans, start poses and "
         f"seeds ({seed}–{seed + len(episodes) - 1}; never used in training). "
         f"Report written in {wall_s:.0f} s.",
         "",

@@ -62,6 +62,8 @@ def test_every_data_file_the_package_reads_is_in_the_wheel():
     read = [
         data.DEFAULT_MODEL_DIR / "model.zip",
         data.DEFAULT_MODEL_DIR / "config.yml",
+        data.DEFAULT_GOALS_MODEL_DIR / "model.zip",
+        data.DEFAULT_GOALS_MODEL_DIR / "config.yml",
         data.DEFAULT_HYPERPARAMS,
         data.SCENARIOS,
     ]
