@@ -227,7 +227,7 @@ def train_ppo(
     PyTorch's default). One suits these small networks: more contend with the env workers for
     the cores (a policy 5× slower measured on a busy 2-core machine).
     """
-    from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
+    from stable_baselines3.common.callbacks import CallbackList
 
     import sfw_gym  # noqa: F401  (registration in this process)
 
@@ -308,10 +308,8 @@ def train_ppo(
             callbacks = CallbackList(
                 [
                     *grad_norms,
-                    CheckpointCallback(
-                        max(checkpoint_every // n_envs, 1),
-                        str(out / "checkpoints"),
-                        name_prefix=algo,
+                    _atomic_checkpoints(
+                        max(checkpoint_every // n_envs, 1), out / "checkpoints", algo
                     ),
                     EvalCallback(
                         eval_env,
@@ -390,6 +388,20 @@ def _monitored_seconds(out: Path) -> float:
         if lines:
             total += float(lines[-1].split(",")[2])
     return total
+
+
+def _atomic_checkpoints(save_freq: int, folder: Path, prefix: str) -> Any:
+    """SB3's ``CheckpointCallback``, each save written atomically: a kill during a save leaves
+    the earlier checkpoints, never a truncated newest one for ``--resume`` to fail on."""
+    from stable_baselines3.common.callbacks import CheckpointCallback
+
+    class AtomicCheckpoints(CheckpointCallback):
+        def _on_step(self) -> bool:
+            if self.n_calls % self.save_freq == 0:
+                _save_atomic(self.model, Path(self._checkpoint_path(extension="zip")))
+            return True
+
+    return AtomicCheckpoints(save_freq, str(folder), name_prefix=prefix)
 
 
 def _save_atomic(model: Any, path: Path) -> None:
