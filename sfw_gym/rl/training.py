@@ -76,6 +76,7 @@ def load_hyperparams(env_id: str, path: str | Path = DEFAULT_HYPERPARAMS) -> dic
             "n_timesteps",
             "n_envs",
             "env_wrapper",
+            "env_kwargs",
             "behaviour_cloning",
         }
     )
@@ -255,7 +256,11 @@ def train_ppo(
     if "." in policy:  # a policy class of one's own, by dotted path
         policy = import_dotted(policy)
     ppo_kwargs = {k: v for k, v in params.items() if k in _PPO_KEYS}
-    env_kwargs = dict(env_kwargs or {})
+    # rl-zoo's env_kwargs block, then the caller's (which win)
+    yaml_kwargs = params.get("env_kwargs") or {}
+    if not isinstance(yaml_kwargs, dict):
+        raise ConfigError(f"{hyperparams_path}: env_kwargs must be a mapping, got {yaml_kwargs!r}")
+    env_kwargs = {**yaml_kwargs, **(env_kwargs or {})}
     wrappers = wrapper_specs(params.get("env_wrapper"))
     for name, _ in wrappers:
         import_dotted(name)

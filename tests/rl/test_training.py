@@ -93,6 +93,7 @@ def test_maskable_ppo_on_candidate_goals_starts_from_the_frontier_agents_choices
         "SfW-ExploreGoals-v0:\n"
         "  policy: 'sfw_gym.rl.goal_policy.GoalsPolicy'\n"
         "  behaviour_cloning: {episodes: 3, epochs: 30}\n"
+        "  env_kwargs: {goals: {cost_per_m_bits: 20.0}}\n"
         "  n_steps: 32\n  batch_size: 32\n  n_epochs: 1\n  learning_rate: !!float 1e-5\n"
     )
     out = tmp_path / "run"
@@ -100,6 +101,11 @@ def test_maskable_ppo_on_candidate_goals_starts_from_the_frontier_agents_choices
     kwargs |= dict(checkpoint_every=32, eval_every=10**9, progress_bar=False)
     summary = train_ppo("SfW-ExploreGoals-v0", 32, out, **kwargs)
     assert summary["algo"] == "ppo_mask" and latest_checkpoint(out, "ppo_mask")[1] == 32
+    # the YAML's env_kwargs and the caller's both reach the env, and the agent reads them back
+    assert summary["env_kwargs"] == {**SMALL, "goals": {"cost_per_m_bits": 20.0}}
+    from sfw_gym.rl.goal_agent import GoalsAgent
+
+    assert GoalsAgent(out).config.cost_per_m_bits == 20.0
     model = MaskablePPO.load(out / "model.zip")
     env = gym.make("SfW-ExploreGoals-v0", **SMALL)
     agree = []
