@@ -21,12 +21,13 @@ import yaml
 
 import sfw_gym  # noqa: F401  (registration)
 from sfw_gym.agents.frontier import explore_lite_choice
+from sfw_gym.agents.greedy import bits_per_metre
 from sfw_gym.navigation.candidates import CandidateGoals
 from sfw_gym.rl.training import HELD_OUT_SEED_OFFSET, plot_training_curve
 
 
 def greedy_choice(menu: CandidateGoals) -> int | None:
-    score = menu.feature("expected_gain_bits") / (menu.feature("path_cost_m") + 1.0)
+    score = bits_per_metre(menu)
     return int(np.argmax(np.where(menu.valid, score, -np.inf))) if menu.valid.any() else None
 
 

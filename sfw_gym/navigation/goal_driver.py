@@ -88,9 +88,10 @@ class GoalDriver:
             if view.bumped:
                 wanted = linear * view.max_linear_speed_m_s * view.control_period_s
                 ahead = wanted > 0 and np.linalg.norm(view.xy - before) < 0.5 * wanted
-                self._slides = 0 if ahead else self._slides + 1
                 if ahead:  # a wall ahead: remembered
                     self.finder.mark_bump(view)
+                else:
+                    self._slides += 1
                 # back off from a wall ahead, and at every third slide along one
                 if (ahead or self._slides >= 3) and view.action_type == "continuous":
                     self._slides = 0

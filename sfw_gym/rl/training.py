@@ -68,6 +68,8 @@ def load_hyperparams(env_id: str, path: str | Path = DEFAULT_HYPERPARAMS) -> dic
     if isinstance(params.get("policy_kwargs"), str):
         params["policy_kwargs"] = parse_policy_kwargs(params["policy_kwargs"])
     wrapper_specs(params.get("env_wrapper"))  # fail early on a malformed entry
+    if not isinstance(params.get("env_kwargs") or {}, dict):
+        raise ConfigError(f"{path}: env_kwargs must be a mapping, got {params['env_kwargs']!r}")
     unknown = (
         set(params)
         - _PPO_KEYS
@@ -257,10 +259,7 @@ def train_ppo(
         policy = import_dotted(policy)
     ppo_kwargs = {k: v for k, v in params.items() if k in _PPO_KEYS}
     # rl-zoo's env_kwargs block, then the caller's (which win)
-    yaml_kwargs = params.get("env_kwargs") or {}
-    if not isinstance(yaml_kwargs, dict):
-        raise ConfigError(f"{hyperparams_path}: env_kwargs must be a mapping, got {yaml_kwargs!r}")
-    env_kwargs = {**yaml_kwargs, **(env_kwargs or {})}
+    env_kwargs = {**(params.get("env_kwargs") or {}), **(env_kwargs or {})}
     wrappers = wrapper_specs(params.get("env_wrapper"))
     for name, _ in wrappers:
         import_dotted(name)
@@ -307,9 +306,9 @@ def train_ppo(
                     _clone_teacher(model, env_id, env_kwargs, seed, params["behaviour_cloning"])
             grad_norms = []  # logged per head where the policy has separate heads
             if hasattr(model.policy, "parameter_groups"):
-                from sfw_gym.rl.goal_policy import HeadGradientNorms
+                from sfw_gym.rl import goal_policy
 
-                grad_norms.append(HeadGradientNorms())
+                grad_norms.append(goal_policy.HeadGradientNorms())
             callbacks = CallbackList(
                 [
                     *grad_norms,

@@ -217,6 +217,7 @@ CASES = [
     bad([*TRAIN, "--n-envs", "0"], r"argument --n-envs: .*'0'", id="train-n-envs-0"),
     bad([*TRAIN, "--n-envs", "-1"], r"argument --n-envs: .*'-1'", id="train-n-envs-negative"),
     bad([*TRAIN, "--seed", "-1"], r"argument --seed: .*'-1'", id="train-seed-negative"),
+    bad([*TRAIN, "--num-threads", "-1"], r"argument --num-threads: .*'-1'", id="train-threads-neg"),
     bad(
         [*TRAIN, "--checkpoint-every", "0"],
         r"argument --checkpoint-every: .*'0'",

@@ -49,6 +49,8 @@ def test_tiny_run_writes_table_curves_and_trajectories(tmp_path):
     assert "| frontier | 2 |" in md and "±" in md
     paired = (tmp_path / "paired.md").read_text()
     assert "| random − frontier | 2 |" in paired
+    ev.evaluate(["frontier"], 2, seed=5, out=tmp_path, **TINY)  # one agent: nothing to pair
+    assert not (tmp_path / "paired.md").exists()
     rec = recs[0]
     for key in (
         "coverage",
@@ -150,10 +152,13 @@ def test_bad_arguments_are_clear_errors(tmp_path):
 
 
 def test_cli_evaluate(tmp_path, capsys):
-    args = ["evaluate", "--agents", "random", "--episodes", "1", "--env", SMALL, "--workers", "1"]
+    args = ["evaluate", "--agents", "random,frontier", "--episodes", "1", "--env", SMALL]
     args += ["--out", str(tmp_path), "--no-progress", "--env-kwargs", '{"max_steps": 20}']
-    assert main(args) == 0
-    assert "| random | 1 |" in capsys.readouterr().out
+    assert main([*args, "--workers", "1"]) == 0
+    printed = capsys.readouterr().out
+    assert "| random | 1 |" in printed
+    assert "paired on the same plans and seeds:\n| agent − reference" in printed
+    assert "| frontier − random | 1 |" in printed
     assert main(["evaluate", "--agents", "bogus", "--out", str(tmp_path)]) == 2
     assert "unknown agent" in capsys.readouterr().err
     assert (

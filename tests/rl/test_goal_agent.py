@@ -11,6 +11,7 @@ from sfw_gym.core.errors import ConfigError
 from tests.envs.test_goals import SMALL
 
 sb3_contrib = pytest.importorskip("sb3_contrib")
+torch = pytest.importorskip("torch")
 from sfw_gym.rl.goal_agent import GoalsAgent  # noqa: E402
 from sfw_gym.rl.goal_policy import GoalsPolicy  # noqa: E402
 
@@ -49,3 +50,11 @@ def test_the_agent_drives_the_explore_env_as_the_goals_env_does(model_dir):
 def test_a_missing_model_is_named(tmp_path):
     with pytest.raises(ConfigError, match=r"model\.zip not found; train one with `sfw-gym train"):
         GoalsAgent(tmp_path)
+
+
+def test_the_agent_runs_torch_on_one_thread_unless_told_otherwise(model_dir):
+    torch.set_num_threads(2)
+    GoalsAgent(model_dir, num_threads=None)
+    assert torch.get_num_threads() == 2
+    GoalsAgent(model_dir)  # a small network: more threads only contend with the envs
+    assert torch.get_num_threads() == 1

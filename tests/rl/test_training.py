@@ -7,7 +7,10 @@ import subprocess
 import sys
 import textwrap
 import time
+import types
+from pathlib import Path
 
+import numpy as np
 import pytest
 
 from sfw_gym.core.errors import ConfigError
@@ -30,6 +33,59 @@ def test_hyperparams_load_for_every_block():
     assert small["policy_kwargs"]["net_arch"] == {"pi": [64], "vf": [64]}
     with pytest.raises(ConfigError, match="no hyperparameters"):
         load_hyperparams("CartPole-v1", DEFAULT_HYPERPARAMS)
+
+
+def test_env_kwargs_in_the_yaml_must_be_a_mapping(tmp_path):
+    yml = tmp_path / "bad.yml"
+    yml.write_text("SfW-ExploreSmall-v0:\n  env_kwargs: [1, 2]\n")
+    with pytest.raises(ConfigError, match="env_kwargs must be a mapping"):
+        load_hyperparams("SfW-ExploreSmall-v0", yml)
+
+
+def test_dagger_rounds_follow_the_cloning_episodes_and_refit_on_everything(monkeypatch):
+    from sfw_gym.rl import goal_policy, training
+
+    calls, fits = [], []
+
+    def decisions(env_id, env_kwargs, seeds, learner=None):
+        seeds = list(seeds)
+        calls.append((seeds, learner))
+        obs = [{"seed": s} for s in seeds]
+        return obs, np.array(seeds), np.ones((len(seeds), 2), bool)
+
+    monkeypatch.setattr(goal_policy, "teacher_decisions", decisions)
+
+    def clone(policy, observations, actions, masks, epochs):
+        assert len(observations) == len(actions) == len(masks)
+        fits.append([o["seed"] for o in observations])
+
+    monkeypatch.setattr(goal_policy, "behaviour_clone", clone)
+    model = types.SimpleNamespace(policy="the policy")
+    spec = {"episodes": 2, "epochs": 1, "dagger_rounds": 2, "dagger_episodes": 3}
+    training._clone_teacher(model, "X", {}, 10, spec)
+    assert calls == [([10, 11], None), ([12, 13, 14], "the policy"), ([15, 16, 17], "the policy")]
+    assert fits == [[10, 11], list(range(10, 15)), list(range(10, 18))]
+
+
+def test_a_save_killed_midway_leaves_no_checkpoint_under_its_name(tmp_path):
+    from sfw_gym.rl.training import _atomic_checkpoints
+
+    class Model:  # what the callback touches of an SB3 model
+        num_timesteps, logger = 64, None
+
+        def get_env(self):
+            return None
+
+        def save(self, path):
+            Path(path).write_bytes(b"PK half a zip")
+            raise KeyboardInterrupt  # killed during the save
+
+    callback = _atomic_checkpoints(1, tmp_path / "checkpoints", "ppo")
+    callback.init_callback(Model())
+    with pytest.raises(KeyboardInterrupt):
+        callback.on_step()
+    assert latest_checkpoint(tmp_path) is None
+    assert not list((tmp_path / "checkpoints").iterdir())  # nor a temp file
 
 
 def test_policy_kwargs_are_parsed_safely():
@@ -78,7 +134,9 @@ def test_killed_run_resumes_from_its_last_checkpoint(tmp_path):
     assert (out / "model.zip").exists() and (out / "config.yml").exists()
 
 
-def test_maskable_ppo_on_candidate_goals_starts_from_the_frontier_agents_choices(tmp_path):
+def test_maskable_ppo_on_candidate_goals_starts_from_the_frontier_agents_choices(
+    tmp_path, monkeypatch
+):
     """ppo_mask: behaviour cloning before PPO (the actor already prefers the teacher's choices),
     checkpoints under its own name, and a resumed run continues."""
     import gymnasium as gym
@@ -93,15 +151,29 @@ def test_maskable_ppo_on_candidate_goals_starts_from_the_frontier_agents_choices
         "SfW-ExploreGoals-v0:\n"
         "  policy: 'sfw_gym.rl.goal_policy.GoalsPolicy'\n"
         "  behaviour_cloning: {episodes: 3, epochs: 30}\n"
-        "  env_kwargs: {goals: {cost_per_m_bits: 20.0}}\n"
+        "  env_kwargs: {goals: {cost_per_m_bits: 20.0}, max_steps: 999}\n"
         "  n_steps: 32\n  batch_size: 32\n  n_epochs: 1\n  learning_rate: !!float 1e-5\n"
     )
     out = tmp_path / "run"
     kwargs = dict(n_envs=1, env_kwargs=SMALL, hyperparams_path=yml, algo="ppo_mask")
     kwargs |= dict(checkpoint_every=32, eval_every=10**9, progress_bar=False)
+    from sfw_gym.rl import goal_policy
+
+    logged = []  # the per-head gradient norms are wired in for a policy with separate heads
+
+    class Recorder(goal_policy.HeadGradientNorms):
+        def __init__(self):
+            super().__init__()
+            logged.append(self)
+
+    monkeypatch.setattr(goal_policy, "HeadGradientNorms", Recorder)
+    torch = pytest.importorskip("torch")
+    torch.set_num_threads(2)
     summary = train_ppo("SfW-ExploreGoals-v0", 32, out, **kwargs)
+    assert len(logged) == 1 and logged[0].model is not None
+    assert torch.get_num_threads() == 1  # one thread unless told otherwise
     assert summary["algo"] == "ppo_mask" and latest_checkpoint(out, "ppo_mask")[1] == 32
-    # the YAML's env_kwargs and the caller's both reach the env, and the agent reads them back
+    # the YAML's env_kwargs and the caller's (which win) reach the env; the agent reads them back
     assert summary["env_kwargs"] == {**SMALL, "goals": {"cost_per_m_bits": 20.0}}
     from sfw_gym.rl.goal_agent import GoalsAgent
 
@@ -131,3 +203,16 @@ def test_shipped_maskable_hyperparameters_load():
     params = load_hyperparams("SfW-ExploreGoals-v0", default_hyperparams("ppo_mask"))
     assert params["policy"] == "sfw_gym.rl.goal_policy.GoalsPolicy"
     assert params["behaviour_cloning"]["episodes"] > 0
+
+
+def test_the_training_curve_draws_other_policies_levels(tmp_path, monkeypatch):
+    from matplotlib.axes import Axes
+
+    from sfw_gym.rl.training import plot_training_curve
+
+    (tmp_path / "train_0.monitor.csv").write_text('#{"t_start": 0}\nr,l,t\n1.0,10,1\n2.0,12,2\n')
+    drawn = []
+    monkeypatch.setattr(Axes, "axhline", lambda ax, y, **kw: drawn.append((y, kw["label"])))
+    path = plot_training_curve(tmp_path, levels={"frontier": 12.3, "greedy": 7.9})
+    assert path is not None and path.stat().st_size > 0
+    assert drawn == [(12.3, "frontier"), (7.9, "greedy")]
