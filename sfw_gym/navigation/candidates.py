@@ -355,24 +355,23 @@ class GoalFinder:
         of the unknown cells on the ray from the router predicted strongest there, plus that of
         the unknown cells in the robot's footprint."""
         grid = view.grid
-        h, w = grid.shape
-        bits = _unknown_bits(view)
         routers = np.asarray(view.routers_xy, np.float64)
         zone = self.strongest_router(view)
         ends = grid.cell_to_world(cells)
         starts = routers[zone[cells[:, 0], cells[:, 1]]]
         length = np.linalg.norm(ends - starts, axis=1)
         n = max(2, int(np.ceil(length.max(initial=0.0) / (0.5 * grid.resolution_m))) + 1)
-        t = np.linspace(0.0, 1.0, n)
-        pts = starts[:, None, :] + (ends - starts)[:, None, :] * t[None, :, None]
-        rc = grid.world_to_cell(pts)
-        flat = np.clip(rc[..., 0], 0, h - 1) * w + np.clip(rc[..., 1], 0, w - 1)
-        # Count each cell once per ray: sort the flat indices per row, keep the first of a run.
-        flat.sort(axis=1)
-        first = np.ones_like(flat, bool)
-        first[:, 1:] = flat[:, 1:] != flat[:, :-1]
-        gain = (bits.ravel()[flat] * first).sum(axis=1)
-        return gain + self._disk_sum(bits, cells, self.reach_offsets)
+        return _expected_gain(
+            view.log_odds,
+            view.belief_u8,
+            starts,
+            ends,
+            np.linspace(0.0, 1.0, n),
+            np.asarray(grid.origin_xy, np.float64),
+            float(grid.resolution_m),
+            np.asarray(cells, np.int64),
+            self.reach_offsets,
+        )
 
     def _disk_sum(self, values: np.ndarray, cells: np.ndarray, offsets: np.ndarray) -> np.ndarray:
         """Per cell, the sum of ``values`` over ``cells + offsets`` inside the grid."""
@@ -566,13 +565,43 @@ def _fill(values: np.ndarray, compute) -> np.ndarray:
     return values
 
 
-def _unknown_bits(view: RobotView) -> np.ndarray:
-    """Entropy (bits) of each unknown cell of the belief; 0 for known cells."""
-    lo = np.abs(view.log_odds.astype(np.float64))
+@njit(cache=True)
+def _unknown_bits_at(log_odds, belief, r, c):  # pragma: no cover (compiled)
+    """Entropy (bits) of cell (r, c) if the belief there is unknown, else 0."""
+    b = belief[r, c]
+    if b <= U8_WALL_MAX or b >= U8_FREE_MIN:
+        return 0.0
+    lo = abs(np.float64(log_odds[r, c]))
     e = np.exp(-lo)
-    bits = (np.log1p(e) + lo * e / (1.0 + e)) / _LN2
-    _, _, unknown = belief_classes(view.belief_u8)
-    return np.where(unknown, bits, 0.0)
+    return (np.log1p(e) + lo * e / (1.0 + e)) / _LN2
+
+
+@njit(cache=True)
+def _expected_gain(
+    log_odds, belief, starts, ends, t, origin, res, cells, offsets
+):  # pragma: no cover (compiled)
+    """Per candidate i: the entropy of the unknown cells on the segment ``starts[i]`` →
+    ``ends[i]`` (sampled at ``t``; each cell once) plus that of the unknown cells at
+    ``cells[i] + offsets`` inside the grid."""
+    h, w = belief.shape
+    out = np.zeros(len(cells))
+    for i in range(len(cells)):
+        total = 0.0
+        last_r, last_c = -1, -1
+        for j in range(len(t)):
+            x = starts[i, 0] + (ends[i, 0] - starts[i, 0]) * t[j]
+            y = starts[i, 1] + (ends[i, 1] - starts[i, 1]) * t[j]
+            r = min(max(int(np.floor((y - origin[1]) / res)), 0), h - 1)
+            c = min(max(int(np.floor((x - origin[0]) / res)), 0), w - 1)
+            if r != last_r or c != last_c:  # a segment meets each cell in one run of samples
+                total += _unknown_bits_at(log_odds, belief, r, c)
+                last_r, last_c = r, c
+        for k in range(len(offsets)):
+            r, c = cells[i, 0] + offsets[k, 0], cells[i, 1] + offsets[k, 1]
+            if 0 <= r < h and 0 <= c < w:
+                total += _unknown_bits_at(log_odds, belief, r, c)
+        out[i] = total
+    return out
 
 
 @njit(cache=True)

@@ -5,6 +5,7 @@ same MLP for every candidate: pointer-style, so what it learns about one goal ho
 masked candidates get no probability (sb3-contrib's ``MaskableCategorical``). The critic is a
 separate MLP of the mean and max of the candidates' features and ``state``: no trunk is shared,
 so the value loss cannot drown the policy's gradients (the waypoint policy's failure).
+``shared_trunk=True`` (an ablation) feeds the critic the scorer's pooled hidden layer instead.
 """
 
 from __future__ import annotations
@@ -43,30 +44,37 @@ class GoalsInputs(BaseFeaturesExtractor):
 class CandidateHeads(nn.Module):
     """``forward_actor``: a logit per candidate; ``forward_critic``: the critic's latent."""
 
-    def __init__(self, k: int, f: int, s: int, hidden: int = 64) -> None:
+    def __init__(
+        self, k: int, f: int, s: int, hidden: int = 64, shared_trunk: bool = False
+    ) -> None:
         super().__init__()
         self.k, self.f, self.s = k, f, s
+        self.shared_trunk = shared_trunk
         self.latent_dim_pi, self.latent_dim_vf = k, hidden
         self.scorer = nn.Sequential(
             nn.Linear(f + s, hidden), nn.Tanh(), nn.Linear(hidden, hidden), nn.Tanh()
         )
         self.score = nn.Linear(hidden, 1)
+        critic_in = 2 * hidden + s if shared_trunk else 2 * f + s
         self.critic = nn.Sequential(
-            nn.Linear(2 * f + s, hidden), nn.Tanh(), nn.Linear(hidden, hidden), nn.Tanh()
+            nn.Linear(critic_in, hidden), nn.Tanh(), nn.Linear(hidden, hidden), nn.Tanh()
         )
 
     def _split(self, features: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         cand = features[:, : self.k * self.f].view(-1, self.k, self.f)
         return cand, features[:, self.k * self.f :]
 
-    def forward_actor(self, features: torch.Tensor) -> torch.Tensor:
-        cand, state = self._split(features)
+    def _hidden(self, cand: torch.Tensor, state: torch.Tensor) -> torch.Tensor:
         both = torch.cat([cand, state[:, None, :].expand(-1, self.k, -1)], dim=2)
-        return self.score(self.scorer(both)).squeeze(-1)
+        return self.scorer(both)
+
+    def forward_actor(self, features: torch.Tensor) -> torch.Tensor:
+        return self.score(self._hidden(*self._split(features))).squeeze(-1)
 
     def forward_critic(self, features: torch.Tensor) -> torch.Tensor:
         cand, state = self._split(features)
-        pooled = torch.cat([cand.mean(1), cand.max(1).values, state], dim=1)
+        per_candidate = self._hidden(cand, state) if self.shared_trunk else cand
+        pooled = torch.cat([per_candidate.mean(1), per_candidate.max(1).values, state], dim=1)
         return self.critic(pooled)
 
     def forward(self, features: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
@@ -76,15 +84,19 @@ class CandidateHeads(nn.Module):
 class GoalsPolicy(MaskableMultiInputActorCriticPolicy):
     """:class:`CandidateHeads` as the policy's heads; the logits are the actor's output as is."""
 
-    def __init__(self, *args: Any, hidden: int = 64, **kwargs: Any) -> None:
-        self.hidden = hidden
+    def __init__(
+        self, *args: Any, hidden: int = 64, shared_trunk: bool = False, **kwargs: Any
+    ) -> None:
+        self.hidden, self.shared_trunk = hidden, shared_trunk
         kwargs.setdefault("features_extractor_class", GoalsInputs)
         super().__init__(*args, **kwargs)
 
     def _build_mlp_extractor(self) -> None:
         inputs = self.features_extractor
         assert isinstance(inputs, GoalsInputs)
-        self.mlp_extractor = CandidateHeads(*inputs.shape, hidden=self.hidden)  # type: ignore[assignment]
+        self.mlp_extractor = CandidateHeads(  # type: ignore[assignment]
+            *inputs.shape, hidden=self.hidden, shared_trunk=self.shared_trunk
+        )
 
     @property
     def heads(self) -> CandidateHeads:
@@ -94,12 +106,17 @@ class GoalsPolicy(MaskableMultiInputActorCriticPolicy):
         return heads
 
     def parameter_groups(self) -> dict[str, list[nn.Parameter]]:
-        """The actor's and the critic's parameters (disjoint: the policy loss reaches only the
-        first, the value loss only the second)."""
+        """The actor's and the critic's parameters (disjoint unless ``shared_trunk``: the policy
+        loss reaches only the first, the value loss only the second)."""
         heads = self.heads
+        trunk = [*heads.scorer.parameters()]
         return {
-            "actor": [*heads.scorer.parameters(), *heads.score.parameters()],
-            "critic": [*heads.critic.parameters(), *self.value_net.parameters()],
+            "actor": [*trunk, *heads.score.parameters()],
+            "critic": [
+                *(trunk if heads.shared_trunk else []),
+                *heads.critic.parameters(),
+                *self.value_net.parameters(),
+            ],
         }
 
     def _build(self, lr_schedule: Any) -> None:
@@ -139,11 +156,13 @@ def teacher_decisions(
     env_kwargs: dict[str, Any],
     seeds: Iterable[int],
     learner: GoalsPolicy | None = None,
+    learner_masked: bool = True,
 ) -> tuple[list[dict[str, np.ndarray]], np.ndarray, np.ndarray]:
     """Observations, choices and masks of the frontier agent's choice on the menu
     (:func:`~sfw_gym.agents.frontier.explore_lite_choice`; any valid goal when it has none)
-    over one episode per seed. The teacher drives, or the ``learner`` (its most likely choice)
-    does: DAgger's states, labelled with the teacher's choices."""
+    over one episode per seed. The teacher drives, or the ``learner`` (its most likely choice,
+    among the valid ones if ``learner_masked``) does: DAgger's states, labelled with the
+    teacher's choices."""
     observations, actions, masks = [], [], []
     for seed in seeds:
         env = gym.make(env_id, **env_kwargs)
@@ -157,7 +176,8 @@ def teacher_decisions(
             actions.append(action)
             masks.append(mask)
             if learner is not None:
-                taken, _ = learner.predict(obs, deterministic=True, action_masks=mask)
+                allowed = mask if learner_masked else np.ones_like(mask)
+                taken, _ = learner.predict(obs, deterministic=True, action_masks=allowed)
                 action = int(taken)
             obs, _, terminated, truncated, _ = env.step(action)
             done = terminated or truncated

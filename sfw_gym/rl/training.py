@@ -80,6 +80,7 @@ def load_hyperparams(env_id: str, path: str | Path = DEFAULT_HYPERPARAMS) -> dic
             "env_wrapper",
             "env_kwargs",
             "behaviour_cloning",
+            "use_masking",
         }
     )
     if unknown:
@@ -220,7 +221,8 @@ def train_ppo(
 
     ``algo="ppo_mask"``: sb3-contrib's MaskablePPO (the env has ``action_masks()``); a
     ``behaviour_cloning`` block in the hyperparameters (``episodes``, ``epochs``) first fits
-    the fresh policy's actor to the frontier agent's choices on that many training episodes.
+    the fresh policy's actor to the frontier agent's choices on that many training episodes;
+    ``use_masking: false`` (an ablation) ignores the masks in cloning, rollouts and updates.
 
     With ``resume=True`` the latest checkpoint in ``OUT/checkpoints`` is loaded and training
     continues from its step count (the step counter, optimiser and rollout schedule carry on);
@@ -258,6 +260,7 @@ def train_ppo(
     if "." in policy:  # a policy class of one's own, by dotted path
         policy = import_dotted(policy)
     ppo_kwargs = {k: v for k, v in params.items() if k in _PPO_KEYS}
+    masking = {"use_masking": bool(params.get("use_masking", True))} if algo == "ppo_mask" else {}
     # rl-zoo's env_kwargs block, then the caller's (which win)
     env_kwargs = {**(params.get("env_kwargs") or {}), **(env_kwargs or {})}
     wrappers = wrapper_specs(params.get("env_wrapper"))
@@ -303,7 +306,9 @@ def train_ppo(
                     **ppo_kwargs,
                 )
                 if params.get("behaviour_cloning"):
-                    _clone_teacher(model, env_id, env_kwargs, seed, params["behaviour_cloning"])
+                    _clone_teacher(
+                        model, env_id, env_kwargs, seed, params["behaviour_cloning"], **masking
+                    )
             grad_norms = []  # logged per head where the policy has separate heads
             if hasattr(model.policy, "parameter_groups"):
                 from sfw_gym.rl import goal_policy
@@ -323,6 +328,7 @@ def train_ppo(
                         best_model_save_path=None,
                         deterministic=False,
                         verbose=0,
+                        **masking,
                     ),
                 ]
             )
@@ -333,6 +339,7 @@ def train_ppo(
                 reset_num_timesteps=previous is None,
                 progress_bar=progress_bar,
                 tb_log_name=algo,
+                **masking,
             )
             wall = time.perf_counter() - start
             _save_atomic(model, out / "model.zip")
@@ -362,11 +369,17 @@ def train_ppo(
 
 
 def _clone_teacher(
-    model: Any, env_id: str, env_kwargs: dict[str, Any], seed: int, spec: dict[str, Any]
+    model: Any,
+    env_id: str,
+    env_kwargs: dict[str, Any],
+    seed: int,
+    spec: dict[str, Any],
+    use_masking: bool = True,
 ) -> None:
     """Behaviour cloning of the frontier agent's menu choices before PPO (training seeds):
     ``episodes`` driven by the teacher, then ``dagger_rounds`` rounds of ``dagger_episodes``
-    driven by the cloned policy and labelled by the teacher (DAgger), refitting on all."""
+    driven by the cloned policy and labelled by the teacher (DAgger), refitting on all.
+    Without ``use_masking`` every action counts as allowed (the learner's and the loss's)."""
     from sfw_gym.rl.goal_policy import behaviour_clone, teacher_decisions
 
     unknown = set(spec) - {"episodes", "epochs", "dagger_rounds", "dagger_episodes"}
@@ -374,11 +387,15 @@ def _clone_teacher(
         raise ConfigError(f"behaviour_cloning: unknown keys {sorted(unknown)}")
     epochs, first = int(spec.get("epochs", 30)), int(spec.get("episodes", 8))
     per_round = int(spec.get("dagger_episodes", 4))
-    observations, actions, masks = teacher_decisions(env_id, env_kwargs, range(seed, seed + first))
+    def decisions(seeds: range, learner: Any = None) -> tuple[list, np.ndarray, np.ndarray]:
+        obs, acts, masks = teacher_decisions(env_id, env_kwargs, seeds, learner, use_masking)
+        return obs, acts, masks if use_masking else np.ones_like(masks)
+
+    observations, actions, masks = decisions(range(seed, seed + first))
     behaviour_clone(model.policy, observations, actions, masks, epochs=epochs)
     for i in range(int(spec.get("dagger_rounds", 0))):
         start = seed + first + i * per_round
-        more = teacher_decisions(env_id, env_kwargs, range(start, start + per_round), model.policy)
+        more = decisions(range(start, start + per_round), model.policy)
         observations += more[0]
         actions, masks = np.concatenate([actions, more[1]]), np.concatenate([masks, more[2]])
         behaviour_clone(model.policy, observations, actions, masks, epochs=epochs)

@@ -58,3 +58,18 @@ def test_the_agent_runs_torch_on_one_thread_unless_told_otherwise(model_dir):
     assert torch.get_num_threads() == 2
     GoalsAgent(model_dir)  # a small network: more threads only contend with the envs
     assert torch.get_num_threads() == 1
+
+
+def test_a_policy_trained_without_masks_chooses_among_all_candidates(model_dir, tmp_path):
+    (tmp_path / "config.yml").write_text("hyperparameters:\n  use_masking: false\n")
+    (tmp_path / "model.zip").write_bytes((model_dir / "model.zip").read_bytes())
+    masks = []
+    agent = GoalsAgent(tmp_path)
+    agent._choose = lambda obs, mask: masks.append(mask) or 0
+    explore = gym.make("SfW-Explore-v0", **SMALL)
+    obs, _ = explore.reset(seed=4)
+    agent.reset(explore, seed=0)
+    for _ in range(20):
+        obs, *_ = explore.step(agent.act(obs))
+    assert masks and all(m.all() for m in masks)
+    assert GoalsAgent(model_dir).use_masking

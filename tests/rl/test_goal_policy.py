@@ -101,3 +101,18 @@ def test_dagger_labels_the_learners_states_with_the_teachers_choices():
         taken.append(int(action))
         obs, *_ = env.step(int(action))
     assert np.mean(np.array(taken) != labels) > 0.2  # other states than the teacher's own
+
+
+def test_the_shared_trunk_ablation_lets_the_value_loss_reach_the_actors_layer():
+    env = gym.make("SfW-ExploreGoals-v0", **SMALL)
+    obs, _ = env.reset(seed=0)
+    model = sb3_contrib.MaskablePPO(
+        GoalsPolicy, env, n_steps=16, batch_size=16, seed=0, policy_kwargs={"shared_trunk": True}
+    )
+    policy = model.policy
+    policy.predict_values(as_batch([obs])).sum().backward()
+    heads = policy.heads
+    assert any(p.grad is not None and p.grad.abs().sum() > 0 for p in heads.scorer.parameters())
+    assert all(p.grad is None for p in heads.score.parameters())
+    groups = policy.parameter_groups()
+    assert {id(p) for p in heads.scorer.parameters()} <= {id(p) for p in groups["critic"]}
