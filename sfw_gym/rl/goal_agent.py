@@ -112,7 +112,9 @@ class GoalsAgent(Agent):
             # the most likely valid candidate: the actor's logits straight, without SB3's
             # predict() (its tensors, checks and distribution cost 1.2 ms a decision)
             with torch.no_grad():
-                x = {k: torch.as_tensor(obs[k], dtype=torch.float32)[None] for k in GoalsInputs.keys}
+                x = {
+                    k: torch.as_tensor(obs[k], dtype=torch.float32)[None] for k in GoalsInputs.keys
+                }
                 features = policy.extract_features(x)
                 logits = policy.heads.forward_actor(features)[0].numpy()  # type: ignore[arg-type]
             return int(np.argmax(np.where(mask, logits, -np.inf)))

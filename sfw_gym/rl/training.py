@@ -387,6 +387,7 @@ def _clone_teacher(
         raise ConfigError(f"behaviour_cloning: unknown keys {sorted(unknown)}")
     epochs, first = int(spec.get("epochs", 30)), int(spec.get("episodes", 8))
     per_round = int(spec.get("dagger_episodes", 4))
+
     def decisions(seeds: range, learner: Any = None) -> tuple[list, np.ndarray, np.ndarray]:
         obs, acts, masks = teacher_decisions(env_id, env_kwargs, seeds, learner, use_masking)
         return obs, acts, masks if use_masking else np.ones_like(masks)
