@@ -2,9 +2,9 @@
 
     python scripts/bench_goals_agent.py [--model PATH] [--seeds 3]
 
-Runs ``GoalsAgent`` (the shipped model by default) on ``SfW-Explore-v0`` held-out seeds and times
+Runs ``PPOAgent`` (the shipped model by default) on ``SfW-Explore-v0`` held-out seeds and times
 each decision's two parts, the candidate menu (``menu_observation``) and the policy's choice
-(``GoalsAgent._choose``), then the whole episode per step beside ``FrontierAgent``'s on the same
+(``PPOAgent._choose``), then the whole episode per step beside ``FrontierAgent``'s on the same
 seeds (one process, side by side).
 """
 
@@ -18,9 +18,9 @@ import numpy as np
 
 import sfw_gym  # noqa: F401  (registration)
 from sfw_gym.agents import make_agent
-from sfw_gym.core.data import DEFAULT_GOALS_MODEL_DIR
+from sfw_gym.core.data import DEFAULT_MODEL_DIR
 from sfw_gym.envs import goals
-from sfw_gym.rl import goal_agent
+from sfw_gym.rl import agent as goal_agent
 
 
 def timed(table: dict[str, list[float]], name: str, fn):
@@ -46,21 +46,21 @@ def episode_seconds(agent, seed: int) -> tuple[float, int]:
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--model", default=str(DEFAULT_GOALS_MODEL_DIR))
+    p.add_argument("--model", default=str(DEFAULT_MODEL_DIR))
     p.add_argument("--seeds", type=int, default=3)
     args = p.parse_args()
     parts: dict[str, list[float]] = {"menu": [], "policy": []}
     goal_agent.menu_observation = timed(parts, "menu", goals.menu_observation)  # type: ignore[assignment]
-    learned = make_agent("goals", path=args.model)
+    learned = make_agent("ppo", path=args.model)
     learned._choose = timed(parts, "policy", learned._choose)  # type: ignore[method-assign]
     frontier = make_agent("frontier")
     episode_seconds(learned, 0)  # warm-up: compiled kernels, torch
     episode_seconds(frontier, 0)
     for v in parts.values():
         v.clear()
-    totals = {"goals": [0.0, 0], "frontier": [0.0, 0]}
+    totals = {"ppo": [0.0, 0], "frontier": [0.0, 0]}
     for seed in range(2_000_000, 2_000_000 + args.seeds):
-        for name, agent in (("goals", learned), ("frontier", frontier)):
+        for name, agent in (("ppo", learned), ("frontier", frontier)):
             t, n = episode_seconds(agent, seed)
             totals[name][0] += t
             totals[name][1] += n
@@ -75,7 +75,7 @@ def main() -> None:
     per_step = {name: 1e3 * t / n for name, (t, n) in totals.items()}
     for name, ms in per_step.items():
         print(f"  {name:<9} episode {ms:.2f} ms per step ({totals[name][1]} steps)")
-    print(f"  goals ÷ frontier per step: {per_step['goals'] / per_step['frontier']:.2f}")
+    print(f"  ppo ÷ frontier per step: {per_step['ppo'] / per_step['frontier']:.2f}")
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # What a new user gets from the wheel, with no checkout in sight: build it, install it in a fresh
 # venv in a temp folder, and run there (1) the light core without torch, (2) with the [rl] extra,
-# PPOAgent(), GoalsAgent(), `sfw-gym demo` and `sfw-gym train ppo`. CI runs this after the tests.
+# WaypointPPOAgent(), PPOAgent(), `sfw-gym demo` and `sfw-gym train ppo`. CI runs this after the tests.
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 python="${PYTHON:-python3}"
@@ -34,8 +34,8 @@ PY
 
 "$py" -m pip install --quiet torch==2.13.0  # the CPU build (an unpinned torch pulls CUDA)
 "$py" -m pip install --quiet "$wheel[rl]"
+"$py" -c "from sfw_gym.rl import WaypointPPOAgent; a = WaypointPPOAgent(); print('WaypointPPOAgent() loads', a.path)"
 "$py" -c "from sfw_gym.rl import PPOAgent; a = PPOAgent(); print('PPOAgent() loads', a.path)"
-"$py" -c "from sfw_gym.rl import GoalsAgent; a = GoalsAgent(); print('GoalsAgent() loads', a.path)"
 "$work/venv/bin/sfw-gym" demo --episodes 1 --workers 1 --out "$work/report" --no-progress | tail -3
 "$work/venv/bin/sfw-gym" train ppo --env SfW-ExploreSmall-v0 --timesteps 256 --out "$work/run" \
     --no-progress | tail -2

@@ -1,10 +1,10 @@
-"""Pretrained PPO vs frontier on held-out generated plans (issue 6's benchmark).
+"""The earlier PPO waypoint policy (``ppo-waypoint``) vs frontier on held-out plans (issue 6).
 
 Usage: ``python scripts/compare_ppo_frontier.py [--episodes 50] [--seed 2000000]
 [--model agents/ppo/SfW-Explore-v0_1] [--out runs/ppo_vs_frontier] [--workers 2]``
 
-Same as ``sfw-gym evaluate --agents ppo,frontier --episodes 50 --seed 2000000``, plus a check that
-no evaluation floorplan occurs in the policy's training logs (the monitor CSVs record the
+Same as ``sfw-gym evaluate --agents ppo-waypoint,frontier --episodes 50 --seed 2000000``, plus a
+check that no evaluation floorplan occurs in the policy's training logs (the monitor CSVs record the
 floorplan of every training and held-out episode), then the Markdown table.
 """
 
@@ -14,7 +14,7 @@ import argparse
 import csv
 from pathlib import Path
 
-from sfw_gym.core.data import DEFAULT_MODEL_DIR
+from sfw_gym.core.data import DEFAULT_WAYPOINT_MODEL_DIR
 from sfw_gym.evaluation import evaluate
 
 
@@ -31,17 +31,17 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--episodes", type=int, default=50)
     p.add_argument("--seed", type=int, default=2_000_000)
-    p.add_argument("--model", default=str(DEFAULT_MODEL_DIR))
+    p.add_argument("--model", default=str(DEFAULT_WAYPOINT_MODEL_DIR))
     p.add_argument("--out", default="runs/ppo_vs_frontier")
     p.add_argument("--workers", type=int, default=2)
     args = p.parse_args()
     out = Path(args.out)
     result = evaluate(
-        ["ppo", "frontier"],
+        ["ppo-waypoint", "frontier"],
         args.episodes,
         args.seed,
         out=out,
-        agent_params={"ppo": {"path": args.model}},
+        agent_params={"ppo-waypoint": {"path": args.model}},
         workers=args.workers,
     )
     seen = trained_floorplans(Path(args.model))

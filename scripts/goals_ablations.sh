@@ -25,6 +25,6 @@ PY
   sfw-gym train ppo_mask --env SfW-ExploreGoals-v0 --timesteps 10000 --checkpoint-every 10000 \
     --eval-every 25000 --eval-episodes 3 --hyperparams "$out/$name.yml" --out "$out/$name" \
     --resume --no-progress
-  sfw-gym evaluate --agents frontier,goals --agent-params "{\"goals\": {\"path\": \"$out/$name\"}}" \
+  sfw-gym evaluate --agents frontier,ppo --agent-params "{\"ppo\": {\"path\": \"$out/$name\"}}" \
     --episodes 50 --seed 2000000 --out "$out/$name-eval"
 done

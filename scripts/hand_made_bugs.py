@@ -21,17 +21,17 @@ CASES = [
     ),
     (
         "bug2a.ppo-waypoint-sample",
-        "sfw_gym/rl/agent.py",
+        "sfw_gym/rl/waypoint_agent.py",
         "        if self.deterministic:",
         "        if False:",
-        "tests/rl/test_ppo_agent.py",
+        "tests/rl/test_waypoint_agent.py",
     ),
     (
         "bug2b.ppo-continuous-sample",
-        "sfw_gym/rl/agent.py",
+        "sfw_gym/rl/waypoint_agent.py",
         "self.model.predict(obs, deterministic=self.deterministic)",
         "self.model.predict(obs, deterministic=False)",
-        "tests/rl/test_ppo_agent.py",
+        "tests/rl/test_waypoint_agent.py",
     ),
     (
         "bug3.waypoint-reward",

@@ -104,6 +104,7 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
             "tests/agents/test_agent_rules.py",
             "tests/agents/test_agent_behaviour.py",
             "tests/rl/test_ppo_agent.py",
+            "tests/rl/test_waypoint_agent.py",
         ],
     ),
     "env": (

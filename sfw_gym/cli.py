@@ -227,7 +227,8 @@ def build_parser() -> argparse.ArgumentParser:
     from sfw_gym.world.radio import BANDS, PRESETS
 
     demo = sub.add_parser(
-        "demo", help="frontier, cross-pass and the pretrained policies on fresh plans → sfw-report/"
+        "demo",
+        help="frontier, cross-pass and the shipped learned explorer on fresh plans → sfw-report/",
     )
     demo.add_argument(
         "--out", type=folder, default="sfw-report", help="report folder (default sfw-report)"
@@ -242,7 +243,9 @@ def build_parser() -> argparse.ArgumentParser:
         "--workers", type=positive_int, default=2, help="worker processes (default 2)"
     )
     demo.add_argument(
-        "--model", default=None, help="a trained PPO folder or model.zip (default: the shipped one)"
+        "--model",
+        default=None,
+        help="a `sfw-gym train ppo_mask` folder or .zip (default: the shipped one)",
     )
     demo.add_argument("--no-progress", action="store_true", help="no progress bar")
     demo.set_defaults(func=_cmd_demo)
@@ -359,7 +362,7 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument(
         "--agents",
         default="frontier,cross-pass,random",
-        help="comma-separated: frontier, cross-pass, greedy, random, ppo, goals (default: "
+        help="comma-separated: frontier, cross-pass, greedy, random, ppo, ppo-waypoint (default: "
         "frontier,cross-pass,random)",
     )
     ev.add_argument(

@@ -1,5 +1,5 @@
-"""``sfw-gym demo``: frontier, cross-pass and the two pretrained policies (the learned
-candidate-goal explorer and the PPO waypoint policy) on a few fresh plans → a report.
+"""``sfw-gym demo``: frontier, cross-pass and the shipped learned explorer (PPO over candidate
+goals) on a few fresh plans → a report.
 
 Everything comes with the package: procedural floorplans, the default radio, the shipped policies.
 The report folder holds ``index.md`` (what ran, the results table, the figures), the evaluation's
@@ -16,7 +16,7 @@ from sfw_gym.core.atomic import write_text_atomic
 from sfw_gym.core.data import scenario
 from sfw_gym.evaluation import evaluate
 
-DEMO_AGENTS = ("frontier", "cross-pass", "goals", "ppo")
+DEMO_AGENTS = ("frontier", "cross-pass", "ppo")
 DEMO_ENV = "SfW-Explore-v0"  # the shipped policy's env
 #: Floorplan seeds far from those the shipped policy was trained on (its training resets used
 #: seeds 0-3 and their RNG streams; its held-out evaluation 1,000,000+): envs/scenarios.yml.
@@ -35,7 +35,8 @@ def run_demo(
 ) -> Path:
     """Run the demo (resumable, like any evaluation) and write ``OUT/index.md``; return its path.
 
-    ``model``: a trained PPO folder (or its ``model.zip``) instead of the shipped policy.
+    ``model``: a ``sfw-gym train ppo_mask`` folder (or a ``.zip`` in it) instead of the shipped
+    policy.
     """
     out = Path(out)
     start = time.perf_counter()
@@ -52,7 +53,7 @@ def run_demo(
     )
     index = out / "index.md"
     wall_s = time.perf_counter() - start
-    policy = str(model) if model is not None else "agents/ppo/SfW-Explore-v0_1"
+    policy = str(model) if model is not None else "agents/ppo_mask/SfW-ExploreGoals-v0_1"
     write_text_atomic(index, _index_markdown(out, result, seed, wall_s, policy))
     return index
 
@@ -67,9 +68,9 @@ def _index_markdown(
         "# sfw_gym demo: WiFi-only exploration",
         "",
         f"`{DEMO_ENV}` (default radio, two routers, 3,000-step budget): frontier exploration, "
-        "frontier with cross-connecting passes, the learned candidate-goal explorer (`goals`: "
-        "MaskablePPO choosing among the navigation menu's goals) and the pretrained PPO "
-        f"waypoint policy (`{policy}`) on the same procedural floorplans, start poses and "
+        "frontier with cross-connecting passes and the learned explorer (`ppo`: MaskablePPO "
+        f"choosing among the navigation menu's candidate goals, `{policy}`) on the same "
+        "procedural floorplans, start poses and "
         f"seeds ({seed}–{seed + len(episodes) - 1}; never used in training). "
         f"Report written in {wall_s:.0f} s.",
         "",

@@ -60,10 +60,10 @@ def test_every_data_file_the_package_reads_is_in_the_wheel():
     ]["sfw_gym"]
     package = REPO / "sfw_gym"
     read = [
+        data.DEFAULT_WAYPOINT_MODEL_DIR / "model.zip",
+        data.DEFAULT_WAYPOINT_MODEL_DIR / "config.yml",
         data.DEFAULT_MODEL_DIR / "model.zip",
         data.DEFAULT_MODEL_DIR / "config.yml",
-        data.DEFAULT_GOALS_MODEL_DIR / "model.zip",
-        data.DEFAULT_GOALS_MODEL_DIR / "config.yml",
         data.DEFAULT_HYPERPARAMS,
         data.SCENARIOS,
     ]
@@ -79,14 +79,14 @@ def test_checkout_agents_and_envs_are_the_package_data_not_copies():
 
 
 def test_models_saved_under_the_old_policy_path_still_load():
-    from sfw_gym.core.data import DEFAULT_MODEL_DIR
+    from sfw_gym.core.data import DEFAULT_WAYPOINT_MODEL_DIR
     from sfw_gym.rl.training import import_dotted
 
-    with zipfile.ZipFile(DEFAULT_MODEL_DIR / "model.zip") as archive:
+    with zipfile.ZipFile(DEFAULT_WAYPOINT_MODEL_DIR / "model.zip") as archive:
         assert b"sfw_gym.agents.waypoint_policy" in archive.read("data")  # pickled before the move
     from sfw_gym.rl.policy import WaypointPolicy
 
     assert import_dotted("sfw_gym.agents.waypoint_policy.WaypointPolicy") is WaypointPolicy
-    from sfw_gym.rl import PPOAgent
+    from sfw_gym.rl import WaypointPPOAgent
 
-    assert isinstance(PPOAgent().model.policy, WaypointPolicy)
+    assert isinstance(WaypointPPOAgent().model.policy, WaypointPolicy)

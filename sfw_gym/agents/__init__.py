@@ -26,7 +26,7 @@ AGENTS: dict[str, str] = {
     "greedy": "sfw_gym.agents.greedy:GreedyInfoGainAgent",
     "random": "sfw_gym.agents.random_agent:RandomAgent",
     "ppo": "sfw_gym.rl.agent:PPOAgent",
-    "goals": "sfw_gym.rl.goal_agent:GoalsAgent",
+    "ppo-waypoint": "sfw_gym.rl.waypoint_agent:WaypointPPOAgent",
 }
 
 

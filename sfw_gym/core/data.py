@@ -24,9 +24,9 @@ def data_path(*parts: str) -> Path:
 
 
 #: The shipped pretrained policy (trained by ``sfw-gym train ppo``).
-DEFAULT_MODEL_DIR = data_path("agents", "ppo", "SfW-Explore-v0_1")
+DEFAULT_WAYPOINT_MODEL_DIR = data_path("agents", "ppo", "SfW-Explore-v0_1")
 #: The shipped candidate-goal explorer (trained by ``sfw-gym train ppo_mask``).
-DEFAULT_GOALS_MODEL_DIR = data_path("agents", "ppo_mask", "SfW-ExploreGoals-v0_1")
+DEFAULT_MODEL_DIR = data_path("agents", "ppo_mask", "SfW-ExploreGoals-v0_1")
 #: PPO hyperparameters per env id (rl-zoo format).
 DEFAULT_HYPERPARAMS = data_path("agents", "hyperparams", "ppo.yml")
 

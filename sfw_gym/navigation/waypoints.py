@@ -34,7 +34,7 @@ class WaypointDriver:
     With discrete actions, contact while turning in place (the robot still touching the wall it
     bumped) does not end the waypoint: the robot turns away and drives on. A goal no path
     reaches costs one step standing still. Shared by :class:`WaypointWrapper` (training) and
-    :class:`sfw_gym.agents.PPOAgent` (evaluation), so both drive alike.
+    :class:`sfw_gym.agents.WaypointPPOAgent` (evaluation), so both drive alike.
     """
 
     def __init__(self, grid_cells: int = 8, max_steps_per_waypoint: int = 60) -> None:

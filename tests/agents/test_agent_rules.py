@@ -10,7 +10,7 @@ import sfw_gym  # noqa: F401  (registers the envs)
 from sfw_gym.agents import CrossPassAgent, FrontierAgent, GreedyInfoGainAgent, RandomAgent
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.navigation.planning import cost_field, disk_offsets
-from sfw_gym.rl.agent import waypoint_settings
+from sfw_gym.rl.waypoint_agent import waypoint_settings
 from tests.agents.test_agents import F, FakeEnv, U, W, _walled_room_with_unreachable_frontier
 
 SMALL = "SfW-ExploreSmall-v0"

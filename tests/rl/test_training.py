@@ -47,24 +47,32 @@ def test_dagger_rounds_follow_the_cloning_episodes_and_refit_on_everything(monke
 
     calls, fits = [], []
 
-    def decisions(env_id, env_kwargs, seeds, learner=None):
+    def decisions(env_id, env_kwargs, seeds, learner=None, learner_masked=True):
         seeds = list(seeds)
-        calls.append((seeds, learner))
+        calls.append((seeds, learner, learner_masked))
         obs = [{"seed": s} for s in seeds]
-        return obs, np.array(seeds), np.ones((len(seeds), 2), bool)
+        return obs, np.array(seeds), np.array([[True, False]] * len(seeds))
 
     monkeypatch.setattr(goal_policy, "teacher_decisions", decisions)
 
     def clone(policy, observations, actions, masks, epochs):
         assert len(observations) == len(actions) == len(masks)
-        fits.append([o["seed"] for o in observations])
+        fits.append(([o["seed"] for o in observations], bool(masks.all())))
 
     monkeypatch.setattr(goal_policy, "behaviour_clone", clone)
     model = types.SimpleNamespace(policy="the policy")
     spec = {"episodes": 2, "epochs": 1, "dagger_rounds": 2, "dagger_episodes": 3}
     training._clone_teacher(model, "X", {}, 10, spec)
-    assert calls == [([10, 11], None), ([12, 13, 14], "the policy"), ([15, 16, 17], "the policy")]
-    assert fits == [[10, 11], list(range(10, 15)), list(range(10, 18))]
+    policy = "the policy"
+    assert calls == [
+        ([10, 11], None, True),
+        ([12, 13, 14], policy, True),
+        ([15, 16, 17], policy, True),
+    ]
+    assert fits == [([10, 11], False), (list(range(10, 15)), False), (list(range(10, 18)), False)]
+    calls.clear(), fits.clear()
+    training._clone_teacher(model, "X", {}, 10, spec, use_masking=False)  # the no-mask ablation
+    assert [c[2] for c in calls] == [False] * 3 and all(all_allowed for _, all_allowed in fits)
 
 
 def test_a_save_killed_midway_leaves_no_checkpoint_under_its_name(tmp_path):
@@ -175,9 +183,9 @@ def test_maskable_ppo_on_candidate_goals_starts_from_the_frontier_agents_choices
     assert summary["algo"] == "ppo_mask" and latest_checkpoint(out, "ppo_mask")[1] == 32
     # the YAML's env_kwargs and the caller's (which win) reach the env; the agent reads them back
     assert summary["env_kwargs"] == {**SMALL, "goals": {"cost_per_m_bits": 20.0}}
-    from sfw_gym.rl.goal_agent import GoalsAgent
+    from sfw_gym.rl.agent import PPOAgent
 
-    assert GoalsAgent(out).config.cost_per_m_bits == 20.0
+    assert PPOAgent(out).config.cost_per_m_bits == 20.0
     model = MaskablePPO.load(out / "model.zip")
     env = gym.make("SfW-ExploreGoals-v0", **SMALL)
     agree = []

@@ -1,0 +1,173 @@
+"""A trained PPO policy (stable-baselines3) behind the agents' interface.
+
+The shipped policy picks waypoints (:class:`sfw_gym.envs.waypoint.WaypointWrapper`): every few
+steps it looks at the observation and names a block of the map; the agent then drives there
+step by step with the wrapper's own :class:`~sfw_gym.navigation.waypoints.WaypointDriver`, so it
+acts exactly as in training. Policies trained on the env's own continuous actions are driven
+directly.
+"""
+
+from __future__ import annotations
+
+import base64
+import functools
+import io
+import json
+import pickle
+import zipfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from sfw_gym.agents.base import Agent, RobotView
+from sfw_gym.core.data import DEFAULT_WAYPOINT_MODEL_DIR
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.navigation.waypoints import WaypointDriver, block_features
+from sfw_gym.rl.training import MOVED_CLASSES, import_dotted, wrapper_specs
+
+WAYPOINT_WRAPPER = "sfw_gym.envs.waypoint.WaypointWrapper"
+
+
+@functools.lru_cache(maxsize=4)
+def _load_model(path: str, device: str) -> Any:
+    import torch
+    from stable_baselines3 import PPO
+
+    # One env's forward pass is tiny: threads only fight the evaluation's other workers.
+    torch.set_num_threads(1)
+    return PPO.load(path, device=device, custom_objects=_moved_objects(path))
+
+
+def _moved_objects(model_zip: str) -> dict[str, Any]:
+    """SB3 ``custom_objects`` for the values a model pickled by a class path that has since
+    moved (:data:`~sfw_gym.rl.training.MOVED_CLASSES`), so that older models keep loading."""
+    with zipfile.ZipFile(model_zip) as archive:
+        data = json.loads(archive.read("data"))
+    out = {}
+    for key, value in data.items():
+        if isinstance(value, dict) and ":serialized:" in value:
+            raw = base64.b64decode(value[":serialized:"])
+            try:
+                pickle.loads(raw)
+            except (ImportError, AttributeError):
+                out[key] = _RenamingUnpickler(io.BytesIO(raw)).load()
+    return out
+
+
+class _RenamingUnpickler(pickle.Unpickler):
+    def find_class(self, module: str, name: str) -> Any:
+        moved = MOVED_CLASSES.get(f"{module}.{name}")
+        return import_dotted(moved) if moved else super().find_class(module, name)
+
+
+def waypoint_settings(config: dict[str, Any]) -> dict[str, int] | None:
+    """The WaypointWrapper's kwargs from a training ``config.yml`` (``{}``: its defaults), or
+    None if the policy was trained without it."""
+    for name, kwargs in wrapper_specs(config.get("hyperparameters", {}).get("env_wrapper")):
+        if name == WAYPOINT_WRAPPER:
+            return dict(kwargs)
+    return None
+
+
+class WaypointPPOAgent(Agent):
+    """Acts with a PPO model trained by ``sfw-gym train ppo`` (by default the shipped one).
+
+    Args:
+        path: A training output folder holding ``model.zip`` and ``config.yml`` (or that
+            ``model.zip``); by default the shipped policy.
+        deterministic: Take the policy's most likely waypoint; else (the default) sample it from
+            the policy with the agent's seeded generator, as in training. A deterministic
+            policy repeats a waypoint it cannot reach forever (nothing in the observation
+            changes); sampling does not.
+        device: Torch device of the policy (``"cpu"`` is plenty for one env).
+        max_steps: Optional step limit of the agent.
+    """
+
+    name = "ppo-waypoint"
+
+    def __init__(
+        self,
+        path: str | Path = DEFAULT_WAYPOINT_MODEL_DIR,
+        deterministic: bool = False,
+        device: str = "cpu",
+        max_steps: int | None = None,
+    ) -> None:
+        super().__init__(max_steps=max_steps)
+        folder = Path(path).parent if Path(path).suffix == ".zip" else Path(path)
+        self.path = str(path)
+        self.deterministic = bool(deterministic)
+        self.device = device
+        model_path = folder / "model.zip"
+        config_path = folder / "config.yml"
+        for file in (model_path, config_path):
+            if not file.is_file():
+                raise ConfigError(
+                    f"WaypointPPOAgent: {file} not found; train one with `sfw-gym train ppo --out "
+                    f"{folder}` or pass path="
+                )
+        try:
+            config = yaml.safe_load(config_path.read_text(encoding="utf-8")) or {}
+        except yaml.YAMLError as exc:
+            raise ConfigError(f"WaypointPPOAgent: {config_path}: not valid YAML ({exc})") from None
+        self.waypoints = waypoint_settings(config)
+        self.model = _load_model(str(model_path), device)
+        if self.waypoints is None:
+            self.action_types = ("continuous",)  # type: ignore[misc]  # this model's only
+
+    def _choose(self, obs: dict[str, np.ndarray]) -> int:
+        """The policy's waypoint for ``obs``: its mode, or a sample drawn with ``self.rng``."""
+        import torch
+
+        policy = self.model.policy
+        with torch.no_grad():
+            tensor, _ = policy.obs_to_tensor(obs)
+            probs = policy.get_distribution(tensor).distribution.probs[0].cpu().numpy()
+        if self.deterministic:
+            return int(np.argmax(probs))
+        probs = probs.astype(np.float64)
+        return int(self.rng.choice(len(probs), p=probs / probs.sum()))
+
+    def _on_reset(self, view: RobotView) -> None:
+        if self.waypoints is not None:
+            self.driver = WaypointDriver(**self.waypoints)
+        self.goals: list[tuple[float, float]] = []
+        self._obs_checked = False
+
+    def _check_obs(self, obs: Any) -> None:
+        """The env's observations must be those the policy was trained on."""
+        trained = self.model.observation_space.spaces
+        differ = {
+            k: v.shape
+            for k, v in trained.items()
+            if k != "blocks" and np.shape(obs.get(k)) != v.shape
+        }
+        if differ:
+            got = {k: np.shape(obs.get(k)) for k in differ}
+            raise ConfigError(
+                f"WaypointPPOAgent: the policy in {self.path} was trained on observations "
+                f"{differ}; this env gives {got} (map_px, crop_px and n_routers must match)"
+            )
+        self._obs_checked = True
+
+    def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
+        if not isinstance(obs, dict):
+            raise ConfigError("WaypointPPOAgent.act(obs) needs the env's (Dict) observation")
+        if not self._obs_checked:
+            self._check_obs(obs)
+        if self.waypoints is None:
+            action, _ = self.model.predict(obs, deterministic=self.deterministic)
+            linear, angular = np.clip(np.asarray(action, np.float64).ravel()[:2], -1.0, 1.0)
+            return float(linear), float(angular)
+        command = self.driver.command(view.odometry_pose, view.bumped)
+        if command is None:  # the waypoint is over: the policy names the next one
+            if "blocks" in self.model.observation_space.spaces:  # as WaypointWrapper adds it
+                blocks = block_features(
+                    view.belief_u8, view.grid, view.odometry_pose, self.driver.grid_cells
+                )
+                obs = {**obs, "blocks": blocks}
+            self.driver.start(view, self._choose(obs))
+            self.goals.append((float(self.driver.goal[0]), float(self.driver.goal[1])))
+            command = self.driver.command(view.odometry_pose, False)
+        return command if command is not None else (0.0, 0.0)
