@@ -22,16 +22,52 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
 from sfw_gym.core.config import check
 from sfw_gym.core.errors import ConfigError
+from sfw_gym.navigation.candidates import FEATURES, CandidateGoals
 from sfw_gym.navigation.view import RobotView
 
 #: Why an exploring agent stopped looking for goals.
 STOP_REASONS = ("no_frontiers", "all_blacklisted", "max_steps")
+
+
+@dataclass(frozen=True)
+class Decision:
+    """One choice of a goal among the candidate menu, as every menu-choosing agent (frontier,
+    greedy, the learned explorer) logs it in :attr:`Agent.decisions`.
+
+    Attributes:
+        step: The agent's step count when it chose.
+        target_rc: The chosen candidate's target cell.
+        n_candidates: How many candidates the menu held.
+        features: The chosen candidate's :data:`~sfw_gym.navigation.candidates.FEATURES`
+            (NaN where that agent's menu does not compute one).
+    """
+
+    step: int
+    target_rc: tuple[int, int]
+    n_candidates: int
+    features: np.ndarray
+
+
+def decision_arrays(decisions: list[Decision]) -> dict[str, np.ndarray]:
+    """A decision log as arrays (for an episode's ``.npz``): ``decision_step`` ``(N,)``,
+    ``decision_target_rc`` ``(N, 2)``, ``decision_n_candidates`` ``(N,)``,
+    ``decision_features`` ``(N, F)`` and ``decision_feature_names`` ``(F,)``."""
+    return {
+        "decision_step": np.array([d.step for d in decisions], np.int64),
+        "decision_target_rc": np.array([d.target_rc for d in decisions], np.int64).reshape(-1, 2),
+        "decision_n_candidates": np.array([d.n_candidates for d in decisions], np.int64),
+        "decision_features": np.array([d.features for d in decisions], np.float64).reshape(
+            -1, len(FEATURES)
+        ),
+        "decision_feature_names": np.array(FEATURES),
+    }
 
 
 class RobotViewHandle:
@@ -82,6 +118,8 @@ class Agent(ABC):
             meanwhile (they fall back to sweeping), so an episode never stalls; the reason is
             cleared when a goal turns up again (``max_steps`` is final).
         steps: Actions taken since :meth:`reset`.
+        decisions: This episode's choices among the candidate menu (:class:`Decision`; empty
+            for agents that choose no menu goals).
     """
 
     name: ClassVar[str] = "agent"
@@ -96,6 +134,7 @@ class Agent(ABC):
         self.action_type = "continuous"
         self.trajectory: list[tuple[float, float]] = []
         self.last_command = (0.0, 0.0)
+        self.decisions: list[Decision] = []
 
     def reset(self, env: Any, seed: int | None = None) -> None:
         """Bind the agent to ``env``'s current episode (call after ``env.reset``).
@@ -117,6 +156,7 @@ class Agent(ABC):
         self.steps = 0
         self.trajectory = []
         self.last_command = (0.0, 0.0)
+        self.decisions = []
         self._on_reset(view)
 
     def act(self, obs: Any = None) -> Any:
@@ -156,6 +196,11 @@ class Agent(ABC):
     @abstractmethod
     def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
         """``(linear, angular)`` fractions in [-1, 1] for this step."""
+
+    def _log_decision(self, menu: CandidateGoals, i: int) -> None:
+        """Log the choice of candidate ``i`` of ``menu`` (:attr:`decisions`)."""
+        target = (int(menu.target_rc[i, 0]), int(menu.target_rc[i, 1]))
+        self.decisions.append(Decision(self.steps, target, len(menu), menu.features[i].copy()))
 
     def _stop(self, reason: str) -> None:
         """Record why the agent has no goal now (``max_steps`` is final)."""

@@ -525,6 +525,7 @@ class FrontierAgent(Agent):
             self._stop("all_blacklisted")
             return None
         best = int(ok[np.argmax(u)])  # the first of equal utilities
+        self._log_decision(menu, best)
         self._resume()
         target = (int(menu.target_rc[best, 0]), int(menu.target_rc[best, 1]))
         return Goal((int(menu.goal_rc[best, 0]), int(menu.goal_rc[best, 1])), target, "frontier")

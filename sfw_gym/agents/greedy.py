@@ -88,6 +88,7 @@ class GreedyInfoGainAgent(FrontierAgent):
             for (r, c), s in zip(menu.target_rc.tolist(), score.tolist(), strict=True)
         ]
         i = int(np.argmax(score))
+        self._log_decision(menu, i)
         self._resume()
         target = (int(menu.target_rc[i, 0]), int(menu.target_rc[i, 1]))
         return Goal((int(menu.goal_rc[i, 0]), int(menu.goal_rc[i, 1])), target, "frontier")

@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from sfw_gym.agents.base import decision_arrays
 from sfw_gym.core.atomic import atomic_path, write_text_atomic
 from sfw_gym.core.constants import U8_FREE
 from sfw_gym.core.errors import ConfigError
@@ -57,7 +58,8 @@ class EpisodeSpec:
         agent_params: Agent constructor parameters.
         curve_every: Record coverage / IoU / path length every this many steps.
         gif_path: Write a GIF of the episode here (None: no GIF).
-        npz_path: Write the final belief, truth and trajectory here (None: not).
+        npz_path: Write the final belief, truth, trajectory and the agent's decision log
+            (:func:`~sfw_gym.agents.base.decision_arrays`) here (None: not).
         band_m: Half-width of the zone-border bands of the band metric.
     """
 
@@ -173,6 +175,7 @@ def run_episode(spec: EpisodeSpec) -> dict[str, Any]:
         "stop_reason": reason,
         "wall_s": time.perf_counter() - start,
         "agent_params": agent.params(),
+        "decisions": len(agent.decisions),
         "curve": [list(map(_py, c)) for c in curve],
         **{k: _py(v) for k, v in summary.items()},
     }
@@ -185,6 +188,7 @@ def run_episode(spec: EpisodeSpec) -> dict[str, Any]:
             routers=np.asarray(gt.radio.routers),
             origin=np.asarray(gt.grid.origin_xy),
             resolution=np.asarray(gt.grid.resolution_m),
+            **decision_arrays(agent.decisions),
         )
     if spec.gif_path:
         _write_gif(Path(spec.gif_path), frames, fps=env.metadata.get("render_fps", 10))

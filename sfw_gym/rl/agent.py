@@ -97,6 +97,8 @@ class PPOAgent(Agent):
             menu, extra = menu_observation(self.finder, view, k)
             mask = action_masks(menu, k) if self.use_masking else np.ones(k, np.bool_)
             choice = self._choose({**obs, **extra}, mask)
+            if choice < len(menu):
+                self._log_decision(menu, choice)
             self.driver.start(view, menu, choice)
             self.n_decisions += 1
             command = self.driver.command(view)

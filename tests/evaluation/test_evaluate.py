@@ -72,6 +72,25 @@ def test_tiny_run_writes_table_curves_and_trajectories(tmp_path):
     )
 
 
+def test_menu_choosing_agents_report_through_one_decision_log(tmp_path):
+    kwargs = {**TINY, "env_kwargs": {"max_steps": 150}}
+    result = ev.evaluate(["frontier", "greedy", "random"], 1, seed=5, out=tmp_path, **kwargs)
+    by_agent = {r["agent"]: r for r in result["records"]}
+    computed = {"frontier": "heading_change_rad", "greedy": "expected_gain_bits"}
+    for name, feature in computed.items():
+        log = np.load(tmp_path / "episodes" / f"{name}_0000.npz")
+        steps, names = log["decision_step"], list(log["decision_feature_names"])
+        assert by_agent[name]["decisions"] == len(steps) > 0, name
+        assert np.all(np.diff(steps) > 0) and steps[-1] < 150
+        features = log["decision_features"]
+        assert features.shape == (len(steps), len(names))
+        assert np.isfinite(features[:, names.index("path_cost_m")]).all()
+        assert np.isfinite(features[:, names.index(feature)]).all()
+        rc, shape = log["decision_target_rc"], log["belief"].shape
+        assert ((rc >= 0) & (rc < shape)).all()
+    assert by_agent["random"]["decisions"] == 0
+
+
 def test_interrupted_run_resumes_without_redoing_episodes(tmp_path, monkeypatch):
     real = ev.run_episode
     calls: list[str] = []

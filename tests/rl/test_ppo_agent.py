@@ -45,6 +45,10 @@ def test_the_agent_drives_the_explore_env_as_the_goals_env_does(model_dir):
         obs, _, _, _, info = explore.step(agent.act(obs))
     assert agent.n_decisions == 12
     np.testing.assert_array_equal(info["true_pose"], pose)
+    # every valid choice is logged, with its menu's features (all of them computed)
+    assert 0 < len(agent.decisions) <= 12
+    assert agent.decisions[-1].target_rc == agent.driver.target
+    assert all(np.isfinite(d.features).all() for d in agent.decisions)
 
 
 def test_a_missing_model_is_named(tmp_path):
