@@ -40,18 +40,28 @@ def register_agent(name: str, entry_point: str) -> None:
 
 
 def agent_class(name: str) -> type[Agent]:
-    """The class registered as ``name``."""
-    if name not in AGENTS:
-        raise ConfigError(f"unknown agent {name!r}; known: {sorted(AGENTS)}")
-    module, _, cls = AGENTS[name].partition(":")
+    """The class registered as ``name``, or named by a ``"module:Class"`` entry point (which
+    also reaches the evaluation's worker processes, where a :func:`register_agent` call made in
+    the parent is unknown)."""
+    entry_point = AGENTS.get(name) or (name if ":" in name else None)
+    if entry_point is None:
+        raise ConfigError(
+            f"unknown agent {name!r}; known: {sorted(AGENTS)} or a 'module:Class' of your own"
+        )
+    module, _, cls = entry_point.partition(":")
     try:
-        return getattr(importlib.import_module(module), cls)
+        found = getattr(importlib.import_module(module), cls)
     except ImportError as exc:
         raise ConfigError(
             f"agent {name!r} needs {exc.name!r}: pip install 'sfw-gym[rl]'"
             if exc.name in ("torch", "stable_baselines3", "sb3_contrib")
-            else f"agent {name!r}: cannot import {AGENTS[name]} ({exc})"
+            else f"agent {name!r}: cannot import {entry_point} ({exc})"
         ) from None
+    except AttributeError:
+        raise ConfigError(f"agent {name!r}: module {module!r} has no {cls!r}") from None
+    if not (isinstance(found, type) and issubclass(found, Agent)):
+        raise ConfigError(f"agent {name!r}: {entry_point} is not an sfw_gym Agent subclass")
+    return found
 
 
 def make_agent(name: str, **params: Any) -> Agent:

@@ -318,14 +318,19 @@ def evaluate(
     """
     import gymnasium as gym
 
-    from sfw_gym.agents import AGENTS, make_agent
+    from sfw_gym.agents import AGENTS, agent_class, make_agent
 
     agents = list(dict.fromkeys(agents))
     if not agents:
         raise ConfigError("--agents: give at least one agent")
-    unknown = [a for a in agents if a not in AGENTS]
+    unknown = [a for a in agents if a not in AGENTS and ":" not in a]
     if unknown:
-        raise ConfigError(f"--agents: unknown agent(s) {unknown}; known: {sorted(AGENTS)}")
+        raise ConfigError(
+            f"--agents: unknown agent(s) {unknown}; known: {sorted(AGENTS)} or a "
+            "'module:Class' of your own"
+        )
+    for name in agents:
+        agent_class(name)  # an entry point of one's own must import, in this process too
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ConfigError(f"--episodes must be an int >= 1, got {episodes!r}")
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:

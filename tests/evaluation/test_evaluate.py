@@ -12,6 +12,7 @@ import pytest
 
 import sfw_gym  # noqa: F401
 from sfw_gym import evaluation as ev
+from sfw_gym.agents import Agent
 from sfw_gym.cli import main
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.evaluation import runner
@@ -89,6 +90,25 @@ def test_menu_choosing_agents_report_through_one_decision_log(tmp_path):
         rc, shape = log["decision_target_rc"], log["belief"].shape
         assert ((rc >= 0) & (rc < shape)).all()
     assert by_agent["random"]["decisions"] == 0
+
+
+class StraightAgent(Agent):
+    """An agent of one's own, named by its entry point (not registered)."""
+
+    name = "straight"
+
+    def _act(self, view, obs):
+        return 1.0, 0.0
+
+
+def test_an_agent_of_ones_own_runs_in_the_workers_by_its_entry_point(tmp_path):
+    entry = f"{__name__}:StraightAgent"
+    result = ev.evaluate(["random", entry], 2, seed=5, out=tmp_path, **{**TINY, "workers": 2})
+    assert sorted({r["agent"] for r in result["records"]}) == sorted(["random", entry])
+    with pytest.raises(ConfigError, match="has no 'Nope'"):
+        ev.evaluate([f"{__name__}:Nope"], 1, out=tmp_path / "x", **TINY)
+    with pytest.raises(ConfigError, match="is not an sfw_gym Agent subclass"):
+        ev.evaluate([f"{__name__}:TINY"], 1, out=tmp_path / "y", **TINY)
 
 
 def test_interrupted_run_resumes_without_redoing_episodes(tmp_path, monkeypatch):
