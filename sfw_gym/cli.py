@@ -98,10 +98,10 @@ def _cmd_map(args: argparse.Namespace) -> int:
     result = map_log(
         args.log,
         routers,
-        scale_m_per_unit=args.scale,
+        scale_m_per_unit=1.0 / args.px_per_m if args.px_per_m else (args.scale or 1.0),
         resolution_m=args.resolution,
         margin_m=args.margin,
-        band=args.band,
+        rssi_column=args.rssi_column,
         config=MapperConfig(router_policy=args.policy),
     )
     paths = write_map(result, args.out, y_down=args.y_down)
@@ -270,11 +270,18 @@ def build_parser() -> argparse.ArgumentParser:
     mp.add_argument(
         "--routers", required=True, help="router positions 'x1,y1;x2,y2' in the CSV's units"
     )
-    mp.add_argument(
+    units = mp.add_mutually_exclusive_group()
+    units.add_argument(
         "--scale",
         type=positive_float,
-        default=1.0,
+        default=None,
         help="metres per CSV unit (default 1; pixels e.g. 0.05)",
+    )
+    units.add_argument(
+        "--px-per-m",
+        type=positive_float,
+        default=None,
+        help="CSV units (canvas pixels) per metre: the SfW logs' about 87 (0.0115 m per pixel)",
     )
     mp.add_argument(
         "--resolution",
@@ -289,10 +296,11 @@ def build_parser() -> argparse.ArgumentParser:
         help="border around the data, metres (default 1)",
     )
     mp.add_argument(
-        "--band",
-        choices=["2.4", "5"],
+        "--rssi-column",
         default=None,
-        help="with 2 RSSI columns per router: which band (default 2.4)",
+        metavar="max|2.4|5|NAME[,NAME...]",
+        help="each router's RSSI: its strongest band (max: the default, as the SfW authors "
+        "mapped), one band, or one column name per router",
     )
     mp.add_argument(
         "--policy",

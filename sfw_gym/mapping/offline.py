@@ -1,14 +1,21 @@
 """Offline mapping of a recorded RSSI log (``sfw-gym map``).
 
-A log is a CSV in the layout of the SfW experiments::
+A log is a CSV in the layouts of the SfW experiments' public logs::
 
-    x_pixel,y_pixel,router1_2.4,router1_5,router2_2.4,router2_5,...
+    x_pixel,y_pixel,rssi                                                  (1 router)
+    x_pixel,y_pixel,router1_2.4,router1_5,router2_2.4,router2_5,          (2 routers, 2 bands)
 
-The first two columns are the robot's position (whatever their names), the others RSSI in dBm.
-:func:`read_rssi_log` parses it leniently where the intent is clear and strictly elsewhere:
+The first two columns are the robot's position (whatever their names; canvas pixels in the SfW
+files, about 0.0115 m each), the others RSSI in dBm. The 2-router files end their header with a
+comma and carry a 7th, unnamed value per row: the strongest of the four readings, which is what
+the authors mapped (``rssi_column="max"``, the default: each router's strongest band; the
+mapper's focused router is then the strongest of those). :func:`read_rssi_log` parses a log
+leniently where the intent is clear and strictly elsewhere, streaming the file:
 
 - a UTF-8 BOM, blank lines, whitespace around cells and quoted cells are accepted;
 - a trailing comma (an empty last header cell and/or an empty last cell on data rows) is dropped;
+- an unnamed last column with values is the SfW files' strongest reading when it equals the row's
+  maximum (``RssiLog.strongest_dbm``), else an RSSI column of its own;
 - an empty RSSI cell (or ``nan``/``NA``/``null``) means "not heard" and becomes -100 dBm;
 - a row whose position is empty or NaN is skipped and counted;
 - a file without a header (first row all numbers) is read as data, columns named ``column<i>``;
@@ -25,6 +32,7 @@ atomically (temp file + rename).
 from __future__ import annotations
 
 import csv
+import itertools
 import json
 import math
 import os
@@ -45,6 +53,7 @@ from sfw_gym.mapping import GridSpec, MapperConfig, SparseInverseKVisibility
 BANDS = ("2.4", "5")
 PROGRESS_MIN_ROWS = 5000
 MAX_GRID_CELLS = 16_000_000
+_CHUNK_ROWS = 65_536
 _MISSING = frozenset({"", "nan", "na", "n/a", "null", "none"})
 _BAND_PATTERNS = {
     "2.4": re.compile(r"(?:^|[^0-9.])2[._]?4\s*(?:g|ghz)?$", re.IGNORECASE),
@@ -64,6 +73,8 @@ class RssiLog:
         rssi_dbm: ``(N, C)`` float64 RSSI; -100 where a cell was empty ("not heard").
         line_numbers: ``(N,)`` line of each kept row in the file (1-based).
         skipped_lines: Lines of rows skipped for a missing/NaN position.
+        strongest_dbm: ``(N,)`` the unnamed last column of the SfW 2-router files, the strongest
+            of the row's RSSI cells (what the authors mapped), or None.
     """
 
     path: Path
@@ -73,6 +84,7 @@ class RssiLog:
     rssi_dbm: np.ndarray
     line_numbers: np.ndarray
     skipped_lines: tuple[int, ...]
+    strongest_dbm: np.ndarray | None = None
 
     @property
     def n_samples(self) -> int:
@@ -146,6 +158,9 @@ def _is_number(text: str) -> bool:
 def read_rssi_log(path: str | os.PathLike[str]) -> RssiLog:
     """Read an RSSI log in the SfW CSV layout (see the module docstring for the rules).
 
+    The file is streamed: rows are parsed into float arrays chunk by chunk, so memory grows with
+    the numbers (about 8 bytes per cell), not with the text.
+
     Args:
         path: The CSV file.
 
@@ -160,7 +175,7 @@ def read_rssi_log(path: str | os.PathLike[str]) -> RssiLog:
     path = Path(path)
     try:
         with open(path, encoding="utf-8-sig", newline="") as fh:
-            rows = list(_numbered_rows(fh))
+            return _parse_rows(path, _numbered_rows(fh))
     except FileNotFoundError:
         raise ConfigError(f"{path}: no such file") from None
     except IsADirectoryError:
@@ -171,34 +186,43 @@ def read_rssi_log(path: str | os.PathLike[str]) -> RssiLog:
         raise ConfigError(f"{path}: malformed CSV: {exc}") from None
     except OSError as exc:
         raise ConfigError(f"{path}: cannot read: {exc.strerror or exc}") from None
-    if not rows:
-        raise ConfigError(f"{path}: empty file (expected a header 'x,y,rssi1,...' and data rows)")
 
-    first_line, first = rows[0]
+
+def _parse_rows(path: Path, rows: Iterator[tuple[int, list[str]]]) -> RssiLog:
+    first_row = next(rows, None)
+    if first_row is None:
+        raise ConfigError(f"{path}: empty file (expected a header 'x,y,rssi1,...' and data rows)")
+    first_line, first = first_row
     header_row = not all(_is_number(c) for c in first if c.strip())
+    # A trailing empty header cell: a trailing comma, or (the SfW 2-router files) an unnamed
+    # last column whose cells hold a value
+    unnamed_last = len(first) > 1 and not first[-1].strip()
     if header_row:
         names = [c.strip() for c in first]
-        if len(names) > 1 and names[-1] == "":
-            names.pop()  # trailing comma
+        if unnamed_last:
+            names.pop()
         names = [n or f"column{j + 1}" for j, n in enumerate(names)]
-        data = rows[1:]
+        data: Iterator[tuple[int, list[str]]] = rows
     else:
-        width = len(first) - (1 if len(first) > 1 and not first[-1].strip() else 0)
-        names = [f"column{j + 1}" for j in range(width)]
-        data = rows
+        names = [f"column{j + 1}" for j in range(len(first) - unnamed_last)]
+        data = itertools.chain([first_row], rows)
     n_cols = len(names)
     if n_cols < 3:
         raise ConfigError(
             f"{path}:{first_line}: need at least 3 columns (x, y and one RSSI column per "
             f"router), got {n_cols}: {names}"
         )
-    if not data:
-        raise ConfigError(f"{path}: no data rows after the header on line {first_line}")
-
-    values = np.empty((len(data), n_cols), np.float64)
-    lines = np.empty(len(data), np.int64)
-    for n, (line, row) in enumerate(data):
-        if len(row) == n_cols + 1 and not row[-1].strip():
+    chunks, line_chunks, extra_chunks = [], [], []
+    values = np.empty((_CHUNK_ROWS, n_cols), np.float64)
+    lines = np.empty(_CHUNK_ROWS, np.int64)
+    extra = np.full(_CHUNK_ROWS, math.nan)  # the unnamed last column's values
+    n = 0
+    for line, row in data:
+        if len(row) == n_cols + 1 and unnamed_last:
+            last, row = row[-1].strip(), row[:-1]
+            if last:
+                extra[n] = _cell_value(last, f"{path}:{line}", "(unnamed last column)")
+        elif len(row) == n_cols + 1 and not row[-1].strip():
             row = row[:-1]  # trailing comma
         if len(row) != n_cols:
             raise ConfigError(
@@ -218,23 +242,45 @@ def read_rssi_log(path: str | os.PathLike[str]) -> RssiLog:
                     _cell_value(c, f"{path}:{line}", name)
                     for c, name in zip(row, names, strict=True)
                 ]
+        n += 1
+        if n == _CHUNK_ROWS:
+            chunks.append(values), line_chunks.append(lines), extra_chunks.append(extra)
+            values, lines = np.empty_like(values), np.empty_like(lines)
+            extra, n = np.full(_CHUNK_ROWS, math.nan), 0
+    chunks.append(values[:n]), line_chunks.append(lines[:n]), extra_chunks.append(extra[:n])
+    all_values, all_lines = np.concatenate(chunks), np.concatenate(line_chunks)
+    all_extra = np.concatenate(extra_chunks)
+    del chunks, line_chunks, extra_chunks
+    if not len(all_values):
+        raise ConfigError(f"{path}: no data rows after the header on line {first_line}")
 
-    keep = np.isfinite(values[:, :2]).all(axis=1)
-    skipped = tuple(int(v) for v in lines[~keep])
+    keep = np.isfinite(all_values[:, :2]).all(axis=1)
+    skipped = tuple(int(v) for v in all_lines[~keep])
     if not keep.any():
         raise ConfigError(
             f"{path}: no row has a position ({len(skipped)} data rows, all with a missing x or y)"
         )
-    rssi = values[keep, 2:]
+    rssi = all_values[keep, 2:]
     rssi[np.isnan(rssi)] = NOT_HEARD_DBM
+    rssi_names = tuple(names[2:])
+    strongest = None
+    last = all_extra[keep]
+    if np.isfinite(last).any():
+        heard = np.where(np.isnan(last), NOT_HEARD_DBM, last)
+        if np.abs(heard - rssi.max(axis=1)).max() <= 0.5:  # the SfW files' strongest reading
+            strongest = heard
+        else:  # a column of its own, only unnamed
+            rssi = np.column_stack([rssi, heard])
+            rssi_names += (f"column{n_cols + 1}",)
     return RssiLog(
         path=path,
         position_names=(names[0], names[1]),
-        rssi_names=tuple(names[2:]),
-        positions=values[keep, :2],
+        rssi_names=rssi_names,
+        positions=all_values[keep, :2],
         rssi_dbm=rssi,
-        line_numbers=lines[keep],
+        line_numbers=all_lines[keep],
         skipped_lines=skipped,
+        strongest_dbm=strongest,
     )
 
 
@@ -300,6 +346,41 @@ def select_router_columns(log: RssiLog, n_routers: int, band: str | None = None)
     )
 
 
+def router_column_groups(
+    log: RssiLog, n_routers: int, rssi_column: str | None = None
+) -> list[list[int]]:
+    """Per router, the RSSI columns (indices into ``log.rssi_names``) whose strongest reading is
+    that router's RSSI.
+
+    Args:
+        log: The parsed log.
+        n_routers: R, the number of router positions given.
+        rssi_column: ``"max"`` (each router's strongest band: what the SfW authors mapped, and
+            the default), ``"2.4"`` or ``"5"`` (one band, :func:`select_router_columns`), or
+            R comma-separated column names in router order.
+
+    Raises:
+        ConfigError: Naming the columns found and the choices known.
+    """
+    if rssi_column in (None, "max"):
+        if len(log.rssi_names) == n_routers:
+            return [[j] for j in range(n_routers)]
+        bands = [select_router_columns(log, n_routers, band) for band in BANDS]
+        return [list(pair) for pair in zip(*bands, strict=True)]
+    if rssi_column in BANDS:
+        return [[j] for j in select_router_columns(log, n_routers, rssi_column)]
+    wanted = [name.strip() for name in rssi_column.split(",")]
+    unknown = [name for name in wanted if name not in log.rssi_names]
+    if unknown or len(wanted) != n_routers:
+        problem = f"no column {unknown}" if unknown else f"{len(wanted)} names"
+        raise ConfigError(
+            f"{log.path}: --rssi-column {rssi_column!r}: {problem}; give 'max', a band "
+            f"({', '.join(BANDS)}) or {n_routers} of the RSSI columns "
+            f"({', '.join(log.rssi_names)}), one per router"
+        )
+    return [[log.rssi_names.index(name)] for name in wanted]
+
+
 # -- mapping --------------------------------------------------------------------------------------
 def map_log(
     log: RssiLog | str | os.PathLike[str],
@@ -308,7 +389,7 @@ def map_log(
     scale_m_per_unit: float = 1.0,
     resolution_m: float = 0.05,
     margin_m: float = 1.0,
-    band: str | None = None,
+    rssi_column: str | None = None,
     config: MapperConfig | None = None,
     progress: bool | None = None,
     max_cells: int = MAX_GRID_CELLS,
@@ -321,7 +402,8 @@ def map_log(
         scale_m_per_unit: Metres per CSV unit, for positions and routers (e.g. 0.05 for pixels).
         resolution_m: Map cell size, metres.
         margin_m: Border around the bounding box of the trajectory and routers, metres.
-        band: ``"2.4"`` or ``"5"`` when the log has two columns per router (default 2.4).
+        rssi_column: Which RSSI feeds each router (:func:`router_column_groups`; default
+            ``"max"``: its strongest band, as the SfW authors mapped).
         config: Mapper configuration (default :class:`MapperConfig`).
         progress: Show a tqdm bar on stderr; None = only for logs over 5,000 rows.
         max_cells: Refuse grids larger than this (a forgotten ``--scale`` on a pixel log).
@@ -345,10 +427,10 @@ def map_log(
         raise ConfigError(f"routers_xy must have shape (R, 2) with R >= 1, got {routers.shape}")
     if not np.isfinite(routers).all():
         raise ConfigError(f"routers_xy must be finite, got {routers.tolist()}")
-    cols = select_router_columns(log, len(routers), band)
+    groups = router_column_groups(log, len(routers), rssi_column)
     positions_m = log.positions * scale_m_per_unit
     routers_m = routers * scale_m_per_unit
-    rssi = np.ascontiguousarray(log.rssi_dbm[:, cols])
+    rssi = np.column_stack([log.rssi_dbm[:, g].max(axis=1) for g in groups])
 
     pts = np.concatenate([positions_m, routers_m])
     # At least one cell of margin: the mapper needs positions strictly inside the grid.
@@ -391,10 +473,15 @@ def map_log(
         grid=grid,
         positions_m=positions_m,
         routers_m=routers_m,
-        columns=tuple(log.rssi_names[j] for j in cols),
+        columns=tuple(_column_label(log, g) for g in groups),
         scale_m_per_unit=float(scale_m_per_unit),
         update_us=times * 1e6,
     )
+
+
+def _column_label(log: RssiLog, group: list[int]) -> str:
+    names = [log.rssi_names[j] for j in group]
+    return names[0] if len(names) == 1 else f"max({', '.join(names)})"
 
 
 def _warm_up(config: MapperConfig) -> None:

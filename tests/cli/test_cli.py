@@ -117,7 +117,8 @@ CASES = [
     bad([*MAP, "--routers", "2"], r"--routers: .*not a count", id="map-routers-count"),
     bad([*MAP, "--routers", "1,nan"], r"--routers: .*'1,nan'", id="map-routers-nan"),
     bad([*MAP, "--routers", "1,1;2,2"], r"2 router positions given", id="map-routers-too-many"),
-    bad([*MAP, "--band", "7"], r"argument --band: invalid choice", id="map-band-unknown"),
+    bad([*MAP, "--rssi-column", "7"], r"--rssi-column '7': no column", id="map-column-unknown"),
+    bad([*MAP, "--scale", "1", "--px-per-m", "87"], r"not allowed with", id="map-two-units"),
     bad([*MAP, "--policy", "nope"], r"argument --policy: invalid choice", id="map-policy-unknown"),
     bad([*MAP, "--out", "{tmp}/m.jpg"], r"--out must be a \.png", id="map-out-not-png"),
     # -- bench

@@ -101,13 +101,14 @@ def test_log_parsed_with_bom_trailing_comma_and_gaps(two_room_log, mapped):
     np.testing.assert_allclose(log.positions * PX, two_room_log["traj"], atol=1e-4)
     np.testing.assert_array_equal(log.rssi_dbm[:, 0], two_room_log["r24"])
     np.testing.assert_array_equal(log.rssi_dbm[:, 1], two_room_log["r5"])
-    assert mapped.columns == ("router1_2.4",)
+    assert mapped.columns == ("max(router1_2.4, router1_5)",)  # the authors' choice
     assert mapped.log.line_numbers[0] == 2
 
 
 def test_map_equals_the_mapper_run_directly(mapped, two_room_log):
     direct = SparseInverseKVisibility(mapped.grid, mapped.routers_m)
-    for p, r in zip(mapped.log.positions * PX, two_room_log["r24"], strict=True):
+    strongest = np.maximum(two_room_log["r24"], two_room_log["r5"])
+    for p, r in zip(mapped.log.positions * PX, strongest, strict=True):
         direct.update(p, np.array([r]))
     np.testing.assert_array_equal(mapped.mapper.occupancy_u8, direct.occupancy_u8)
     np.testing.assert_allclose(mapped.routers_m, [ROUTER_M])
@@ -129,11 +130,17 @@ def test_wall_found_and_visited_cells_free(mapped, two_room_log):
         assert free[room].mean() >= 0.7
 
 
-def test_band_5_uses_the_other_columns(two_room_log):
+def test_one_band_or_named_columns_on_request(two_room_log):
     router = [np.asarray(ROUTER_M) / PX]
-    res = map_log(two_room_log["path"], router, scale_m_per_unit=PX, band="5", progress=True)
+    path = two_room_log["path"]
+    res = map_log(path, router, scale_m_per_unit=PX, rssi_column="5", progress=True)
     assert res.columns == ("router1_5",)
     assert res.mapper.n_updates == len(two_room_log["traj"])
+    assert map_log(path, router, scale_m_per_unit=PX, rssi_column="router1_2.4").columns == (
+        "router1_2.4",
+    )
+    with pytest.raises(ConfigError, match=r"--rssi-column 'rssi': no column \['rssi'\]; give"):
+        map_log(path, router, scale_m_per_unit=PX, rssi_column="rssi")
 
 
 def test_write_map_png_npy_json(mapped, tmp_path):
@@ -144,7 +151,7 @@ def test_write_map_png_npy_json(mapped, tmp_path):
     np.testing.assert_array_equal(occ, mapped.mapper.occupancy_u8)
     meta = json.loads(paths["json"].read_text())
     assert meta["shape"] == list(mapped.grid.shape)
-    assert meta["rssi_columns"] == ["router1_2.4"]
+    assert meta["rssi_columns"] == ["max(router1_2.4, router1_5)"]
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [
         "map.json",
         "map.npy",
@@ -233,6 +240,84 @@ def test_bad_files_and_arguments(tmp_path):
     res = map_log(log, [[10, 10]], scale_m_per_unit=0.01)
     with pytest.raises(ConfigError, match=r"--out must be a \.png"):
         write_map(res, tmp_path / "map.jpg")
+
+
+@pytest.fixture(scope="module")
+def sfw_two_router_log(tmp_path_factory):
+    """A log in the SfW paper's public 2-router layout, written here: a BOM, the header
+    ``x_pixel,y_pixel,router1_2.4,router1_5,router2_2.4,router2_5,`` (trailing comma) and a 7th,
+    unnamed value per row, the strongest of the four; positions in canvas pixels."""
+    rng = np.random.default_rng(1)
+    traj = survey()
+    second = (5.0, 1.0)
+    r1 = [rssi_at(traj, rng), rssi_at(traj, rng, offset_db=-7.0)]
+    d2 = np.maximum(np.hypot(*(traj - np.asarray(second)).T), 0.1)
+    r2 = [
+        np.round(K0_DBM + off - 20 * np.log10(d2) + rng.normal(0, 2, len(traj))) for off in (0, -7)
+    ]
+    cells = np.column_stack([traj / SFW_PX_M, r1[0], r1[1], r2[0], r2[1]])
+    strongest = cells[:, 2:].max(axis=1)
+    lines = ["x_pixel,y_pixel,router1_2.4,router1_5,router2_2.4,router2_5,"]
+    lines += [
+        f"{x:.1f},{y:.1f},{a:.0f},{b:.0f},{c:.0f},{d:.0f},{m:.0f}"
+        for (x, y, a, b, c, d), m in zip(cells, strongest, strict=True)
+    ]
+    path = tmp_path_factory.mktemp("sfw") / "sfw_2routers.csv"
+    path.write_bytes(b"\xef\xbb\xbf" + "\r\n".join(lines).encode() + b"\r\n")
+    routers_px = np.array([ROUTER_M, second]) / SFW_PX_M
+    return {"path": path, "routers_px": routers_px, "strongest": strongest, "n": len(traj)}
+
+
+SFW_PX_M = 0.0115  # metres per canvas pixel in the SfW buildings
+
+
+def test_the_sfw_two_router_layout_reads_as_it_is(sfw_two_router_log):
+    log = read_rssi_log(sfw_two_router_log["path"])
+    assert log.rssi_names == ("router1_2.4", "router1_5", "router2_2.4", "router2_5")
+    assert log.n_samples == sfw_two_router_log["n"]
+    np.testing.assert_array_equal(log.strongest_dbm, sfw_two_router_log["strongest"])
+    res = map_log(log, sfw_two_router_log["routers_px"], scale_m_per_unit=SFW_PX_M)
+    # each router's strongest band; the strongest router's is the authors' 7th column
+    assert res.columns == ("max(router1_2.4, router1_5)", "max(router2_2.4, router2_5)")
+    per_router = np.column_stack([log.rssi_dbm[:, [0, 1]].max(1), log.rssi_dbm[:, [2, 3]].max(1)])
+    np.testing.assert_array_equal(per_router.max(axis=1), log.strongest_dbm)
+
+
+def test_cli_maps_the_sfw_two_router_layout(sfw_two_router_log, tmp_path, capsys):
+    routers = ";".join(f"{x:.1f},{y:.1f}" for x, y in sfw_two_router_log["routers_px"])
+    argv = ["map", str(sfw_two_router_log["path"]), "--routers", routers]
+    argv += [
+        "--px-per-m",
+        str(1 / SFW_PX_M),
+        "--rssi-column",
+        "max",
+        "--out",
+        str(tmp_path / "m.png"),
+    ]
+    assert main(argv) == 0
+    assert "max(router1_2.4, router1_5), max(router2_2.4, router2_5)" in capsys.readouterr().out
+    assert main([*argv[:-4], "--out", str(tmp_path / "d.png")]) == 0  # max is the default
+    np.testing.assert_array_equal(np.load(tmp_path / "m.npy"), np.load(tmp_path / "d.npy"))
+    one = read_rssi_log(write(tmp_path, "x_pixel,y_pixel,rssi\n10,10,-40\n12,10,-41\n"))
+    assert one.rssi_names == ("rssi",) and one.strongest_dbm is None
+
+
+def test_an_unnamed_last_column_that_is_no_maximum_is_a_column(tmp_path):
+    log = read_rssi_log(write(tmp_path, "x,y,r1,\n0,0,-40,-70\n1,0,-45,-20\n"))
+    assert log.rssi_names == ("r1", "column4") and log.strongest_dbm is None
+    np.testing.assert_array_equal(log.rssi_dbm, [[-40, -70], [-45, -20]])
+
+
+def test_a_long_log_streams_in_chunks(tmp_path, monkeypatch):
+    from sfw_gym.mapping import offline
+
+    monkeypatch.setattr(offline, "_CHUNK_ROWS", 7)
+    rows = "".join(f"{i},{i % 3},{-40 - i % 11}\n" for i in range(50))
+    log = read_rssi_log(write(tmp_path, "x,y,r\n" + rows + ",,-40\n"))
+    assert log.n_samples == 50 and log.skipped_lines == (52,)
+    np.testing.assert_array_equal(log.positions[:, 0], np.arange(50))
+    np.testing.assert_array_equal(log.line_numbers, np.arange(2, 52))
+    np.testing.assert_array_equal(log.rssi_dbm[:, 0], -40 - np.arange(50) % 11)
 
 
 # -- the CLI ---------------------------------------------------------------------------------------
