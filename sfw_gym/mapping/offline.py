@@ -212,7 +212,7 @@ def _parse_rows(path: Path, rows: Iterator[tuple[int, list[str]]]) -> RssiLog:
             f"{path}:{first_line}: need at least 3 columns (x, y and one RSSI column per "
             f"router), got {n_cols}: {names}"
         )
-    chunks, line_chunks, extra_chunks = [], [], []
+    chunks: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
     values = np.empty((_CHUNK_ROWS, n_cols), np.float64)
     lines = np.empty(_CHUNK_ROWS, np.int64)
     extra = np.full(_CHUNK_ROWS, math.nan)  # the unnamed last column's values
@@ -244,13 +244,12 @@ def _parse_rows(path: Path, rows: Iterator[tuple[int, list[str]]]) -> RssiLog:
                 ]
         n += 1
         if n == _CHUNK_ROWS:
-            chunks.append(values), line_chunks.append(lines), extra_chunks.append(extra)
+            chunks.append((values, lines, extra))
             values, lines = np.empty_like(values), np.empty_like(lines)
             extra, n = np.full(_CHUNK_ROWS, math.nan), 0
-    chunks.append(values[:n]), line_chunks.append(lines[:n]), extra_chunks.append(extra[:n])
-    all_values, all_lines = np.concatenate(chunks), np.concatenate(line_chunks)
-    all_extra = np.concatenate(extra_chunks)
-    del chunks, line_chunks, extra_chunks
+    chunks.append((values[:n], lines[:n], extra[:n]))
+    all_values, all_lines, all_extra = (np.concatenate(part) for part in zip(*chunks, strict=True))
+    del chunks
     if not len(all_values):
         raise ConfigError(f"{path}: no data rows after the header on line {first_line}")
 
@@ -264,9 +263,9 @@ def _parse_rows(path: Path, rows: Iterator[tuple[int, list[str]]]) -> RssiLog:
     rssi[np.isnan(rssi)] = NOT_HEARD_DBM
     rssi_names = tuple(names[2:])
     strongest = None
-    last = all_extra[keep]
-    if np.isfinite(last).any():
-        heard = np.where(np.isnan(last), NOT_HEARD_DBM, last)
+    unnamed = all_extra[keep]
+    if np.isfinite(unnamed).any():
+        heard = np.where(np.isnan(unnamed), NOT_HEARD_DBM, unnamed)
         if np.abs(heard - rssi.max(axis=1)).max() <= 0.5:  # the SfW files' strongest reading
             strongest = heard
         else:  # a column of its own, only unnamed
