@@ -5,11 +5,11 @@
 
 from __future__ import annotations
 
-from sfw_gym.core.errors import ConfigError, FloorplanError
+from sfw_gym.core.errors import ConfigError, FloorplanError, SfwGymError
 from sfw_gym.envs import ENV_IDS, register_envs
 
 __version__ = "0.1.0"
 
 register_envs()
 
-__all__ = ["ENV_IDS", "ConfigError", "FloorplanError", "__version__"]
+__all__ = ["ENV_IDS", "ConfigError", "FloorplanError", "SfwGymError", "__version__"]

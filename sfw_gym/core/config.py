@@ -113,6 +113,18 @@ def check(name: str, value: Any, **bounds: Any) -> Any:
     return Range(**bounds).check(name, value)
 
 
+def float_array(name: str, value: Any) -> Any:
+    """``value`` as a float64 numpy array, or a ConfigError naming ``name`` (for values that
+    are no numbers at all: strings, dicts, ragged lists)."""
+    import numpy as np
+
+    try:
+        return np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError):
+        brief = " ".join(repr(value).split())[:80]
+        raise ConfigError(f"{name} must be numbers, got {brief}") from None
+
+
 def unknown_key_error(what: str, key: Any, valid: Iterable[str]) -> ConfigError:
     """``ConfigError`` for an unknown key, naming the nearest valid one."""
     valid = sorted(valid)

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 
+from sfw_gym.core.config import float_array
 from sfw_gym.core.constants import U8_FREE
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.mapping import GridSpec
@@ -91,7 +92,7 @@ def build_scene(
         if not 1 <= routers <= max_routers:
             raise ConfigError(f"routers: a count must be in [1, {max_routers}], got {routers}")
         routers = place_routers(plan, int(routers), rng)
-    routers = np.asarray(routers, dtype=np.float64)
+    routers = float_array("routers", routers)
     if routers.ndim == 2 and len(routers) > max_routers:
         raise ConfigError(
             f"routers: {len(routers)} positions given, the env was made for at most {max_routers} "
@@ -113,7 +114,7 @@ def _start_pose(
     rng: np.random.Generator,
 ) -> tuple[float, float, float]:
     if start_pose is not None:
-        pose = np.asarray(start_pose, dtype=np.float64)
+        pose = float_array("start_pose", start_pose)
         if pose.shape != (3,) or not np.isfinite(pose).all():
             raise ConfigError(
                 f"start_pose must be three finite numbers (x, y, θ), got {start_pose!r}"

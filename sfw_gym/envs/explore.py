@@ -263,20 +263,31 @@ class SfWExploreEnv(gym.Env):
 
     def _command(self, action: Any) -> tuple[float, float]:
         cfg = self.robot_config
+        brief = " ".join(repr(action).split())[:80]  # one line, however big the action
         if self.action_type == "discrete":
-            a = np.asarray(action)
+            try:
+                a = np.asarray(action)
+            except (TypeError, ValueError):  # ragged lists
+                a = np.asarray(None)
             if a.shape != () or a.dtype.kind not in "iu" or not 0 <= int(a) < len(DISCRETE_ACTIONS):
-                raise ValueError(
+                raise ConfigError(
                     f"action must be an integer in [0, {len(DISCRETE_ACTIONS)}) "
-                    f"({', '.join(DISCRETE_ACTION_NAMES)}), got {action!r}"
+                    f"({', '.join(DISCRETE_ACTION_NAMES)}), got {brief}"
                 )
             lin, ang = DISCRETE_ACTIONS[int(a)]
         else:
-            a = np.asarray(action, dtype=np.float64)
+            try:
+                a = np.asarray(action, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise ConfigError(
+                    f"action must be 2 numbers (linear, angular), got {brief}"
+                ) from None
             if a.shape != (2,):
-                raise ValueError(f"action must have shape (2,) = (linear, angular), got {a.shape}")
+                raise ConfigError(
+                    f"action must have shape (2,) = (linear, angular), got shape {a.shape}: {brief}"
+                )
             if not np.isfinite(a).all():
-                raise ValueError(f"action must be finite, got {a.tolist()}")
+                raise ConfigError(f"action must be finite, got {a.tolist()}")
             lin, ang = min(max(a[0], -1.0), 1.0), min(max(a[1], -1.0), 1.0)
         return float(lin) * cfg.max_linear_speed_m_s, float(ang) * cfg.max_angular_speed_rad_s
 

@@ -19,6 +19,7 @@ from gymnasium import spaces
 
 from sfw_gym.core.config import Config, setting
 from sfw_gym.core.constants import NOT_HEARD_DBM
+from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.explore import SfWExploreEnv
 from sfw_gym.navigation.candidates import FEATURES, CandidateGoals, GoalFinder
 from sfw_gym.navigation.goal_driver import GoalDriver
@@ -113,7 +114,7 @@ class SfWGoalsEnv(gym.Env):
         a = np.asarray(action)
         k = self.config.max_candidates
         if a.shape != () or a.dtype.kind not in "iu" or not 0 <= int(a) < k:
-            raise ValueError(f"goal action must be an integer in [0, {k}), got {action!r}")
+            raise ConfigError(f"goal action must be an integer in [0, {k}), got {action!r}")
         cfg = self.config
         start_path, start_steps = self.explore.path_length_m, self.explore.steps
         view = self.explore.robot_view()

@@ -75,7 +75,7 @@ class WaypointWrapper(gym.Wrapper):
         """Plan to waypoint ``action`` and drive there (see the class doc)."""
         a = np.asarray(action)
         if a.shape != () or a.dtype.kind not in "iu" or not 0 <= int(a) < self.n_waypoints:
-            raise ValueError(
+            raise ConfigError(
                 f"waypoint action must be an integer in [0, {self.n_waypoints}), got {action!r}"
             )
         view = self._robot_view()

@@ -28,6 +28,8 @@ EXTERIOR_WALL_M = 0.1
 MIN_EXTENT_M, MAX_EXTENT_M = 1.0, 500.0
 #: A free space smaller than this cannot hold a robot: rejected as absurd.
 MIN_AREA_M2 = 0.5
+#: A floorplan file larger than this is refused before it is read (HouseExpo's are ~10 kB).
+MAX_FILE_BYTES = 50_000_000
 #: Above this many segments, wall counting runs on all cores.
 _PARALLEL_MIN_SEGMENTS = 2048
 FORMAT_NAME = "sfw_gym.floorplan"
@@ -215,8 +217,13 @@ def load_floorplan(source: str | os.PathLike[str] | Mapping[str, Any]) -> Floorp
     if isinstance(source, Mapping):
         where, data = "<dict>", source
     else:
-        where = str(source)
+        where = str(source) if str(source).isprintable() else repr(str(source))
         try:
+            size = Path(source).stat().st_size
+            if size > MAX_FILE_BYTES:
+                raise FloorplanError(
+                    f"{where}: {size:,} bytes, over the {MAX_FILE_BYTES:,} a floorplan may have"
+                )
             text = Path(source).read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError) as exc:
             raise FloorplanError(f"{where}: cannot read floorplan file: {exc}") from exc
@@ -224,6 +231,10 @@ def load_floorplan(source: str | os.PathLike[str] | Mapping[str, Any]) -> Floorp
             data = json.loads(text)
         except json.JSONDecodeError as exc:
             raise FloorplanError(f"{where}: not valid JSON: {exc}") from exc
+        except RecursionError:
+            raise FloorplanError(f"{where}: not valid JSON: nested too deeply") from None
+        except ValueError as exc:  # e.g. an integer of more than 4,300 digits
+            raise FloorplanError(f"{where}: not valid JSON: {exc}") from None
     if not isinstance(data, Mapping):
         raise FloorplanError(f"{where}: expected a JSON object, got {type(data).__name__}")
     try:
@@ -233,6 +244,8 @@ def load_floorplan(source: str | os.PathLike[str] | Mapping[str, Any]) -> Floorp
             return _from_houseexpo_dict(data)
     except FloorplanError as exc:
         raise FloorplanError(f"{where}: {exc}") from None
+    except (TypeError, ValueError, OverflowError, RecursionError) as exc:  # values of odd types
+        raise FloorplanError(f"{where}: malformed plan: {type(exc).__name__}: {exc}") from None
     raise FloorplanError(
         f"{where}: neither a HouseExpo plan (key 'verts') nor an sfw_gym plan "
         f"(key 'format' = {FORMAT_NAME!r}); keys found: {sorted(map(str, data))[:10]}"

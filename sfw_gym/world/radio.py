@@ -53,17 +53,17 @@ class RadioConfig(Config):
     clamped to it.
     """
 
-    frequency_ghz: float = setting(2.437, gt=0.0)
-    tx_power_dbm: float = setting(20.0)
-    path_loss_d0_db: float | None = setting(None, optional=True)
-    reference_distance_m: float = setting(1.0, gt=0.0)
-    path_loss_exponent: float = setting(2.0, gt=0.0)
+    frequency_ghz: float = setting(2.437, ge=0.1, le=100.0)
+    tx_power_dbm: float = setting(20.0, ge=-50.0, le=60.0)
+    path_loss_d0_db: float | None = setting(None, optional=True, ge=0.0, le=200.0)
+    reference_distance_m: float = setting(1.0, ge=1e-3, le=100.0)
+    path_loss_exponent: float = setting(2.0, gt=0.0, le=10.0)
     wall_loss_db: Mapping[str, float] = field(default_factory=lambda: _uniform_losses(10.0))
-    max_total_wall_loss_db: float = setting(45.0, ge=0.0)
-    shadowing_sigma_db: float = setting(4.0, ge=0.0)
-    shadowing_correlation_m: float = setting(5.0, gt=0.0)
-    noise_sigma_db: float = setting(2.0, ge=0.0)
-    sensitivity_dbm: float = setting(-90.0)
+    max_total_wall_loss_db: float = setting(45.0, ge=0.0, le=500.0)
+    shadowing_sigma_db: float = setting(4.0, ge=0.0, le=50.0)
+    shadowing_correlation_m: float = setting(5.0, gt=0.0, le=1e4)
+    noise_sigma_db: float = setting(2.0, ge=0.0, le=50.0)
+    sensitivity_dbm: float = setting(-90.0, ge=-200.0, le=0.0)
 
     def validate(self) -> None:
         if not isinstance(self.wall_loss_db, Mapping):

@@ -220,12 +220,14 @@ def test_router_outside_message(two_rooms):
     [
         (
             {"frequency_ghz": 0.0},
-            r"^RadioConfig\.frequency_ghz must be a finite number > 0, got 0\.0$",
+            r"^RadioConfig\.frequency_ghz must be a finite number in \[0\.1, 100\], got 0\.0$",
         ),
+        # physical bounds: a 2e9 dBm transmitter would overflow the int32 readings
+        ({"tx_power_dbm": 2.1e9}, r"^RadioConfig\.tx_power_dbm must be a finite number in"),
         ({"frequency_ghz": True}, r"^RadioConfig\.frequency_ghz must be a finite number"),
         (
             {"path_loss_d0_db": math.inf},
-            r"^RadioConfig\.path_loss_d0_db must be None or a finite number, got inf",
+            r"^RadioConfig\.path_loss_d0_db must be None or a finite number in \[0, 200\], got inf",
         ),
         ({"wall_loss_db": [10.0]}, r"^RadioConfig\.wall_loss_db must map material names to"),
         ({"wall_loss_db": "generic"}, r"^RadioConfig\.wall_loss_db must map material names to"),
