@@ -186,6 +186,10 @@ def read_rssi_log(path: str | os.PathLike[str]) -> RssiLog:
         raise ConfigError(f"{path}: malformed CSV: {exc}") from None
     except OSError as exc:
         raise ConfigError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    except ConfigError:
+        raise
+    except ValueError as exc:  # a NUL in the file name
+        raise ConfigError(f"{str(path)!r}: cannot read: {exc}") from None
 
 
 def _parse_rows(path: Path, rows: Iterator[tuple[int, list[str]]]) -> RssiLog:

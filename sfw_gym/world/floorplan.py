@@ -225,8 +225,8 @@ def load_floorplan(source: str | os.PathLike[str] | Mapping[str, Any]) -> Floorp
                     f"{where}: {size:,} bytes, over the {MAX_FILE_BYTES:,} a floorplan may have"
                 )
             text = Path(source).read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
-            raise FloorplanError(f"{where}: cannot read floorplan file: {exc}") from exc
+        except (OSError, UnicodeDecodeError, ValueError) as exc:  # ValueError: a NUL in the name
+            raise FloorplanError(f"{where}: cannot read floorplan file: {exc}") from None
         try:
             data = json.loads(text)
         except json.JSONDecodeError as exc:

@@ -108,14 +108,14 @@ class RobotConfig(Config):
             than ``radius_m`` to a wall line.
     """
 
-    radius_m: float = setting(0.17, gt=0.0)
-    max_linear_speed_m_s: float = setting(0.5, gt=0.0)
-    max_angular_speed_rad_s: float = setting(1.5, gt=0.0)
-    control_period_s: float = setting(0.2, gt=0.0)
-    physics_substeps: int = setting(10, integer=True, ge=1)
-    odometry_translation_std: float = setting(0.0, ge=0.0)
-    odometry_heading_std_rad: float = setting(0.0, ge=0.0)
-    wall_radius_m: float = setting(0.01, ge=0.0)
+    radius_m: float = setting(0.17, ge=0.01, le=5.0)
+    max_linear_speed_m_s: float = setting(0.5, gt=0.0, le=20.0)
+    max_angular_speed_rad_s: float = setting(1.5, gt=0.0, le=50.0)
+    control_period_s: float = setting(0.2, ge=1e-3, le=10.0)
+    physics_substeps: int = setting(10, integer=True, ge=1, le=1000)
+    odometry_translation_std: float = setting(0.0, ge=0.0, le=10.0)
+    odometry_heading_std_rad: float = setting(0.0, ge=0.0, le=10.0)
+    wall_radius_m: float = setting(0.01, ge=0.0, le=1.0)
 
     def validate(self) -> None:
         travel = self.max_substep_travel_m
