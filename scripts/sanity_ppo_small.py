@@ -3,8 +3,8 @@
     python scripts/sanity_ppo_small.py [--timesteps 40000] [--out runs/sanity_small] [--episodes 20]
 
 Trains ``sfw-gym train ppo`` on ``SfW-ExploreSmall-v0`` (raw continuous actions, SB3's
-``MultiInputPolicy``, the hyperparameters of ``ppo.yml``; resumable), prints the held-out
-evaluation return at each evaluation (the learning curve), then the episode return of the trained
+``MultiInputPolicy``, the hyperparameters and ``env_kwargs`` of ``ppo.yml``; resumable), prints
+the held-out return at each evaluation (the learning curve), then the episode return of the trained
 policy and of uniformly random actions on the same held-out seeds (2,000,000 + i), paired: mean
 difference with a 95 % CI (Student t). If this does not rise, nothing above it will.
 """
@@ -59,7 +59,7 @@ def main() -> None:
     from stable_baselines3 import PPO
 
     model = PPO.load(out / "model.zip", device="cpu")
-    env = gym.make(ENV_ID)
+    env = gym.make(ENV_ID, **summary["env_kwargs"])  # as trained (the YAML's env_kwargs)
     env.action_space.seed(0)
     seeds = range(2_000_000, 2_000_000 + args.episodes)
     learned = [episode_return(env, s, lambda o: model.predict(o)[0]) for s in seeds]

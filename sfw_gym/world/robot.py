@@ -359,6 +359,12 @@ class Robot:
                     body.velocity = (v * math.cos(a), v * math.sin(a))
                 space_step(dt)
         else:
+            # Re-insert the disc: pymunk keeps, between steps, cached contact impulses (it
+            # warm-starts the next contact solve from them) and the disc's collision pairs in the
+            # order they arose, and a pickle carries neither. Near walls every step starts from
+            # what a fresh copy has, so a copy continues exactly.
+            space.remove(self._disc)
+            space.add(self._disc)
             self._drive_by_callback(True)
             space.collision_bias = self._collision_bias
             for _ in range(substeps - 1):
