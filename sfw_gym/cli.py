@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sfw_gym.core.errors import ConfigError, FloorplanError
+from sfw_gym.core.errors import ConfigError, SfwGymError
 
 
 def checked(convert: Callable, ok: Callable, what: str) -> Callable:
@@ -221,6 +221,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="sfw-gym", description="Active WiFi exploration: worlds, mapping, agents."
     )
+    parser.add_argument(
+        "--debug", action="store_true", help="show the traceback of an error (else one line)"
+    )
     sub = parser.add_subparsers(dest="command", required=True)
 
     from sfw_gym.demo import DEMO_EPISODES, DEMO_SEED
@@ -401,19 +404,30 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``sfw-gym``; bad input ends with a one-line error and exit status 2."""
+    """Entry point of ``sfw-gym``: exit status 0; 2 with a one-line error for bad input; 1 with
+    a one-line error for any other failure (``--debug``: the traceback instead); 130 on Ctrl-C."""
     import gymnasium as gym
 
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
-    except (ConfigError, FloorplanError) as exc:
-        message = str(exc)
-    except gym.error.Error as exc:  # e.g. NameNotFound: an unknown env id
-        message = f"--env {getattr(args, 'env', '')}: {exc}"
+    except (SfwGymError, gym.error.Error) as exc:
+        if args.debug:
+            raise
+        status, message = 2, str(exc)
+        if isinstance(exc, gym.error.Error):  # e.g. NameNotFound: an unknown env id
+            message = f"--env {getattr(args, 'env', '')}: {exc}"
+    except KeyboardInterrupt:
+        print(f"sfw-gym {args.command}: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # a failure, not bad input: one line unless --debug
+        if args.debug:
+            raise
+        status = 1
+        message = f"failed: {type(exc).__name__}: {exc} (run with --debug for the traceback)"
     # One line, even when the message quotes a multi-line parser error (YAML, JSON).
     print(f"sfw-gym {args.command}: error: {' '.join(message.split())}", file=sys.stderr)
-    return 2
+    return status
 
 
 if __name__ == "__main__":

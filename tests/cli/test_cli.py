@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from sfw_gym.cli import main
+from sfw_gym.core.errors import ConfigError
 
 SMALL = "SfW-ExploreSmall-v0"
 TINY_PPO = f"""{SMALL}:
@@ -337,3 +338,22 @@ def test_bench_memory_option_reports_rss(inputs, capsys):
     out = run_cli([*BENCH, "--memory-steps", "30"], capsys)
     assert re.search(r"memory: RSS .* MiB before, .* MiB after 30 steps", out)
     assert "SfW-ExploreSmall-v0" in out and "CartPole-v1" in out and "load average" in out
+
+
+def test_a_failure_is_one_line_and_status_1_and_debug_shows_the_traceback(monkeypatch, capsys):
+    from sfw_gym import bench
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("disk on fire")
+
+    monkeypatch.setattr(bench, "main_bench", broken)
+    assert main(["bench", "--steps", "1"]) == 1
+    err = capsys.readouterr().err
+    assert err.strip() == (
+        "sfw-gym bench: error: failed: RuntimeError: disk on fire (run with --debug for the "
+        "traceback)"
+    )
+    with pytest.raises(RuntimeError, match="disk on fire"):
+        main(["--debug", "bench", "--steps", "1"])
+    with pytest.raises(ConfigError):  # bad input too, with --debug
+        main(["--debug", "map", "nope.csv", "--routers", "1,1"])
