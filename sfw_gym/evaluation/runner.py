@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import json
 import multiprocessing as mp
+import os
 from collections.abc import Iterable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
@@ -33,9 +34,10 @@ from typing import Any
 import numpy as np
 
 from sfw_gym.agents.base import decision_arrays
-from sfw_gym.core.atomic import atomic_path, write_text_atomic
+from sfw_gym.core.atomic import atomic_path, remove_stale_temps, write_text_atomic
 from sfw_gym.core.constants import U8_FREE
 from sfw_gym.core.errors import ConfigError
+from sfw_gym.core.processes import die_with_parent
 from sfw_gym.envs.explore import unwrap_sfw
 from sfw_gym.evaluation.plots import plot_curves, plot_trajectories
 from sfw_gym.evaluation.report import paired_markdown, results_csv, results_markdown
@@ -360,26 +362,15 @@ def evaluate(
         gif_episodes=gif_episodes,
         curve_every=curve_every,
     )
+    remove_stale_temps(out)  # of a run killed mid-write
     ckpt = out / CHECKPOINT
     records = load_checkpoint(ckpt)
+    manifest = _manifest(
+        out, records, agents, episodes, seed, env_id, floorplans, env_kwargs, agent_params
+    )
     done = {r["key"] for r in records}
     todo = [s for s in specs if s.key not in done]
-    write_text_atomic(
-        out / "config.json",
-        json.dumps(
-            {
-                "agents": agents,
-                "episodes": episodes,
-                "seed": seed,
-                "env_id": env_id,
-                "floorplans": str(floorplans) if floorplans else None,
-                "env_kwargs": env_kwargs or {},
-                "agent_params": agent_params or {},
-            },
-            indent=2,
-        )
-        + "\n",
-    )
+    write_text_atomic(out / "config.json", json.dumps(manifest, indent=2) + "\n")
     _run_all(todo, records, ckpt, workers, progress, total=len(specs), done=len(specs) - len(todo))
     keys = {s.key for s in specs}
     mine = [r for r in records if r["key"] in keys]
@@ -396,6 +387,65 @@ def evaluate(
     files += plot_curves(mine, agents, out)
     files += plot_trajectories(mine, agents, out)
     return {"rows": rows, "records": mine, "files": files}
+
+
+def _manifest(
+    out: Path,
+    records: list[dict[str, Any]],
+    agents: list[str],
+    episodes: int,
+    seed: int,
+    env_id: str,
+    floorplans: str | Path | None,
+    env_kwargs: dict[str, Any] | None,
+    agent_params: dict[str, dict[str, Any]] | None,
+) -> dict[str, Any]:
+    """The run's ``config.json``: what its episodes ran with. Resuming in a folder whose
+    recorded episodes ran with another env, plans, env kwargs or agent parameters is refused
+    (their records would be reused as if they were this run's); more agents or episodes extend
+    it."""
+    given = json.loads(
+        json.dumps(
+            {
+                "env_id": env_id,
+                "floorplans": str(floorplans) if floorplans else None,
+                "env_kwargs": env_kwargs or {},
+                "agent_params": {name: (agent_params or {}).get(name, {}) for name in agents},
+            }
+        )
+    )
+    path = out / "config.json"
+    previous: dict[str, Any] = {}
+    if records and path.is_file():
+        try:
+            previous = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, json.JSONDecodeError) as exc:
+            raise ConfigError(
+                f"{path}: unreadable run manifest ({exc}); use another --out"
+            ) from None
+    ran = {r["agent"] for r in records}
+    for key in ("env_id", "floorplans", "env_kwargs"):
+        if previous and previous.get(key) != given[key]:
+            raise ConfigError(
+                f"{out}: its {len(records)} recorded episodes ran with {key} "
+                f"{previous.get(key)!r}, this run asks for {given[key]!r}; use another --out "
+                f"(or delete {out / CHECKPOINT} to start over)"
+            )
+    before = previous.get("agent_params", {})
+    for name in agents:
+        if previous and name in ran and before.get(name, {}) != given["agent_params"][name]:
+            raise ConfigError(
+                f"{out}: its recorded {name!r} episodes ran with parameters "
+                f"{before.get(name, {})!r}, this run asks for {given['agent_params'][name]!r}; "
+                f"use another --out"
+            )
+    return {
+        "agents": list(dict.fromkeys([*previous.get("agents", []), *agents])),
+        "episodes": max(episodes, int(previous.get("episodes", 0))),
+        "seed": seed,
+        **given,
+        "agent_params": {**before, **given["agent_params"]},
+    }
 
 
 def _run_all(
@@ -423,7 +473,12 @@ def _run_all(
                 finish(run_episode(spec))
             return
         # "spawn": forking a process that has run numba's OpenMP kernels is unsafe.
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"))
+        pool = ProcessPoolExecutor(
+            max_workers=workers,
+            mp_context=mp.get_context("spawn"),
+            initializer=die_with_parent,  # a killed evaluation leaves no worker behind
+            initargs=(os.getpid(),),
+        )
         try:
             pending: set[Any] = set()
             queue = list(todo)
