@@ -19,6 +19,7 @@ import re
 import shutil
 import sys
 import time
+import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -240,8 +241,14 @@ def train_ppo(
         import torch
 
         torch.set_num_threads(num_threads)
-    if timesteps < 1:
-        raise ConfigError(f"timesteps must be ≥ 1, got {timesteps}")
+    for name, value in (
+        ("timesteps", timesteps),
+        ("checkpoint_every", checkpoint_every),
+        ("eval_every", eval_every),
+        ("eval_episodes", eval_episodes),
+    ):
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise ConfigError(f"{name} must be an integer ≥ 1, got {value!r}")
     if algo not in ALGOS:
         raise ConfigError(f"unknown algo {algo!r}; known: {list(ALGOS)}")
     Algo: Any
@@ -314,22 +321,25 @@ def train_ppo(
                 from sfw_gym.rl import goal_policy
 
                 grad_norms.append(goal_policy.HeadGradientNorms())
+            evaluations = EvalCallback(
+                eval_env,
+                n_eval_episodes=eval_episodes,
+                eval_freq=max(eval_every // n_envs, 1),
+                log_path=str(out / "eval"),
+                best_model_save_path=None,
+                deterministic=False,
+                verbose=0,
+                **masking,
+            )
+            if previous:  # a resumed run appends to the evaluations so far, not over them
+                _continue_evaluations(evaluations, out / "eval" / "evaluations.npz", start_steps)
             callbacks = CallbackList(
                 [
                     *grad_norms,
                     _atomic_checkpoints(
                         max(checkpoint_every // n_envs, 1), out / "checkpoints", algo
                     ),
-                    EvalCallback(
-                        eval_env,
-                        n_eval_episodes=eval_episodes,
-                        eval_freq=max(eval_every // n_envs, 1),
-                        log_path=str(out / "eval"),
-                        best_model_save_path=None,
-                        deterministic=False,
-                        verbose=0,
-                        **masking,
-                    ),
+                    evaluations,
                 ]
             )
             start = time.perf_counter()
@@ -402,13 +412,33 @@ def _clone_teacher(
         behaviour_clone(model.policy, observations, actions, masks, epochs=epochs)
 
 
+def _continue_evaluations(callback: Any, path: Path, up_to_steps: int) -> None:
+    """Load the held-out evaluations recorded up to ``up_to_steps`` (the resumed checkpoint)
+    into SB3's ``EvalCallback``, which would otherwise start its file afresh."""
+    if not path.is_file():
+        return
+    try:
+        with np.load(path) as data:
+            keep = data["timesteps"] <= up_to_steps
+            callback.evaluations_timesteps = data["timesteps"][keep].tolist()
+            callback.evaluations_results = data["results"][keep].tolist()
+            callback.evaluations_length = data["ep_lengths"][keep].tolist()
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile) as exc:
+        raise ConfigError(f"{path}: cannot resume its evaluations ({exc})") from None
+
+
 def _monitored_seconds(out: Path) -> float:
-    """Training wall time over every run segment: the last episode end time of each monitor."""
+    """Training wall time over every run segment: the last complete episode end time of each
+    monitor (a line cut short by a kill is skipped)."""
     total = 0.0
     for csv in out.glob("train_*.monitor.csv"):
-        lines = csv.read_text(encoding="utf-8").splitlines()[2:]
-        if lines:
-            total += float(lines[-1].split(",")[2])
+        for line in reversed(csv.read_text(encoding="utf-8", errors="replace").splitlines()[2:]):
+            cells = line.split(",")
+            try:
+                total += float(cells[2])
+                break
+            except (IndexError, ValueError):
+                continue
     return total
 
 

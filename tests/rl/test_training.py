@@ -224,3 +224,21 @@ def test_the_training_curve_draws_other_policies_levels(tmp_path, monkeypatch):
     path = plot_training_curve(tmp_path, levels={"frontier": 12.3, "greedy": 7.9})
     assert path is not None and path.stat().st_size > 0
     assert drawn == [(12.3, "frontier"), (7.9, "greedy")]
+
+
+def test_a_resumed_run_keeps_its_evaluations_and_survives_a_cut_monitor_line(tmp_path):
+    from sfw_gym.rl.training import _monitored_seconds
+
+    run = {"n_envs": 1, "env_kwargs": TINY, "checkpoint_every": 64, "eval_every": 64}
+    train_ppo("SfW-ExploreSmall-v0", 128, tmp_path, eval_episodes=1, progress_bar=False, **run)
+    with (tmp_path / "train_0.monitor.csv").open("a") as fh:
+        fh.write("0.71,30,")  # a line cut short by a kill
+    assert _monitored_seconds(tmp_path) > 0
+    train_ppo(
+        "SfW-ExploreSmall-v0", 256, tmp_path, eval_episodes=1, resume=True, progress_bar=False,
+        **run,
+    )  # fmt: skip
+    steps = np.load(tmp_path / "eval" / "evaluations.npz")["timesteps"].tolist()
+    assert steps == [64, 128, 192, 256]  # the first segment's evaluations are still there
+    with pytest.raises(ConfigError, match="checkpoint_every must be an integer ≥ 1, got 0"):
+        train_ppo("SfW-ExploreSmall-v0", 8, tmp_path / "x", **{**run, "checkpoint_every": 0})
