@@ -27,3 +27,7 @@ NOT_HEARD_DBM = -100
 #: Discrete actions as (linear, angular) commands in [-1, 1]: 0 forward, 1 turn left, 2 turn right.
 DISCRETE_ACTIONS = ((1.0, 0.0), (0.0, 1.0), (0.0, -1.0))
 DISCRETE_ACTION_NAMES = ("forward", "turn_left", "turn_right")
+
+#: Above this many vertices (or wall segments), world geometry takes its bulk paths: a HouseExpo
+#: outline is simplified to 1 cm, the robot's walls are added in a shuffled order.
+BULK_VERTICES = 2048

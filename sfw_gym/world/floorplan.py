@@ -16,7 +16,7 @@ from shapely.geometry import Polygon
 from shapely.validation import explain_validity
 
 from sfw_gym.core.atomic import write_text_atomic
-from sfw_gym.core.constants import U8_FREE, U8_UNKNOWN, U8_WALL
+from sfw_gym.core.constants import BULK_VERTICES, U8_FREE, U8_UNKNOWN, U8_WALL
 from sfw_gym.core.errors import FloorplanError
 from sfw_gym.world.wall_crossing import DEFAULT_MIN_PIECE_M, cross_walls, cross_walls_parallel
 
@@ -28,6 +28,9 @@ EXTERIOR_WALL_M = 0.1
 MIN_EXTENT_M, MAX_EXTENT_M = 1.0, 500.0
 #: A free space smaller than this cannot hold a robot: rejected as absurd.
 MIN_AREA_M2 = 0.5
+#: A free space with more vertices than this is refused (HouseExpo's have tens to hundreds;
+#: a reset costs about 0.1 s per 1,000 vertices beyond a few thousand).
+MAX_VERTICES = 50_000
 #: A floorplan file larger than this is refused before it is read (HouseExpo's are ~10 kB).
 MAX_FILE_BYTES = 50_000_000
 #: Above this many segments, wall counting runs on all cores.
@@ -260,10 +263,24 @@ def floorplan_from_polygon(
     exterior_wall_m: float = EXTERIOR_WALL_M,
     rooms: Sequence[Room] = (),
 ) -> Floorplan:
-    """A plan whose walls all share one material, its footprint the free space grown by a wall."""
+    """A plan whose walls all share one material, its footprint the free space grown by a wall.
+
+    An outline of more than :data:`~sfw_gym.core.constants.BULK_VERTICES` vertices is simplified
+    to 1 cm (far below the map's cells) first, and its footprint is grown from a 10 cm
+    simplification by the wall plus their distance (an exterior wall thicker by up to about
+    0.25 m in places): GEOS's buffer of a serrated 10,000-vertex outline takes seconds."""
     _check_polygon(free_space, "free_space", name)
+    outline = free_space
+    if _n_vertices(free_space) > BULK_VERTICES:
+        free_space = free_space.simplify(0.01, preserve_topology=True)
+        _check_polygon(free_space, "free_space (simplified to 1 cm)", name)
+        coarse = free_space.simplify(0.1, preserve_topology=True)
+        # grown by its distance from the outline more, the footprint holds the free space and
+        # a wall of at least exterior_wall_m all round
+        margin = coarse.hausdorff_distance(outline) + 0.001
+        outline, exterior_wall_m = coarse, exterior_wall_m + margin
     with np.errstate(divide="ignore", invalid="ignore"):  # GEOS on slivers; validated below
-        grown = free_space.buffer(exterior_wall_m, join_style="mitre")
+        grown = outline.buffer(exterior_wall_m, join_style="mitre")
     footprint = Polygon(grown.exterior)
     n_edges = len(_polygon_edges(free_space))
     return Floorplan(free_space, footprint, (material,) * n_edges, name=name, rooms=tuple(rooms))
@@ -346,11 +363,21 @@ def _parse_ring(verts: Any, what: str) -> np.ndarray:
     return pts
 
 
+def _n_vertices(poly: Polygon) -> int:
+    return len(poly.exterior.coords) + sum(len(r.coords) for r in poly.interiors)
+
+
 def _check_polygon(poly: Any, what: str, name: str) -> None:
     if not isinstance(poly, Polygon):
         raise FloorplanError(f"floorplan {name!r}: {what} must be a shapely Polygon")
     if poly.is_empty or poly.area <= 0:
         raise FloorplanError(f"floorplan {name!r}: {what} has zero area")
+    n_vertices = _n_vertices(poly)
+    if n_vertices > MAX_VERTICES:
+        raise FloorplanError(
+            f"floorplan {name!r}: {what} has {n_vertices:,} vertices, over the {MAX_VERTICES:,} "
+            "the simulation takes (simplify the outline, e.g. shapely's simplify(0.01))"
+        )
     coords = np.asarray(poly.exterior.coords)
     if not np.isfinite(coords).all():
         raise FloorplanError(f"floorplan {name!r}: {what} contains NaN or infinite coordinates")

@@ -36,6 +36,7 @@ import numpy as np
 import pymunk
 
 from sfw_gym.core.config import Config, setting
+from sfw_gym.core.constants import BULK_VERTICES
 from sfw_gym.core.errors import ConfigError
 
 __all__ = ["Pose", "Robot", "RobotConfig", "StepResult"]
@@ -222,13 +223,17 @@ class Robot:
         self._collision_bias = (1.0 - _OVERLAP_CORRECTION_PER_SUBSTEP) ** (1.0 / dt)
         space.collision_bias = self._collision_bias
         walls = []
-        for x0, y0, x1, y1 in self._walls.tolist():
+        wall_filter = pymunk.ShapeFilter(categories=_WALL_CATEGORY)
+        for x0, y0, x1, y1 in self._walls.tolist():  # friction and elasticity: pymunk's 0
             seg = pymunk.Segment(space.static_body, (x0, y0), (x1, y1), config.wall_radius_m)
-            seg.friction = 0.0
-            seg.elasticity = 0.0
             seg.collision_type = _WALL_COLLISION_TYPE
-            seg.filter = pymunk.ShapeFilter(categories=_WALL_CATEGORY)
+            seg.filter = wall_filter
             walls.append(seg)
+        if len(walls) > BULK_VERTICES:
+            # Chipmunk's static BB-tree degenerates when walls arrive in outline order (10,000
+            # segments: 0.54 s to add; 0.02 s in a fixed shuffled order)
+            order = np.random.default_rng(0).permutation(len(walls))
+            walls = [walls[i] for i in order]
         if walls:
             space.add(*walls)
 

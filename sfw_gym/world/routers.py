@@ -6,6 +6,7 @@ import numpy as np
 import shapely
 from sklearn.cluster import KMeans
 
+from sfw_gym.core.constants import BULK_VERTICES
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.core.threads import single_threaded_openmp
 from sfw_gym.world.floorplan import Floorplan
@@ -23,14 +24,28 @@ def place_routers(floorplan: Floorplan, n: int, rng: np.random.Generator) -> np.
     """
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
         raise ConfigError(f"number of routers must be a positive integer, got {n!r}")
-    region = floorplan.free_space.buffer(-ROUTER_CLEARANCE_M)
-    if region.is_empty:
-        region = floorplan.free_space
+    free = floorplan.free_space
+    if len(floorplan.edges) > BULK_VERTICES:  # the clearance by distance queries, not a buffer
+
+        def is_open(pts: np.ndarray) -> np.ndarray:
+            inside = shapely.contains_xy(free, pts[:, 0], pts[:, 1])
+            near = shapely.dwithin(free.boundary, shapely.points(pts), ROUTER_CLEARANCE_M)
+            return inside & ~near
+
+        region = free
+    else:
+        region = free.buffer(-ROUTER_CLEARANCE_M)
+        if region.is_empty:
+            region = free
+
+        def is_open(pts: np.ndarray) -> np.ndarray:
+            return shapely.contains_xy(region, pts[:, 0], pts[:, 1])
+
     xmin, ymin, xmax, ymax = region.bounds
     candidates = np.empty((0, 2))
     for _ in range(50):  # rejection sampling: keep drawing until there are enough open spots
         pts = rng.uniform((xmin, ymin), (xmax, ymax), size=(512, 2))
-        candidates = np.vstack([candidates, pts[shapely.contains_xy(region, pts[:, 0], pts[:, 1])]])
+        candidates = np.vstack([candidates, pts[is_open(pts)]])
         if len(candidates) >= 256:
             break
     if len(candidates) < n:
