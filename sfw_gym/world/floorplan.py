@@ -155,6 +155,11 @@ class Floorplan:
             raise FloorplanError(f"segment endpoints must have shape (M, 2), got {a2.shape}")
         a2 = np.array(a2.reshape(-1, 2), order="C")  # copies: broadcast views are read-only
         b2 = np.array(b2.reshape(-1, 2), order="C")
+        if not (np.isfinite(a2).all() and np.isfinite(b2).all()):  # NaN crossed no wall: 0
+            bad = np.flatnonzero(~(np.isfinite(a2).all(1) & np.isfinite(b2).all(1)))
+            raise FloorplanError(
+                f"segment endpoints must be finite; rows {bad[:5].tolist()} are not"
+            )
         edge_loss = table[self.edge_material_index]
         kernel = cross_walls_parallel if len(a2) >= _PARALLEL_MIN_SEGMENTS else cross_walls
         return kernel(self.edges, edge_loss, a2, b2, float(min_piece_m))

@@ -1,4 +1,5 @@
-"""Plans with many vertices: a size guard, and bulk geometry that keeps what the plan means."""
+"""Plans at their limits: many vertices (a size guard, bulk geometry that keeps what the plan
+means) and segments with NaN ends."""
 
 from __future__ import annotations
 
@@ -49,3 +50,8 @@ def test_a_plan_over_the_vertex_limit_is_refused_by_name(tmp_path):
     path = serrated(MAX_VERTICES + 10, tmp_path)
     with pytest.raises(FloorplanError, match=r"serrated_50010\.json: .* has 50,011 vertices, over"):
         load_floorplan(path)
+
+
+def test_counting_walls_from_a_nan_point_is_an_error_not_zero(two_rooms):
+    with pytest.raises(FloorplanError, match=r"must be finite; rows \[1\] are not"):
+        two_rooms.count_walls(np.array([[1.0, 1.0], [np.nan, 1.0]]), np.array([9.0, 1.0]))
