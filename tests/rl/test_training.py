@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
@@ -242,3 +243,30 @@ def test_a_resumed_run_keeps_its_evaluations_and_survives_a_cut_monitor_line(tmp
     assert steps == [64, 128, 192, 256]  # the first segment's evaluations are still there
     with pytest.raises(ConfigError, match="checkpoint_every must be an integer ≥ 1, got 0"):
         train_ppo("SfW-ExploreSmall-v0", 8, tmp_path / "x", **{**run, "checkpoint_every": 0})
+
+
+@pytest.mark.slow
+def test_a_killed_training_leaves_no_env_worker_behind(tmp_path):
+    out = tmp_path / "run"
+    script = textwrap.dedent(f"""
+        from sfw_gym.rl.training import train_ppo
+        train_ppo("SfW-ExploreSmall-v0", 100_000, {str(out)!r}, n_envs=2, env_kwargs={TINY!r},
+                  checkpoint_every=64, eval_every=10**9, progress_bar=False)
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", script], start_new_session=True)
+    try:
+        deadline = time.monotonic() + 240
+        while not latest_checkpoint(out) and time.monotonic() < deadline:
+            assert proc.poll() is None, "training ended before it was killed"
+            time.sleep(0.5)
+    finally:
+        proc.send_signal(signal.SIGKILL)  # the trainer only (SB3's workers exit on the closed pipe)
+        proc.wait()
+    deadline = time.monotonic() + 15
+    while time.monotonic() < deadline:
+        try:
+            os.killpg(proc.pid, 0)
+        except ProcessLookupError:
+            return
+        time.sleep(0.2)
+    pytest.fail("a worker outlived its killed training")
