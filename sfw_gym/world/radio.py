@@ -92,6 +92,7 @@ class RadioConfig(Config):
         ``residential`` (per-material losses: the hard mode); ``band`` "2.4" or "5" GHz.
 
         At 5 GHz only the frequency (hence PL(d0) ≈ 46.8 dB) changes; wall losses stay the preset's.
+        A ``wall_loss_db`` override may name some materials only (the rest keep the preset's).
         """
         losses = {
             "default": _uniform_losses(10.0),
@@ -102,6 +103,10 @@ class RadioConfig(Config):
             raise ConfigError(f"unknown radio preset {name!r}; choose one of {list(PRESETS)}")
         if band not in BANDS:
             raise ConfigError(f"unknown radio band {band!r}; choose one of {list(BANDS)}")
+        overrides = dict(overrides)
+        given = overrides.get("wall_loss_db")
+        if isinstance(given, Mapping):  # some materials: the others keep the preset's losses
+            overrides["wall_loss_db"] = {**losses[name], **given}
         return cls.from_dict(
             {"frequency_ghz": BANDS[band], "wall_loss_db": losses[name], **overrides}, "radio"
         )

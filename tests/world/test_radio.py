@@ -303,3 +303,13 @@ def test_shadowing_table_covers_bounds_left_of_and_below_the_origin():
     _, ny, nx = f.table_db.shape
     assert f.origin.tolist() == [-4.5, -3.5]
     assert f.origin[0] + 0.5 * (nx - 1) >= 1.7 and f.origin[1] + 0.5 * (ny - 1) >= -0.5
+
+
+def test_a_wall_loss_override_may_name_some_materials_only():
+    radio = RadioConfig.preset("residential", wall_loss_db={"glass": 2.0})
+    assert radio.wall_loss_db["glass"] == 2.0
+    assert (
+        radio.wall_loss_db["concrete"] == RadioConfig.preset("residential").wall_loss_db["concrete"]
+    )
+    with pytest.raises(ConfigError, match=r"unknown \['lava'\]"):
+        RadioConfig.preset(wall_loss_db={"lava": 5.0})
