@@ -97,7 +97,7 @@ class PPOAgent(Agent):
             menu, extra = menu_observation(self.finder, view, k)
             mask = action_masks(menu, k) if self.use_masking else np.ones(k, np.bool_)
             choice = self._choose({**obs, **extra}, mask)
-            if choice < len(menu):
+            if choice < len(menu) and menu.valid[choice]:  # else the driver turns in place
                 self._log_decision(menu, choice)
             self.driver.start(view, menu, choice)
             self.n_decisions += 1
