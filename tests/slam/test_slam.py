@@ -1,0 +1,132 @@
+"""Radio SLAM pieces against cases computed by hand: similarity (Eq. 2), the distance model
+(Eq. 3), the pose graph (Eq. 1) and its robust kernel, the trajectory error."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.slam import (
+    PoseGraph,
+    SimilarityRangeModel,
+    absolute_trajectory_error,
+    cosine_similarity,
+    kernel_similarity,
+)
+
+nan = np.nan
+
+
+def test_cosine_similarity_is_the_papers_eq_2():
+    f_i, f_j = np.array([-40.0, -50.0, nan]), np.array([-40.0, nan, -60.0])
+    # common AP 0 only in the numerator, each fingerprint's own APs in its norm
+    expected = 1600.0 / (math.sqrt(1600 + 2500) * math.sqrt(1600 + 3600))
+    assert cosine_similarity(f_i, f_j) == pytest.approx(expected)
+    assert cosine_similarity(f_i, f_i) == pytest.approx(1.0)
+    assert cosine_similarity(np.array([-40.0, nan]), np.array([nan, -40.0])) == 0.0
+    many = cosine_similarity(f_i, np.stack([f_i, f_j]))  # one against many
+    np.testing.assert_allclose(many, [1.0, expected])
+
+
+def test_kernel_similarity_falls_with_the_rssi_difference_and_the_shared_aps():
+    f = np.array([-40.0, -50.0])
+    assert kernel_similarity(f, f) == pytest.approx(1.0)
+    assert kernel_similarity(f, f - 6.0, sigma_db=6.0) == pytest.approx(math.exp(-0.5))
+    half = kernel_similarity(np.array([-40.0, -50.0]), np.array([-40.0, nan]))
+    assert half == pytest.approx(0.5)  # the one common AP agrees; half the heard APs are shared
+
+
+def test_the_distance_model_bins_pairs_as_eq_3():
+    model = SimilarityRangeModel(bin_width=0.05, min_samples=5)
+    model.update(np.full(10, 0.92), np.r_[np.full(5, 1.0), np.full(5, 3.0)])
+    model.update(np.full(3, 0.41), np.full(3, 9.0))  # too few in its bin
+    mean, var = model.predict(np.array([0.91, 0.42, 0.1]))
+    assert mean[0] == pytest.approx(2.0) and var[0] == pytest.approx(1.0)
+    assert np.isnan(mean[1:]).all() and np.isnan(var[1:]).all()
+    with pytest.raises(ConfigError, match="bin_width"):
+        SimilarityRangeModel(bin_width=0.0)
+
+
+def square_loop(n_side: int = 10, side_m: float = 10.0, laps: int = 2) -> np.ndarray:
+    """Poses around a square, counter-clockwise, heading along the path, ``laps`` times."""
+    poses = []
+    for k in list(range(4)) * laps:
+        heading = k * math.pi / 2
+        start = np.array([[0, 0], [side_m, 0], [side_m, side_m], [0, side_m]][k], float)
+        for t in range(n_side):
+            xy = start + (t * side_m / n_side) * np.array([math.cos(heading), math.sin(heading)])
+            poses.append([*xy, heading])
+    return np.array(poses)
+
+
+def relative(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float]:
+    c, s = math.cos(a[2]), math.sin(a[2])
+    d = b[:2] - a[:2]
+    return (
+        c * d[0] + s * d[1],
+        -s * d[0] + c * d[1],
+        (b[2] - a[2] + math.pi) % (2 * math.pi) - math.pi,
+    )
+
+
+def compose(a: np.ndarray, delta: tuple[float, float, float]) -> np.ndarray:
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return np.array(
+        [a[0] + c * delta[0] - s * delta[1], a[1] + s * delta[0] + c * delta[1], a[2] + delta[2]]
+    )
+
+
+def drifting_graph(truth: np.ndarray, robust: str, false_closure: bool = False):
+    """Odometry with a heading bias, radio closures between the laps' poses 1.5 m or less apart."""
+    graph = PoseGraph(len(truth), robust=robust)
+    odometry = [truth[0]]
+    for k in range(len(truth) - 1):
+        dx, dy, dth = relative(truth[k], truth[k + 1])
+        measured = (dx, dy, dth + 0.02)  # 0.02 rad of heading drift per step
+        graph.add_odometry(k, k + 1, measured, sigma_xy=0.05, sigma_theta=0.02)
+        odometry.append(compose(odometry[-1], measured))
+    for i in range(len(truth)):
+        for j in range(i + 20, len(truth)):  # the second lap passes the first
+            d = float(np.linalg.norm(truth[i, :2] - truth[j, :2]))
+            if d <= 1.5:
+                graph.add_range(i, j, d, sigma_m=0.3)
+    if false_closure:  # far-apart poses claimed to be the same place
+        for i, j in ((5, 65), (15, 55), (25, 75)):
+            graph.add_range(i, j, 0.0, sigma_m=0.3)
+    return graph, np.array(odometry)
+
+
+def test_odometry_alone_is_kept_and_closures_undo_the_drift():
+    truth = square_loop()
+    graph, odometry = drifting_graph(truth, robust="none")
+    assert absolute_trajectory_error(odometry, truth) > 1.0  # the drift opens the loop
+    solved = graph.optimize(odometry)
+    assert absolute_trajectory_error(solved, truth) < 0.3
+    np.testing.assert_allclose(solved[0], odometry[0], atol=1e-6)  # the first pose stays
+    chain = PoseGraph(len(truth))
+    for k in range(len(truth) - 1):
+        chain.add_odometry(k, k + 1, relative(odometry[k], odometry[k + 1]), 0.05, 0.02)
+    np.testing.assert_allclose(chain.optimize(odometry), odometry, atol=1e-9)  # nothing to fix
+
+
+def test_a_robust_kernel_keeps_a_false_closure_from_bending_the_trajectory():
+    truth = square_loop()
+    plain_graph, odometry = drifting_graph(truth, robust="none", false_closure=True)
+    robust_graph, _ = drifting_graph(truth, robust="cauchy", false_closure=True)
+    plain = absolute_trajectory_error(plain_graph.optimize(odometry), truth)
+    robust = absolute_trajectory_error(robust_graph.optimize(odometry), truth)
+    assert robust < 0.3 < plain
+
+
+def test_ate_ignores_a_rigid_motion_and_rejects_mismatched_trajectories():
+    truth = square_loop()
+    c, s = math.cos(0.7), math.sin(0.7)
+    moved = truth[:, :2] @ np.array([[c, s], [-s, c]]) + [3.0, -2.0]
+    assert absolute_trajectory_error(moved, truth) == pytest.approx(0.0, abs=1e-9)
+    with pytest.raises(ConfigError, match="same"):
+        absolute_trajectory_error(truth[:3], truth)
+    with pytest.raises(ConfigError, match="robust"):
+        PoseGraph(3, robust="tukey")
