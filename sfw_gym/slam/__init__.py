@@ -5,7 +5,7 @@ of odometry and range edges optimised by a sparse Levenberg–Marquardt with a r
 
 from __future__ import annotations
 
-from sfw_gym.slam.fingerprints import cosine_similarity, kernel_similarity
+from sfw_gym.slam.fingerprints import closure_candidates, cosine_similarity, kernel_similarity
 from sfw_gym.slam.pose_graph import PoseGraph, absolute_trajectory_error
 from sfw_gym.slam.range_model import SimilarityRangeModel
 
@@ -13,6 +13,7 @@ __all__ = [
     "PoseGraph",
     "SimilarityRangeModel",
     "absolute_trajectory_error",
+    "closure_candidates",
     "cosine_similarity",
     "kernel_similarity",
 ]

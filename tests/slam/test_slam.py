@@ -13,6 +13,7 @@ from sfw_gym.slam import (
     PoseGraph,
     SimilarityRangeModel,
     absolute_trajectory_error,
+    closure_candidates,
     cosine_similarity,
     kernel_similarity,
 )
@@ -130,3 +131,29 @@ def test_ate_ignores_a_rigid_motion_and_rejects_mismatched_trajectories():
         absolute_trajectory_error(truth[:3], truth)
     with pytest.raises(ConfigError, match="robust"):
         PoseGraph(3, robust="tukey")
+
+
+def test_closure_candidates_are_close_fingerprints_far_apart_along_the_path():
+    rng = np.random.default_rng(0)
+    places = rng.uniform(-90, -40, (5, 8))  # five places, eight APs
+    visits = [0, 1, 2, 3, 4, 0, 2]  # the walk returns to places 0 and 2
+    fingerprints = places[visits] + rng.normal(0, 1, (len(visits), 8))
+    fingerprints[3, 5] = nan  # an AP not heard once
+    travelled = np.arange(len(visits)) * 10.0
+    pairs = closure_candidates(fingerprints, travelled, min_travel_m=15.0, radius_db=8.0)
+    assert pairs.tolist() == [[0, 5], [2, 6]]
+    brute = [
+        (i, j)
+        for i in range(len(visits))
+        for j in range(i + 1, len(visits))
+        if np.linalg.norm(
+            np.nan_to_num(fingerprints[i], nan=-100) - np.nan_to_num(fingerprints[j], nan=-100)
+        )
+        <= 8.0
+        and travelled[j] - travelled[i] >= 15.0
+    ]
+    assert [tuple(p) for p in pairs] == brute  # the KD-tree finds what all pairs would
+    assert closure_candidates(fingerprints, travelled, min_travel_m=100.0, radius_db=8.0).shape == (
+        0,
+        2,
+    )
