@@ -28,8 +28,8 @@ EXTERIOR_WALL_M = 0.1
 MIN_EXTENT_M, MAX_EXTENT_M = 1.0, 500.0
 #: A free space smaller than this cannot hold a robot: rejected as absurd.
 MIN_AREA_M2 = 0.5
-#: A free space with more vertices than this is refused (HouseExpo's have tens to hundreds;
-#: a reset costs about 0.1 s per 1,000 vertices beyond a few thousand).
+#: A free space with more vertices than this is refused (HouseExpo's have tens to hundreds; a
+#: reset costs about 25 ms per 1,000 vertices: scripts/bench_plan_size.py).
 MAX_VERTICES = 50_000
 #: A floorplan file larger than this is refused before it is read (HouseExpo's are ~10 kB).
 MAX_FILE_BYTES = 50_000_000
@@ -155,7 +155,7 @@ class Floorplan:
             raise FloorplanError(f"segment endpoints must have shape (M, 2), got {a2.shape}")
         a2 = np.array(a2.reshape(-1, 2), order="C")  # copies: broadcast views are read-only
         b2 = np.array(b2.reshape(-1, 2), order="C")
-        if not (np.isfinite(a2).all() and np.isfinite(b2).all()):  # NaN crossed no wall: 0
+        if not (np.isfinite(a2).all() and np.isfinite(b2).all()):  # (NaN used to count 0 walls)
             bad = np.flatnonzero(~(np.isfinite(a2).all(1) & np.isfinite(b2).all(1)))
             raise FloorplanError(
                 f"segment endpoints must be finite; rows {bad[:5].tolist()} are not"
