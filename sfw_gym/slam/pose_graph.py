@@ -141,7 +141,7 @@ class PoseGraph:
         x = np.array(poses, np.float64).reshape(self.n_poses, 3)
         anchor = x[0].copy()
         edges = (np.array(self._odo).reshape(-1, 7), np.array(self._rng).reshape(-1, 4))
-        lam = 1e-3
+        lam, nu = 1e-3, 2.0  # damping, and its growth after a rejected step (Nielsen)
         _, _, errors = self._linearize(x, anchor, None, edges)
         weights = self._robust_weights(errors)
         for _ in range(iterations):
@@ -150,20 +150,21 @@ class PoseGraph:
             jt = jac.T.tocsr()
             h = (jt @ jac).tocsc()
             g = jt @ r
-            diag = h.diagonal()
+            diag = np.maximum(h.diagonal(), 1e-9)
             while True:
-                damped = h + sp.diags(lam * np.maximum(diag, 1e-9))
-                # symmetric positive definite: a minimum-degree ordering of A + Aᵀ fills in far
-                # less than the default COLAMD (2,000 poses: 17 ms a solve before)
-                step = spsolve(damped, -g, permc_spec="MMD_AT_PLUS_A").reshape(-1, 3)
-                trial = x + step
+                step = spsolve(h + sp.diags(lam * diag), -g)
+                trial = x + step.reshape(-1, 3)
                 trial[:, 2] = _wrap(trial[:, 2])
                 r_new, _, _ = self._linearize(trial, anchor, weights, edges)
                 new_cost = float(r_new @ r_new)
-                if new_cost < cost:
-                    x, lam = trial, max(lam / 10.0, 1e-12)
+                predicted = -2.0 * float(step @ g) - float(step @ (h @ step))
+                rho = (cost - new_cost) / predicted if predicted > 0 else -1.0
+                if rho > 0:  # accepted: trust the model more the better it predicted
+                    x = trial
+                    lam *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
+                    nu = 2.0
                     break
-                lam *= 10.0
+                lam, nu = lam * nu, 2.0 * nu
                 if lam > 1e12:
                     return x
             _, _, errors = self._linearize(x, anchor, None, edges)
