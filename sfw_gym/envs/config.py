@@ -28,7 +28,8 @@ class RewardConfig(Config):
 @dataclass(frozen=True)
 class ExploreConfig(Config):
     """Actions, routers, the map's resolution, observation sizes and the step budget
-    (``steps_per_m2``: None, or a budget of ``min(max_steps, ceil(steps_per_m2 × free area))``)."""
+    (``steps_per_m2``: None, or a budget of ``min(max_steps, ceil(steps_per_m2 × free area))``);
+    ``n_background_aps`` access points beyond the routers, heard as a fingerprint."""
 
     prefix: ClassVar[str | None] = ""  # gym.make keyword arguments
 
@@ -41,3 +42,4 @@ class ExploreConfig(Config):
     crop_px: int = setting(48, integer=True, ge=36, le=512)
     max_steps: int = setting(3000, integer=True, ge=1, le=10**7)
     steps_per_m2: float | None = setting(None, optional=True, ge=1e-3, le=1e5)
+    n_background_aps: int = setting(0, integer=True, ge=0, le=64)

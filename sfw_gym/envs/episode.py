@@ -22,6 +22,7 @@ from sfw_gym.world import (
     RobotConfig,
     generate_floorplan,
     load_floorplan,
+    place_background_aps,
     place_routers,
 )
 
@@ -38,6 +39,7 @@ class EpisodeScene:
     robot: Robot
     truth_u8: np.ndarray  # 0 wall, 255 free, 127 outside
     grid_origin: tuple[float, float]
+    background: RadioModel | None = None  # access points beyond the routers (their fingerprint)
 
 
 @dataclass(frozen=True)
@@ -84,8 +86,10 @@ def build_scene(
     resolution_m: float,
     rng: np.random.Generator,
     generator_params: dict[str, Any] | None = None,
+    n_background_aps: int = 0,
 ) -> EpisodeScene:
-    """Assemble an episode; every random choice comes from ``rng``."""
+    """Assemble an episode; every random choice comes from ``rng`` (the background access
+    points' last, so that without them every other draw is as before)."""
     plan = resolve_floorplan(floorplan, generator_params)
     truth, origin = plan.rasterize(resolution_m)
     if isinstance(routers, int | np.integer) and not isinstance(routers, bool):
@@ -101,7 +105,11 @@ def build_scene(
     radio = RadioModel(plan, routers, radio_config, rng)
     pose = _start_pose(plan, truth, origin, resolution_m, robot_config.radius_m, start_pose, rng)
     robot = Robot(plan.edges, robot_config, pose, rng)
-    return EpisodeScene(plan, radio, robot, truth, origin)
+    background = None
+    if n_background_aps:
+        aps = place_background_aps(plan, n_background_aps, rng)
+        background = RadioModel(plan, aps, radio_config, rng, in_free_space=False)
+    return EpisodeScene(plan, radio, robot, truth, origin, background)
 
 
 def _start_pose(

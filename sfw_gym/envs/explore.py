@@ -18,7 +18,11 @@ from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.config import RESET_OPTIONS, ExploreConfig, RewardConfig
 from sfw_gym.envs.episode import EpisodeScene, GroundTruth, build_scene
 from sfw_gym.envs.map_tracker import MapTracker
-from sfw_gym.envs.observation import ObservationBuilder, observation_space
+from sfw_gym.envs.observation import (
+    ObservationBuilder,
+    fingerprint_observation,
+    observation_space,
+)
 from sfw_gym.mapping import GridSpec, MapperConfig, SparseInverseKVisibility
 from sfw_gym.navigation.view import RobotView
 from sfw_gym.world import Floorplan, RadioConfig, RobotConfig
@@ -83,7 +87,10 @@ class SfWExploreEnv(gym.Env):
     MapperConfig overrides), ``resolution_m`` (0.1), ``map_px`` (64), ``crop_px`` (48),
     ``coverage_target`` (0.95), ``collision_penalty`` (0.1), ``reward_scale`` (0.01),
     ``max_steps`` (3000), ``steps_per_m2`` (None: the budget is ``max_steps``; a number: the
-    budget is ``min(max_steps, ceil(steps_per_m2 × free area))``), ``render_mode`` (None |
+    budget is ``min(max_steps, ceil(steps_per_m2 × free area))``), ``n_background_aps`` (0:
+    access points beyond the routers, half in the building and half in its neighbourhood, whose
+    RSSI the robot hears as a fingerprint: ``obs["fingerprint"]``, ``obs["fingerprint_heard"]``
+    and ``info["fingerprint"]``; Radio SLAM's input), ``render_mode`` (None |
     "rgb_array" | "human"), ``render_size`` ((960, 480): every frame is ``width × height``, the
     plan letterboxed into it, so video writers work across plans; None: the plan's own size).
     ``reset(options=…)``: ``floorplan`` (a Floorplan, a path or a generator seed), ``routers``
@@ -114,6 +121,7 @@ class SfWExploreEnv(gym.Env):
         reward_scale: float = 0.01,
         max_steps: int = 3000,
         steps_per_m2: float | None = None,
+        n_background_aps: int = 0,
         render_mode: str | None = None,
         render_size: tuple[int, int] | None = (960, 480),
         **unknown: Any,
@@ -137,6 +145,7 @@ class SfWExploreEnv(gym.Env):
             crop_px=crop_px,
             max_steps=max_steps,
             steps_per_m2=steps_per_m2,
+            n_background_aps=n_background_aps,
         )
         self.reward_config = RewardConfig(
             reward_scale=reward_scale,
@@ -173,7 +182,8 @@ class SfWExploreEnv(gym.Env):
         self.render_size = _frame_size(render_size)
         self._folder_plans = _folder_plans(floorplan)
 
-        self.observation_space = observation_space(n_routers, map_px, crop_px)
+        self.n_background_aps = cfg.n_background_aps
+        self.observation_space = observation_space(n_routers, map_px, crop_px, cfg.n_background_aps)
         if action_type == "continuous":
             self.action_space = spaces.Box(-1.0, 1.0, (2,), np.float32)
         else:
@@ -202,6 +212,7 @@ class SfWExploreEnv(gym.Env):
             resolution_m=self.resolution_m,
             rng=self.np_random,
             generator_params=self.generator_params,
+            n_background_aps=self.n_background_aps,
         )
         s = self.scene
         self.grid = GridSpec(s.grid_origin, self.resolution_m, s.truth_u8.shape)
@@ -317,9 +328,13 @@ class SfWExploreEnv(gym.Env):
         self.obs_builder.mark_visited(odom.x, odom.y)
         rssi_slots = np.full(self.n_routers, float(NOT_HEARD_DBM))
         rssi_slots[: len(rssi)] = rssi
-        return self.obs_builder.build(
+        obs = self.obs_builder.build(
             self.mapper.occupancy_u8, rssi_slots, bumped, odom, self.tracker.known_fraction
         )
+        if s.background is not None:  # the fingerprint of the access points beyond the routers
+            self.fingerprint = s.background.measure(np.array(true_pose[:2])).astype(np.float64)
+            obs.update(fingerprint_observation(self.fingerprint))
+        return obs
 
     def _info(self, *, terminal: bool) -> dict[str, Any]:
         s = self.scene
@@ -343,6 +358,10 @@ class SfWExploreEnv(gym.Env):
             "floorplan": s.floorplan.name,
             "max_steps": self.episode_max_steps,
         }
+        if s.background is not None:  # dBm per background AP, NaN where not heard
+            info["fingerprint"] = np.where(
+                self.fingerprint > NOT_HEARD_DBM, self.fingerprint, np.nan
+            )
         if terminal:
             info["summary"] = {k: v for k, v in info.items() if np.isscalar(v)} | {
                 "steps": self.steps,

@@ -21,15 +21,28 @@ MAP_CHANNELS = ("belief", "trajectory_and_robot", "routers")
 TRAJECTORY_U8, ROBOT_U8 = 128, 255
 
 
-def observation_space(n_routers: int, map_px: int, crop_px: int) -> spaces.Dict:
-    """The Dict space: ``map`` (3, map_px, map_px), ``local`` (1, crop_px, crop_px), ``state``."""
-    return spaces.Dict(
-        {
-            "map": spaces.Box(0, 255, (len(MAP_CHANNELS), map_px, map_px), np.uint8),
-            "local": spaces.Box(0, 255, (1, crop_px, crop_px), np.uint8),
-            "state": spaces.Box(-1.0, 1.0, (state_size(n_routers),), np.float32),
-        }
-    )
+def observation_space(
+    n_routers: int, map_px: int, crop_px: int, n_background_aps: int = 0
+) -> spaces.Dict:
+    """The Dict space: ``map`` (3, map_px, map_px), ``local`` (1, crop_px, crop_px), ``state``;
+    with background access points also ``fingerprint`` (their RSSI scaled as the routers' in
+    ``state``, 0 where not heard) and ``fingerprint_heard`` (1 where heard)."""
+    entries: dict[str, spaces.Space] = {
+        "map": spaces.Box(0, 255, (len(MAP_CHANNELS), map_px, map_px), np.uint8),
+        "local": spaces.Box(0, 255, (1, crop_px, crop_px), np.uint8),
+        "state": spaces.Box(-1.0, 1.0, (state_size(n_routers),), np.float32),
+    }
+    if n_background_aps:
+        entries["fingerprint"] = spaces.Box(0.0, 1.0, (n_background_aps,), np.float32)
+        entries["fingerprint_heard"] = spaces.Box(0, 1, (n_background_aps,), np.int8)
+    return spaces.Dict(entries)
+
+
+def fingerprint_observation(rssi_dbm: np.ndarray) -> dict[str, np.ndarray]:
+    """The ``fingerprint`` entries for background RSSI readings (dBm; not heard at the floor)."""
+    heard = rssi_dbm > RSSI_FLOOR_DBM
+    scaled = np.clip((rssi_dbm - RSSI_FLOOR_DBM) / RSSI_SPAN_DB, 0.0, 1.0) * heard
+    return {"fingerprint": scaled.astype(np.float32), "fingerprint_heard": heard.astype(np.int8)}
 
 
 def state_size(n_routers: int) -> int:

@@ -15,7 +15,7 @@ from sfw_gym.world.floorplan import (
 from sfw_gym.world.generator import generate_floorplan
 from sfw_gym.world.radio import RadioConfig, RadioModel
 from sfw_gym.world.robot import Pose, Robot, RobotConfig, StepResult
-from sfw_gym.world.routers import place_routers
+from sfw_gym.world.routers import place_background_aps, place_routers
 
 __all__ = [
     "MATERIALS",
@@ -30,5 +30,6 @@ __all__ = [
     "floorplan_from_polygon",
     "generate_floorplan",
     "load_floorplan",
+    "place_background_aps",
     "place_routers",
 ]

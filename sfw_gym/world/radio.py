@@ -249,7 +249,8 @@ class RadioModel:
 
     Args:
         floorplan: the ground-truth plan.
-        routers: (R, 2) router positions in metres; each must lie in the free space.
+        routers: (R, 2) router positions in metres; each must lie in the free space unless
+            ``in_free_space`` is False (background access points).
         config: the radio parameters.
         rng: the source of the shadowing field (drawn here) and of temporal noise (each reading).
     """
@@ -260,10 +261,15 @@ class RadioModel:
         routers: np.ndarray,
         config: RadioConfig | None = None,
         rng: np.random.Generator | None = None,
+        *,
+        in_free_space: bool = True,
     ) -> None:
         self.floorplan = floorplan
         self.config = config or RadioConfig()
-        self.routers = validate_routers(floorplan, routers)
+        if in_free_space:
+            self.routers = validate_routers(floorplan, routers)
+        else:  # background access points may stand anywhere, walls and neighbours included
+            self.routers = np.asarray(routers, np.float64).reshape(-1, 2)
         self.rng = rng if rng is not None else np.random.default_rng()
         self._d0_loss_db = self.config.d0_loss_db
         losses = self.config.wall_loss_db

@@ -55,3 +55,34 @@ def place_routers(floorplan: Floorplan, n: int, rng: np.random.Generator) -> np.
         centres = KMeans(n_clusters=n, n_init=1, random_state=seed).fit(candidates).cluster_centers_
     nearest = np.argmin(np.linalg.norm(candidates[:, None] - centres[None], axis=2), axis=0)
     return candidates[nearest]
+
+
+def place_background_aps(
+    floorplan: Floorplan,
+    n: int,
+    rng: np.random.Generator,
+    *,
+    outside_share: float = 0.5,
+    reach_m: float = 10.0,
+) -> np.ndarray:
+    """``n`` access points beyond the mapping routers (n, 2): about ``1 - outside_share`` of
+    them in the building's free space, the others outside its footprint within ``reach_m`` of
+    it (neighbouring units), uniformly. The robot does not know where they are."""
+    if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 0:
+        raise ConfigError(f"number of background APs must be an integer >= 0, got {n!r}")
+    xmin, ymin, xmax, ymax = floorplan.bounds
+    n_out = int(rng.binomial(n, outside_share))
+    found: list[np.ndarray] = []
+    for inside, count, pad in ((True, n - n_out, 0.0), (False, n_out, reach_m)):
+        kept = np.zeros((0, 2))
+        for _ in range(200):
+            if len(kept) >= count:
+                break
+            pts = rng.uniform((xmin - pad, ymin - pad), (xmax + pad, ymax + pad), size=(256, 2))
+            shape = floorplan.free_space if inside else floorplan.footprint
+            hit = shapely.contains_xy(shape, pts[:, 0], pts[:, 1])
+            kept = np.vstack([kept, pts[hit if inside else ~hit]])
+        if len(kept) < count:
+            raise ConfigError(f"floorplan {floorplan.name!r}: no room for {count} access points")
+        found.append(kept[:count])
+    return np.concatenate(found)
