@@ -1,19 +1,24 @@
 """Radio SLAM from WiFi fingerprints (Liu et al., "Exploiting Radio Fingerprints for SLAM"):
 fingerprint similarity (Eq. 2), the similarity → distance model (Eq. 3), and an SE(2) pose graph
 of odometry and range edges optimised by a sparse Levenberg–Marquardt with a robust kernel
-(Eq. 1). Work in progress (issue 15): the env does not use it yet."""
+(Eq. 1), and :func:`radio_slam`, which puts them together on a run's odometry and fingerprints.
+Work in progress (issue 15): the env does not use it yet."""
 
 from __future__ import annotations
 
 from sfw_gym.slam.fingerprints import closure_candidates, cosine_similarity, kernel_similarity
 from sfw_gym.slam.pose_graph import PoseGraph, absolute_trajectory_error
+from sfw_gym.slam.radio_slam import RadioSlamConfig, RadioSlamResult, radio_slam
 from sfw_gym.slam.range_model import SimilarityRangeModel
 
 __all__ = [
     "PoseGraph",
+    "RadioSlamConfig",
+    "RadioSlamResult",
     "SimilarityRangeModel",
     "absolute_trajectory_error",
     "closure_candidates",
     "cosine_similarity",
     "kernel_similarity",
+    "radio_slam",
 ]

@@ -157,3 +157,35 @@ def test_closure_candidates_are_close_fingerprints_far_apart_along_the_path():
         0,
         2,
     )
+
+
+@pytest.mark.slow
+def test_radio_slam_on_a_drifting_run_with_background_aps_beats_odometry():
+    import gymnasium as gym
+
+    import sfw_gym  # noqa: F401  (registration)
+    from sfw_gym.agents import FrontierAgent
+    from sfw_gym.slam import radio_slam
+
+    noisy = {"odometry_translation_std": 0.05, "odometry_heading_std_rad": 0.02}
+    env = gym.make("SfW-Explore-v0", n_background_aps=16, robot=noisy, max_steps=1500)
+    obs, _ = env.reset(seed=2_000_001)
+    agent = FrontierAgent()
+    agent.reset(env, seed=0)
+    truth, odometry, prints = [], [], []
+    done = False
+    while not done:
+        obs, _, terminated, truncated, info = env.step(agent.act(obs))
+        truth.append(info["true_pose"])
+        odometry.append(info["odometry_pose"])
+        prints.append(info["fingerprint"])
+        done = terminated or truncated
+    truth, odometry = np.array(truth), np.array(odometry)
+    result = radio_slam(odometry, np.array(prints))
+    apart = np.linalg.norm(
+        truth[result.closures[:, 0], :2] - truth[result.closures[:, 1], :2], axis=1
+    )
+    assert len(apart) > 100 and np.mean(apart < 2.0) > 0.9  # closures are real revisits
+    before = absolute_trajectory_error(odometry, truth)
+    after = absolute_trajectory_error(result.poses, truth)
+    assert after < 0.7 * before, (before, after)

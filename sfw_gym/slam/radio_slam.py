@@ -1,0 +1,92 @@
+"""Radio SLAM (the paper's first system): odometry plus radio loop closures, optimised.
+
+:func:`radio_slam` takes a run's odometry poses and fingerprints: it fits the Eq. 3 distance
+model on pairs a short drive apart (where odometry has not drifted yet), finds closure candidates
+among fingerprints a long drive apart (a KD-tree), keeps those whose similarity passes a
+threshold and whose similarity bin has a distance estimate, and optimises the pose graph.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from sfw_gym.core.config import Config, setting
+from sfw_gym.slam.fingerprints import closure_candidates, kernel_similarity
+from sfw_gym.slam.pose_graph import PoseGraph
+from sfw_gym.slam.range_model import SimilarityRangeModel
+
+
+@dataclass(frozen=True)
+class RadioSlamConfig(Config):
+    """Radio SLAM's settings (distances in metres, RSSI in dB)."""
+
+    prefix: ClassVar[str | None] = "slam"
+    sigma_db: float = setting(6.0, gt=0.0, le=50.0)  # the kernel similarity's width
+    train_travel_m: float = setting(3.0, gt=0.0)  # pairs this short a drive apart fit the model
+    train_lag: int = setting(40, integer=True, ge=1)  # … at most this many poses apart
+    min_travel_m: float = setting(10.0, ge=0.0)  # closures: at least this long a drive apart
+    radius_db: float = setting(12.0, gt=0.0)  # closure candidates: fingerprints this close
+    threshold: float = setting(0.8, ge=0.0, le=1.0)  # … and at least this similar
+    max_closures: int = setting(2000, integer=True, ge=1)  # an even subsample beyond this
+    min_sigma_m: float = setting(0.3, gt=0.0)  # a closure's standard deviation at least
+    odometry_sigma_m: float = setting(0.02, gt=0.0)  # per step
+    odometry_sigma_rad: float = setting(0.02, gt=0.0)  # per step
+    robust: str = setting("cauchy", choices=("none", "huber", "cauchy"))
+
+
+@dataclass
+class RadioSlamResult:
+    """Corrected poses ``(N, 3)``, the closures used ``(C, 2)`` with their distance estimates."""
+
+    poses: np.ndarray
+    closures: np.ndarray
+    closure_distance_m: np.ndarray
+
+
+def radio_slam(
+    odometry: np.ndarray, fingerprints: np.ndarray, config: RadioSlamConfig | None = None
+) -> RadioSlamResult:
+    """Correct ``odometry`` ``(N, 3)`` with radio loop closures between ``fingerprints``
+    ``(N, L)`` (dBm, NaN where not heard)."""
+    cfg = config or RadioSlamConfig()
+    odo = np.asarray(odometry, np.float64)
+    fp = np.asarray(fingerprints, np.float64)
+    n = len(odo)
+    travelled = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(odo[:, :2], axis=0), axis=1))]
+    model = SimilarityRangeModel()
+    for lag in range(1, min(cfg.train_lag, n - 1) + 1):
+        i = np.arange(n - lag)
+        j = i + lag
+        short = travelled[j] - travelled[i] <= cfg.train_travel_m
+        d = np.linalg.norm(odo[j[short], :2] - odo[i[short], :2], axis=1)
+        model.update(kernel_similarity(fp[i[short]], fp[j[short]], cfg.sigma_db), d)
+    pairs = closure_candidates(
+        fp, travelled, min_travel_m=cfg.min_travel_m, radius_db=cfg.radius_db
+    )
+    similarity = kernel_similarity(fp[pairs[:, 0]], fp[pairs[:, 1]], cfg.sigma_db)
+    mean, var = model.predict(similarity)
+    keep = (similarity >= cfg.threshold) & np.isfinite(mean)
+    pairs, mean, var = pairs[keep], mean[keep], var[keep]
+    if len(pairs) > cfg.max_closures:
+        pick = np.linspace(0, len(pairs) - 1, cfg.max_closures).astype(int)
+        pairs, mean, var = pairs[pick], mean[pick], var[pick]
+    graph = PoseGraph(n, robust=cfg.robust)
+    for k in range(n - 1):
+        graph.add_odometry(
+            k, k + 1, _relative(odo[k], odo[k + 1]), cfg.odometry_sigma_m, cfg.odometry_sigma_rad
+        )
+    for (i, j), m, v in zip(pairs.tolist(), mean.tolist(), var.tolist(), strict=True):
+        graph.add_range(i, j, m, max(math.sqrt(v), cfg.min_sigma_m))
+    return RadioSlamResult(graph.optimize(odo), pairs, mean)
+
+
+def _relative(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float]:
+    """Pose ``b`` in ``a``'s frame."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    dth = (b[2] - a[2] + math.pi) % (2.0 * math.pi) - math.pi
+    return c * dx + s * dy, -s * dx + c * dy, dth
