@@ -44,11 +44,11 @@ def agent_class(name: str) -> type[Agent]:
     also reaches the evaluation's worker processes, where a :func:`register_agent` call made in
     the parent is unknown)."""
     entry_point = AGENTS.get(name) or (name if ":" in name else None)
-    if entry_point is None:
+    module, _, cls = (entry_point or "").partition(":")
+    if not (module and cls):
         raise ConfigError(
             f"unknown agent {name!r}; known: {sorted(AGENTS)} or a 'module:Class' of your own"
         )
-    module, _, cls = entry_point.partition(":")
     try:
         found = getattr(importlib.import_module(module), cls)
     except ImportError as exc:
@@ -59,6 +59,8 @@ def agent_class(name: str) -> type[Agent]:
         ) from None
     except AttributeError:
         raise ConfigError(f"agent {name!r}: module {module!r} has no {cls!r}") from None
+    except (ValueError, TypeError) as exc:  # e.g. a relative module name
+        raise ConfigError(f"agent {name!r}: cannot import {entry_point} ({exc})") from None
     if not (isinstance(found, type) and issubclass(found, Agent)):
         raise ConfigError(f"agent {name!r}: {entry_point} is not an sfw_gym Agent subclass")
     return found

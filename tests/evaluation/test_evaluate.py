@@ -105,6 +105,9 @@ def test_an_agent_of_ones_own_runs_in_the_workers_by_its_entry_point(tmp_path):
     entry = f"{__name__}:StraightAgent"
     result = ev.evaluate(["random", entry], 2, seed=5, out=tmp_path, **{**TINY, "workers": 2})
     assert sorted({r["agent"] for r in result["records"]}) == sorted(["random", entry])
+    for odd in (":", "x:", ":Agent", ".rel:Agent"):  # one clean line each
+        with pytest.raises(ConfigError, match="agent"):
+            ev.evaluate([odd], 1, out=tmp_path / "z", **TINY)
     with pytest.raises(ConfigError, match="has no 'Nope'"):
         ev.evaluate([f"{__name__}:Nope"], 1, out=tmp_path / "x", **TINY)
     with pytest.raises(ConfigError, match="is not an sfw_gym Agent subclass"):
