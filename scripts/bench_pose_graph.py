@@ -17,22 +17,7 @@ import time
 import numpy as np
 from scipy.spatial import cKDTree
 
-from sfw_gym.slam import PoseGraph, absolute_trajectory_error
-
-
-def relative(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float]:
-    c, s = math.cos(a[2]), math.sin(a[2])
-    d = b[:2] - a[:2]
-    return (
-        c * d[0] + s * d[1],
-        -s * d[0] + c * d[1],
-        (b[2] - a[2] + math.pi) % (2 * math.pi) - math.pi,
-    )
-
-
-def compose(a: np.ndarray, d: tuple[float, float, float]) -> np.ndarray:
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return np.array([a[0] + c * d[0] - s * d[1], a[1] + s * d[0] + c * d[1], a[2] + d[2]])
+from sfw_gym.slam import PoseGraph, absolute_trajectory_error, compose_pose, relative_pose
 
 
 def main() -> None:
@@ -50,10 +35,10 @@ def main() -> None:
     graph = PoseGraph(len(truth))
     odometry = [truth[0]]
     for k in range(len(truth) - 1):
-        dx, dy, dth = relative(truth[k], truth[k + 1])
+        dx, dy, dth = relative_pose(truth[k], truth[k + 1])
         measured = (dx * (1 + 0.01 * rng.normal()), dy, dth + 0.003 + 0.002 * rng.normal())
         graph.add_odometry(k, k + 1, measured, 0.05, 0.01)
-        odometry.append(compose(odometry[-1], measured))
+        odometry.append(compose_pose(odometry[-1], measured))
     odometry_arr = np.array(odometry)
     pairs = sorted(cKDTree(truth[:, :2]).query_pairs(args.closure_m))
     pairs = [(i, j) for i, j in pairs if abs(i - j) >= per_lap // 4][:: args.every]

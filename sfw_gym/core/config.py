@@ -113,6 +113,11 @@ def check(name: str, value: Any, **bounds: Any) -> Any:
     return Range(**bounds).check(name, value)
 
 
+def brief_repr(value: Any) -> str:
+    """``repr(value)`` on one line, at most 80 characters (for error messages)."""
+    return " ".join(repr(value).split())[:80]
+
+
 def float_array(name: str, value: Any) -> Any:
     """``value`` as a float64 numpy array, or a ConfigError naming ``name`` (for values that
     are no numbers at all: strings, dicts, ragged lists)."""
@@ -121,8 +126,7 @@ def float_array(name: str, value: Any) -> Any:
     try:
         return np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError, OverflowError):
-        brief = " ".join(repr(value).split())[:80]
-        raise ConfigError(f"{name} must be numbers, got {brief}") from None
+        raise ConfigError(f"{name} must be numbers, got {brief_repr(value)}") from None
 
 
 def unknown_key_error(what: str, key: Any, valid: Iterable[str]) -> ConfigError:

@@ -12,7 +12,7 @@ import numpy as np
 from gymnasium import spaces
 
 from sfw_gym.core.buffers import AppendOnlyArray
-from sfw_gym.core.config import unknown_key_error
+from sfw_gym.core.config import brief_repr, float_array, unknown_key_error
 from sfw_gym.core.constants import DISCRETE_ACTION_NAMES, DISCRETE_ACTIONS, NOT_HEARD_DBM
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.config import RESET_OPTIONS, ExploreConfig, RewardConfig
@@ -274,7 +274,6 @@ class SfWExploreEnv(gym.Env):
 
     def _command(self, action: Any) -> tuple[float, float]:
         cfg = self.robot_config
-        brief = " ".join(repr(action).split())[:80]  # one line, however big the action
         if self.action_type == "discrete":
             try:
                 a = np.asarray(action)
@@ -283,19 +282,15 @@ class SfWExploreEnv(gym.Env):
             if a.shape != () or a.dtype.kind not in "iu" or not 0 <= int(a) < len(DISCRETE_ACTIONS):
                 raise ConfigError(
                     f"action must be an integer in [0, {len(DISCRETE_ACTIONS)}) "
-                    f"({', '.join(DISCRETE_ACTION_NAMES)}), got {brief}"
+                    f"({', '.join(DISCRETE_ACTION_NAMES)}), got {brief_repr(action)}"
                 )
             lin, ang = DISCRETE_ACTIONS[int(a)]
         else:
-            try:
-                a = np.asarray(action, dtype=np.float64)
-            except (TypeError, ValueError):
-                raise ConfigError(
-                    f"action must be 2 numbers (linear, angular), got {brief}"
-                ) from None
+            a = float_array("action", action)
             if a.shape != (2,):
                 raise ConfigError(
-                    f"action must have shape (2,) = (linear, angular), got shape {a.shape}: {brief}"
+                    f"action must have shape (2,) = (linear, angular), got shape {a.shape}: "
+                    f"{brief_repr(action)}"
                 )
             if not np.isfinite(a).all():
                 raise ConfigError(f"action must be finite, got {a.tolist()}")

@@ -7,7 +7,12 @@ Work in progress (issue 15): the env does not use it yet."""
 from __future__ import annotations
 
 from sfw_gym.slam.fingerprints import closure_candidates, cosine_similarity, kernel_similarity
-from sfw_gym.slam.pose_graph import PoseGraph, absolute_trajectory_error
+from sfw_gym.slam.pose_graph import (
+    PoseGraph,
+    absolute_trajectory_error,
+    compose_pose,
+    relative_pose,
+)
 from sfw_gym.slam.radio_slam import RadioSlamConfig, RadioSlamResult, radio_slam
 from sfw_gym.slam.range_model import SimilarityRangeModel
 
@@ -18,7 +23,9 @@ __all__ = [
     "SimilarityRangeModel",
     "absolute_trajectory_error",
     "closure_candidates",
+    "compose_pose",
     "cosine_similarity",
     "kernel_similarity",
     "radio_slam",
+    "relative_pose",
 ]

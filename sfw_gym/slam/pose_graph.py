@@ -5,6 +5,7 @@ with a bounded force instead of bending the trajectory."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -18,6 +19,21 @@ ROBUST_KERNELS = ("none", "huber", "cauchy")
 
 def _wrap(angle: np.ndarray) -> np.ndarray:
     return (angle + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def relative_pose(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float]:
+    """Pose ``b`` seen from pose ``a``: ``(dx, dy, dθ)`` in ``a``'s frame (an odometry edge)."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    return c * dx + s * dy, -s * dx + c * dy, float(_wrap(b[2] - a[2]))
+
+
+def compose_pose(a: np.ndarray, delta: tuple[float, float, float]) -> np.ndarray:
+    """The pose ``delta`` (in ``a``'s frame) leads to from ``a``: the inverse of
+    :func:`relative_pose`."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    dx, dy, dth = delta
+    return np.array([a[0] + c * dx - s * dy, a[1] + s * dx + c * dy, a[2] + dth])
 
 
 @dataclass

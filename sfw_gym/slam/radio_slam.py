@@ -16,7 +16,7 @@ import numpy as np
 
 from sfw_gym.core.config import Config, setting
 from sfw_gym.slam.fingerprints import closure_candidates, kernel_similarity
-from sfw_gym.slam.pose_graph import PoseGraph
+from sfw_gym.slam.pose_graph import PoseGraph, relative_pose
 from sfw_gym.slam.range_model import SimilarityRangeModel
 
 
@@ -77,16 +77,12 @@ def radio_slam(
     graph = PoseGraph(n, robust=cfg.robust)
     for k in range(n - 1):
         graph.add_odometry(
-            k, k + 1, _relative(odo[k], odo[k + 1]), cfg.odometry_sigma_m, cfg.odometry_sigma_rad
+            k,
+            k + 1,
+            relative_pose(odo[k], odo[k + 1]),
+            cfg.odometry_sigma_m,
+            cfg.odometry_sigma_rad,
         )
     for (i, j), m, v in zip(pairs.tolist(), mean.tolist(), var.tolist(), strict=True):
         graph.add_range(i, j, m, max(math.sqrt(v), cfg.min_sigma_m))
     return RadioSlamResult(graph.optimize(odo), pairs, mean)
-
-
-def _relative(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float]:
-    """Pose ``b`` in ``a``'s frame."""
-    c, s = math.cos(a[2]), math.sin(a[2])
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    dth = (b[2] - a[2] + math.pi) % (2.0 * math.pi) - math.pi
-    return c * dx + s * dy, -s * dx + c * dy, dth

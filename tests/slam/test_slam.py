@@ -14,8 +14,10 @@ from sfw_gym.slam import (
     SimilarityRangeModel,
     absolute_trajectory_error,
     closure_candidates,
+    compose_pose,
     cosine_similarity,
     kernel_similarity,
+    relative_pose,
 )
 
 nan = np.nan
@@ -63,32 +65,15 @@ def square_loop(n_side: int = 10, side_m: float = 10.0, laps: int = 2) -> np.nda
     return np.array(poses)
 
 
-def relative(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float]:
-    c, s = math.cos(a[2]), math.sin(a[2])
-    d = b[:2] - a[:2]
-    return (
-        c * d[0] + s * d[1],
-        -s * d[0] + c * d[1],
-        (b[2] - a[2] + math.pi) % (2 * math.pi) - math.pi,
-    )
-
-
-def compose(a: np.ndarray, delta: tuple[float, float, float]) -> np.ndarray:
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return np.array(
-        [a[0] + c * delta[0] - s * delta[1], a[1] + s * delta[0] + c * delta[1], a[2] + delta[2]]
-    )
-
-
 def drifting_graph(truth: np.ndarray, robust: str, false_closure: bool = False):
     """Odometry with a heading bias, radio closures between the laps' poses 1.5 m or less apart."""
     graph = PoseGraph(len(truth), robust=robust)
     odometry = [truth[0]]
     for k in range(len(truth) - 1):
-        dx, dy, dth = relative(truth[k], truth[k + 1])
+        dx, dy, dth = relative_pose(truth[k], truth[k + 1])
         measured = (dx, dy, dth + 0.02)  # 0.02 rad of heading drift per step
         graph.add_odometry(k, k + 1, measured, sigma_xy=0.05, sigma_theta=0.02)
-        odometry.append(compose(odometry[-1], measured))
+        odometry.append(compose_pose(odometry[-1], measured))
     for i in range(len(truth)):
         for j in range(i + 20, len(truth)):  # the second lap passes the first
             d = float(np.linalg.norm(truth[i, :2] - truth[j, :2]))
@@ -109,7 +94,7 @@ def test_odometry_alone_is_kept_and_closures_undo_the_drift():
     np.testing.assert_allclose(solved[0], odometry[0], atol=1e-6)  # the first pose stays
     chain = PoseGraph(len(truth))
     for k in range(len(truth) - 1):
-        chain.add_odometry(k, k + 1, relative(odometry[k], odometry[k + 1]), 0.05, 0.02)
+        chain.add_odometry(k, k + 1, relative_pose(odometry[k], odometry[k + 1]), 0.05, 0.02)
     np.testing.assert_allclose(chain.optimize(odometry), odometry, atol=1e-9)  # nothing to fix
 
 
