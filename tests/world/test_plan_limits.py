@@ -55,3 +55,48 @@ def test_a_plan_over_the_vertex_limit_is_refused_by_name(tmp_path):
 def test_counting_walls_from_a_nan_point_is_an_error_not_zero(two_rooms):
     with pytest.raises(FloorplanError, match=r"must be finite; rows \[1\] are not"):
         two_rooms.count_walls(np.array([[1.0, 1.0], [np.nan, 1.0]]), np.array([9.0, 1.0]))
+
+
+def test_a_bulk_plan_robot_keeps_clear_of_every_wall_and_its_copies_continue_exactly():
+    """Over BULK_VERTICES walls pymunk holds only those near the robot, chosen again as it
+    moves: the robot must still stop at every wall, and a pickled copy (taken at any step)
+    must drive on exactly like the original."""
+    import pickle
+
+    from sfw_gym.core.constants import BULK_VERTICES
+    from sfw_gym.world import generate_floorplan
+    from sfw_gym.world.robot import Robot, RobotConfig
+
+    plan = generate_floorplan(3)
+    pieces = int(np.ceil((BULK_VERTICES + 1) / len(plan.edges)))
+    t = np.linspace(0.0, 1.0, pieces + 1)[:, None]
+    a, b = plan.edges[:, None, :2], plan.edges[:, None, 2:]
+    walls = np.concatenate([a + (b - a) * t[:-1], a + (b - a) * t[1:]], axis=2).reshape(-1, 4)
+    assert len(walls) > BULK_VERTICES
+    config = RobotConfig()
+    for trial in range(6):
+        rng = np.random.default_rng(trial)
+        pose = plan.free_space.buffer(-0.3).representative_point()
+        robot = Robot(walls, config, (pose.x, pose.y, rng.uniform(-3, 3)))
+        commands = rng.uniform([-0.5, -1.5], [0.5, 1.5], (400, 2))
+        commands[rng.random(400) < 0.6, 0] = 0.5  # mostly full speed ahead: many contacts
+        copy_at, copy = int(rng.integers(50, 300)), None
+        bumps = 0
+        for i, (v, w) in enumerate(commands):
+            step = robot.step(v, w)
+            bumps += step.bumped
+            if copy is not None:
+                assert copy.step(v, w) == step, f"trial {trial}: the copy left at step {i}"
+            elif i == copy_at:
+                copy = pickle.loads(pickle.dumps(robot))
+            centre = np.array(step.pose[:2])
+            clearance = np.min(np.hypot(*(centre - _closest(centre, walls)).T))
+            assert clearance >= config.radius_m, f"trial {trial} step {i}: into a wall"
+        assert bumps > 10  # the drive did meet walls
+        assert len(robot._active_walls) < len(walls) / 2  # pymunk holds the nearby walls only
+
+
+def _closest(p: np.ndarray, walls: np.ndarray) -> np.ndarray:
+    a, d = walls[:, :2], walls[:, 2:] - walls[:, :2]
+    t = np.clip(np.einsum("ij,ij->i", p - a, d) / np.einsum("ij,ij->i", d, d), 0.0, 1.0)
+    return a + t[:, None] * d
