@@ -3,7 +3,8 @@ started by behaviour cloning) with checkpoints, resume, held-out evaluation and 
 
 Layout of an output folder::
 
-    OUT/checkpoints/<algo>_<steps>_steps.zip   every ``checkpoint_every`` env steps
+    OUT/checkpoints/<algo>_<steps>_steps.zip   every ``checkpoint_every`` env steps, each with
+    OUT/checkpoints/<algo>_<steps>_steps.state.pkl   what an exact resume needs (rl.resume)
     OUT/tb/                                 TensorBoard logs
     OUT/train_<start>.monitor.csv           episode return, length, floorplan (one per run segment)
     OUT/eval/evaluations.npz                held-out evaluation (EvalCallback)
@@ -26,9 +27,16 @@ from typing import Any
 import numpy as np
 import yaml
 
-from sfw_gym.core.atomic import atomic_path, write_text_atomic
+from sfw_gym.core.atomic import atomic_path, remove_stale_temps, write_text_atomic
 from sfw_gym.core.data import DEFAULT_HYPERPARAMS
 from sfw_gym.core.errors import ConfigError
+from sfw_gym.rl.resume import (
+    Snapshots,
+    restore_state,
+    resumable_checkpoints,
+    save_checkpoint,
+    state_path,
+)
 
 #: Classes that moved, by their old dotted path: configs and models saved before still load.
 MOVED_CLASSES = {
@@ -176,7 +184,7 @@ def _make_env_fn(env_id: str, env_kwargs: dict[str, Any], wrappers: list[tuple[s
         env = gym.make(env_id, **env_kwargs)
         for name, kwargs in wrappers:
             env = import_dotted(name)(env, **kwargs)
-        return env
+        return Snapshots(env)
 
     return make
 
@@ -184,7 +192,7 @@ def _make_env_fn(env_id: str, env_kwargs: dict[str, Any], wrappers: list[tuple[s
 def _make_venv(
     env_id: str,
     n_envs: int,
-    seed: int,
+    seed: int | None,
     env_kwargs: dict[str, Any],
     wrappers: list[tuple[str, dict]],
     monitor: Path,
@@ -195,7 +203,8 @@ def _make_venv(
     qualified = env_id if ":" in env_id else f"sfw_gym:{env_id}"
     fns = [_make_env_fn(qualified, env_kwargs, wrappers) for _ in range(n_envs)]
     venv = SubprocVecEnv(fns) if n_envs > 1 else DummyVecEnv(fns)
-    venv.seed(seed)
+    if seed is not None:  # None: the envs' states are restored instead
+        venv.seed(seed)
     # The floorplan column lets a later comparison prove its plans were never trained on.
     return VecMonitor(venv, filename=str(monitor), info_keywords=("floorplan",))
 
@@ -226,8 +235,10 @@ def train_ppo(
     ``use_masking: false`` (an ablation) ignores the masks in cloning, rollouts and updates.
 
     With ``resume=True`` the latest checkpoint in ``OUT/checkpoints`` is loaded and training
-    continues from its step count (the step counter, optimiser and rollout schedule carry on);
-    without a checkpoint it starts afresh. Returns a summary (steps, wall time, paths).
+    continues from it exactly (envs mid-episode, random generators, step counter, optimiser and
+    schedules: the final model equals an uninterrupted run's; :mod:`sfw_gym.rl.resume`);
+    without a checkpoint it starts afresh. Checkpoints are taken between PPO iterations, at the
+    first after every ``checkpoint_every`` env steps. Returns a summary (steps, wall time, paths).
 
     ``num_threads``: PyTorch's CPU threads in this process (rl-zoo's ``--num-threads``; None:
     PyTorch's default). One suits these small networks: more contend with the env workers for
@@ -274,8 +285,11 @@ def train_ppo(
     for name, _ in wrappers:
         import_dotted(name)
 
+    if resume:
+        remove_stale_temps(out)  # of a run killed mid-write
     previous = latest_checkpoint(out, algo) if resume else None
     start_steps = previous[1] if previous else 0
+    exact = previous is not None and state_path(previous[0]).is_file()
     if previous is not None and start_steps >= timesteps:  # already there (killed after its last
         with atomic_path(out / "model.zip") as tmp:  # checkpoint)
             shutil.copyfile(previous[0], tmp)
@@ -284,7 +298,7 @@ def train_ppo(
         venv = _make_venv(
             env_id,
             n_envs,
-            seed + start_steps,
+            None if exact else seed + start_steps,
             env_kwargs,
             wrappers,
             out / f"train_{start_steps}.monitor.csv",
@@ -292,7 +306,7 @@ def train_ppo(
         eval_env = _make_venv(
             env_id,
             1,
-            seed + HELD_OUT_SEED_OFFSET,
+            None if exact else seed + HELD_OUT_SEED_OFFSET,
             env_kwargs,
             wrappers,
             out / f"eval_{start_steps}.monitor.csv",
@@ -302,6 +316,8 @@ def train_ppo(
                 model = Algo.load(
                     previous[0], env=venv, device=device, tensorboard_log=str(out / "tb")
                 )
+                if exact:
+                    restore_state(model, venv, eval_env, previous[0])
             else:
                 model = Algo(
                     policy,
@@ -333,11 +349,12 @@ def train_ppo(
             )
             if previous:  # a resumed run appends to the evaluations so far, not over them
                 _continue_evaluations(evaluations, out / "eval" / "evaluations.npz", start_steps)
+                evaluations.n_calls = start_steps // n_envs  # and keeps their schedule
             callbacks = CallbackList(
                 [
                     *grad_norms,
-                    _atomic_checkpoints(
-                        max(checkpoint_every // n_envs, 1), out / "checkpoints", algo
+                    resumable_checkpoints(
+                        checkpoint_every, out / "checkpoints", algo, venv, eval_env
                     ),
                     evaluations,
                 ]
@@ -354,7 +371,8 @@ def train_ppo(
             wall = time.perf_counter() - start
             _save_atomic(model, out / "model.zip")
             # A final checkpoint, so that a later resume starts from the end of this run.
-            _save_atomic(model, out / "checkpoints" / f"{algo}_{model.num_timesteps}_steps.zip")
+            final = out / "checkpoints" / f"{algo}_{model.num_timesteps}_steps.zip"
+            save_checkpoint(model, venv, eval_env, final)
         finally:
             venv.close()
             eval_env.close()
@@ -440,20 +458,6 @@ def _monitored_seconds(out: Path) -> float:
             except (IndexError, ValueError):
                 continue
     return total
-
-
-def _atomic_checkpoints(save_freq: int, folder: Path, prefix: str) -> Any:
-    """SB3's ``CheckpointCallback``, each save written atomically: a kill during a save leaves
-    the earlier checkpoints, never a truncated newest one for ``--resume`` to fail on."""
-    from stable_baselines3.common.callbacks import CheckpointCallback
-
-    class AtomicCheckpoints(CheckpointCallback):
-        def _on_step(self) -> bool:
-            if self.n_calls % self.save_freq == 0:
-                _save_atomic(self.model, Path(self._checkpoint_path(extension="zip")))
-            return True
-
-    return AtomicCheckpoints(save_freq, str(folder), name_prefix=prefix)
 
 
 def _save_atomic(model: Any, path: Path) -> None:

@@ -77,24 +77,28 @@ def test_dagger_rounds_follow_the_cloning_episodes_and_refit_on_everything(monke
 
 
 def test_a_save_killed_midway_leaves_no_checkpoint_under_its_name(tmp_path):
-    from sfw_gym.rl.training import _atomic_checkpoints
+    from sfw_gym.rl.resume import save_checkpoint, state_path
 
-    class Model:  # what the callback touches of an SB3 model
-        num_timesteps, logger = 64, None
-
-        def get_env(self):
-            return None
+    class Model:  # what a checkpoint takes of an SB3 model
+        num_timesteps, _last_obs, _last_episode_starts = 64, None, None
+        ep_info_buffer = ep_success_buffer = None
 
         def save(self, path):
             Path(path).write_bytes(b"PK half a zip")
             raise KeyboardInterrupt  # killed during the save
 
-    callback = _atomic_checkpoints(1, tmp_path / "checkpoints", "ppo")
-    callback.init_callback(Model())
+    class Venv:  # and of its VecMonitor
+        episode_returns = episode_lengths = episode_count = 0
+
+        def env_method(self, name):
+            return [b"env"]
+
+    path = tmp_path / "checkpoints" / "ppo_64_steps.zip"
     with pytest.raises(KeyboardInterrupt):
-        callback.on_step()
+        save_checkpoint(Model(), Venv(), Venv(), path)
     assert latest_checkpoint(tmp_path) is None
-    assert not list((tmp_path / "checkpoints").iterdir())  # nor a temp file
+    # the state went first; the zip, which makes a checkpoint, never arrived, nor a temp file
+    assert sorted((tmp_path / "checkpoints").iterdir()) == [state_path(path)]
 
 
 def test_policy_kwargs_are_parsed_safely():
@@ -103,44 +107,94 @@ def test_policy_kwargs_are_parsed_safely():
         parse_policy_kwargs("dict(activation_fn=__import__('os').system('true'))")
 
 
-def test_killed_run_resumes_from_its_last_checkpoint(tmp_path):
-    out = tmp_path / "run"
-    script = textwrap.dedent(f"""
-        from sfw_gym.rl.training import train_ppo
-        train_ppo("SfW-ExploreSmall-v0", 100_000, {str(out)!r}, n_envs=1, env_kwargs={TINY!r},
-                  checkpoint_every=64, eval_every=10**9, progress_bar=False)
-    """)
-    proc = subprocess.Popen([sys.executable, "-c", script])
-    try:
-        deadline = time.monotonic() + 240
-        while time.monotonic() < deadline:
-            found = latest_checkpoint(out)
-            if found and found[1] >= 128:
-                break
-            assert proc.poll() is None, "training ended before it was killed"
-            time.sleep(0.5)
-        else:
-            pytest.fail("no checkpoint within 240 s")
-    finally:
-        proc.send_signal(signal.SIGKILL)
-        proc.wait()
-    path, steps = latest_checkpoint(out)
-    target = steps + 128
-    summary = train_ppo(
-        "SfW-ExploreSmall-v0",
-        target,
-        out,
-        n_envs=1,
-        env_kwargs=TINY,
-        checkpoint_every=64,
-        eval_every=10**9,
-        resume=True,
-        progress_bar=False,
+@pytest.mark.slow
+def test_a_run_killed_five_times_ends_with_the_uninterrupted_runs_model(tmp_path):
+    """SIGKILL at random points (each after a new checkpoint), resume each time: the final
+    model and the held-out evaluations equal those of a run never interrupted."""
+    run = dict(n_envs=2, env_kwargs=TINY, checkpoint_every=128, eval_every=256, eval_episodes=2)
+    target = 2560
+    out = tmp_path / "killed"
+    main = tmp_path / "main.py"  # a file: SB3's workers start by forkserver and import it
+    main.write_text(
+        textwrap.dedent(f"""
+            from sfw_gym.rl.training import train_ppo
+            if __name__ == "__main__":
+                train_ppo("SfW-ExploreSmall-v0", {target}, {str(out)!r}, resume=True,
+                          progress_bar=False, **{run!r})
+        """)
     )
-    assert summary["resumed_from"] == str(path)
-    assert target <= summary["steps"] < target + 128  # continued, not restarted from 0
-    assert latest_checkpoint(out)[1] == summary["steps"]
-    assert (out / "model.zip").exists() and (out / "config.yml").exists()
+    rng = np.random.default_rng(5)
+    kills, resumed_at = 0, 0
+    while True:
+        proc = subprocess.Popen([sys.executable, str(main)], start_new_session=True)
+        try:
+            deadline = time.monotonic() + 240
+            while proc.poll() is None and time.monotonic() < deadline:
+                found = latest_checkpoint(out)
+                if kills < 5 and found and found[1] > resumed_at:
+                    time.sleep(rng.uniform(0.0, 1.0))  # somewhere in the next iteration
+                    os.killpg(proc.pid, signal.SIGKILL)
+                    kills += 1
+                    break
+                time.sleep(0.1)
+        finally:
+            if proc.poll() is None:
+                os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+        if proc.returncode == 0:
+            break
+        assert proc.returncode == -signal.SIGKILL, "training failed on its own"
+        resumed_at = latest_checkpoint(out)[1]
+    assert kills == 5 and resumed_at < target
+    train_ppo("SfW-ExploreSmall-v0", target, tmp_path / "whole", progress_bar=False, **run)
+    for name in ("policy.pth", "policy.optimizer.pth"):
+        killed, whole = (
+            _zip_tensors(tmp_path / d / "model.zip", name) for d in ("killed", "whole")
+        )
+        assert killed.keys() == whole.keys()
+        assert all(torch_equal(killed[k], whole[k]) for k in killed), name
+    killed, whole = (
+        np.load(tmp_path / d / "eval" / "evaluations.npz") for d in ("killed", "whole")
+    )
+    assert (
+        killed["timesteps"].tolist()
+        == whole["timesteps"].tolist()
+        == list(range(256, target + 1, 256))
+    )
+    np.testing.assert_array_equal(killed["results"], whole["results"])
+    assert not list(out.rglob(".*.tmp*"))  # no temp file left behind by the kills
+
+
+def _zip_tensors(path: Path, member: str) -> dict:
+    import io
+    import zipfile
+
+    import torch
+
+    with zipfile.ZipFile(path) as archive:
+        state = torch.load(io.BytesIO(archive.read(member)), weights_only=False)
+    flat: dict = {}
+
+    def walk(prefix: str, value) -> None:
+        if isinstance(value, dict):
+            for k, v in value.items():
+                walk(f"{prefix}.{k}", v)
+        elif isinstance(value, list | tuple):
+            for k, v in enumerate(value):
+                walk(f"{prefix}.{k}", v)
+        else:
+            flat[prefix] = value
+
+    walk("", state)
+    return flat
+
+
+def torch_equal(a, b) -> bool:
+    import torch
+
+    if isinstance(a, torch.Tensor):
+        return isinstance(b, torch.Tensor) and torch.equal(a, b)
+    return a == b
 
 
 def test_maskable_ppo_on_candidate_goals_starts_from_the_frontier_agents_choices(
