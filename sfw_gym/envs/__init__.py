@@ -33,6 +33,13 @@ ENV_IDS: dict[str, dict[str, Any]] = {
         "robot": {"odometry_translation_std": 0.05, "odometry_heading_std_rad": 0.02},
         "n_background_aps": 16,
     },
+    # The same drift, mapped along Radio SLAM's trajectory: solved again every 100 steps, the
+    # map rebuilt along each correction (sfw_gym.slam.OnlineRadioSlam).
+    "SfW-ExploreRadioSLAM-v0": {
+        "robot": {"odometry_translation_std": 0.05, "odometry_heading_std_rad": 0.02},
+        "n_background_aps": 16,
+        "pose_source": "radio_slam",
+    },
 }
 #: Ids whose env is not the explore env itself.
 ENTRY_POINTS: dict[str, str] = {"SfW-ExploreGoals-v0": "sfw_gym.envs.goals:SfWGoalsEnv"}

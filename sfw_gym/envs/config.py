@@ -6,9 +6,13 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from sfw_gym.core.config import Config, setting
+from sfw_gym.core.errors import ConfigError
 from sfw_gym.world.radio import BANDS, PRESETS
 
 ACTION_TYPES = ("continuous", "discrete")
+#: Where the robot believes it is, and so where it maps: its odometry, Radio SLAM (odometry
+#: corrected by radio loop closures, the map rebuilt along each correction), or the truth.
+POSE_SOURCES = ("odometry", "radio_slam", "true")
 #: Keys of ``reset(options=...)``.
 RESET_OPTIONS = ("floorplan", "routers", "start_pose")
 
@@ -43,3 +47,11 @@ class ExploreConfig(Config):
     max_steps: int = setting(3000, integer=True, ge=1, le=10**7)
     steps_per_m2: float | None = setting(None, optional=True, ge=1e-3, le=1e5)
     n_background_aps: int = setting(0, integer=True, ge=0, le=64)
+    pose_source: str = setting("odometry", choices=POSE_SOURCES)
+
+    def validate(self) -> None:
+        if self.pose_source == "radio_slam" and self.n_background_aps < 1:
+            raise ConfigError(
+                "pose_source='radio_slam' closes loops with background access points: "
+                "pass n_background_aps >= 1 (SfW-ExploreRadioSLAM-v0 has 16)"
+            )

@@ -17,6 +17,7 @@ from sfw_gym.core.constants import DISCRETE_ACTION_NAMES, DISCRETE_ACTIONS, NOT_
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.config import RESET_OPTIONS, ExploreConfig, RewardConfig
 from sfw_gym.envs.episode import EpisodeScene, GroundTruth, build_scene
+from sfw_gym.envs.map_history import MapHistory
 from sfw_gym.envs.map_tracker import MapTracker
 from sfw_gym.envs.observation import (
     ObservationBuilder,
@@ -25,6 +26,7 @@ from sfw_gym.envs.observation import (
 )
 from sfw_gym.mapping import GridSpec, MapperConfig, SparseInverseKVisibility
 from sfw_gym.navigation.view import RobotView
+from sfw_gym.slam import OnlineRadioSlam, RadioSlamConfig
 from sfw_gym.world import Floorplan, RadioConfig, RobotConfig
 from sfw_gym.world.generator import GeneratorConfig
 
@@ -122,6 +124,8 @@ class SfWExploreEnv(gym.Env):
         max_steps: int = 3000,
         steps_per_m2: float | None = None,
         n_background_aps: int = 0,
+        pose_source: str = "odometry",
+        slam: dict[str, Any] | None = None,
         render_mode: str | None = None,
         render_size: tuple[int, int] | None = (960, 480),
         **unknown: Any,
@@ -146,6 +150,7 @@ class SfWExploreEnv(gym.Env):
             max_steps=max_steps,
             steps_per_m2=steps_per_m2,
             n_background_aps=n_background_aps,
+            pose_source=pose_source,
         )
         self.reward_config = RewardConfig(
             reward_scale=reward_scale,
@@ -183,6 +188,8 @@ class SfWExploreEnv(gym.Env):
         self._folder_plans = _folder_plans(floorplan)
 
         self.n_background_aps = cfg.n_background_aps
+        self.pose_source = cfg.pose_source
+        self.slam_config = RadioSlamConfig.from_dict(slam, "slam")
         self.observation_space = observation_space(n_routers, map_px, crop_px, cfg.n_background_aps)
         if action_type == "continuous":
             self.action_space = spaces.Box(-1.0, 1.0, (2,), np.float32)
@@ -236,7 +243,15 @@ class SfWExploreEnv(gym.Env):
         self._routers_view = np.array(s.radio.routers, np.float64)
         self._routers_view.flags.writeable = False
         self.trajectory: list[tuple[float, float]] = []
-        self.odometry_trajectory = AppendOnlyArray(2, np.float64)
+        self.odometry_trajectory = AppendOnlyArray(2, np.float64)  # of the pose estimate
+        self.pose_estimates = AppendOnlyArray(3, np.float64)
+        self.pose_estimate = tuple(s.robot.odometry_pose)
+        self._squared_pose_errors = 0.0
+        self.slam: OnlineRadioSlam | None = None
+        self.map_history: MapHistory | None = None
+        if self.pose_source == "radio_slam":
+            self.slam = OnlineRadioSlam(self.slam_config, self.slam_config.solve_every)
+            self.map_history = MapHistory(self.slam_config.solve_every)
         self.last_gain_bits = 0.0
         self.last_rays: np.ndarray = np.zeros(0, np.int64)
         obs = self._sense_and_map(bumped=False)
@@ -301,35 +316,89 @@ class SfWExploreEnv(gym.Env):
         s = self.scene
         assert s is not None
         true_pose = s.robot.pose
-        odom = s.robot.odometry_pose
         rssi, true_k = s.radio.measure_with_k(np.array(true_pose[:2]))
+        if s.background is not None:  # the fingerprint of the access points beyond the routers
+            self.fingerprint = s.background.measure(np.array(true_pose[:2])).astype(np.float64)
+        entropy_before = self.mapper.entropy_bits
+        pose = self._estimate_pose(true_pose)
+        self.pose_estimate = pose
         self.rssi_history.append(rssi)
         self.trajectory.append((true_pose.x, true_pose.y))
-        self.odometry_trajectory.append((odom.x, odom.y))
-        (x0, y0, x1, y1) = self._grid_bounds
-        if x0 <= odom.x < x1 and y0 <= odom.y < y1:
-            self.last_gain_bits = self.mapper.update(
-                odom[:2], rssi.astype(np.float64), bumped=bumped, heading_rad=odom.theta
-            )
-            self.tracker.apply(self.mapper.last_changed_cells, self.mapper.occupancy_u8)
+        self.odometry_trajectory.append(pose[:2])
+        self.pose_estimates.append(pose)
+        self._squared_pose_errors += (pose[0] - true_pose.x) ** 2 + (pose[1] - true_pose.y) ** 2
+        if self.map_history is not None:
+            self.map_history.record(len(self.trajectory) - 1, self.mapper, bumped)
+        updated, self.last_gain_bits = self._map_at(pose, rssi, bumped)
+        if updated:
             est_k = self.mapper.last_k
             heard = (rssi > NOT_HEARD_DBM) & (est_k >= 0)
             # k = K means "K or more walls" (sfw_gym.mapping.metrics.k_value_accuracy with max_k)
             true_k = np.minimum(true_k, self.mapper_config.max_k)
             self.k_correct += int((est_k[heard] == true_k[heard]).sum())
             self.k_total += int(heard.sum())
-        else:  # odometry drifted off the map: nothing to update (documented in the info)
-            self.last_gain_bits = 0.0
-        self.obs_builder.mark_visited(odom.x, odom.y)
+        if self.slam is not None:  # a replay moved the entropy too: the gain is the difference
+            self.last_gain_bits = entropy_before - self.mapper.entropy_bits
+        self.obs_builder.mark_visited(pose[0], pose[1])
         rssi_slots = np.full(self.n_routers, float(NOT_HEARD_DBM))
         rssi_slots[: len(rssi)] = rssi
         obs = self.obs_builder.build(
-            self.mapper.occupancy_u8, rssi_slots, bumped, odom, self.tracker.known_fraction
+            self.mapper.occupancy_u8, rssi_slots, bumped, pose, self.tracker.known_fraction
         )
-        if s.background is not None:  # the fingerprint of the access points beyond the routers
-            self.fingerprint = s.background.measure(np.array(true_pose[:2])).astype(np.float64)
+        if s.background is not None:
             obs.update(fingerprint_observation(self.fingerprint))
         return obs
+
+    def _estimate_pose(self, true_pose: tuple[float, float, float]) -> tuple[float, float, float]:
+        """This step's pose estimate from the env's pose source (Radio SLAM: after a solve that
+        moved past poses, the map is rebuilt along them first)."""
+        assert self.scene is not None
+        if self.pose_source == "true":
+            return tuple(true_pose)
+        odometry = self.scene.robot.odometry_pose
+        if self.slam is None:
+            return tuple(odometry)
+        moved_from = self.slam.add(odometry, self.fingerprint)
+        if moved_from is not None:
+            self._remap(self.slam.estimate()[:-1], moved_from)
+        return tuple(self.slam.latest().tolist())
+
+    def _map_at(
+        self, pose: tuple[float, float, float], rssi: np.ndarray, bumped: bool
+    ) -> tuple[bool, float]:
+        """Fuse a reading at ``pose``: whether it was fused, and the information gain (bits).
+        Nothing is fused where the estimate lies off the map (odometry drifted out of it)."""
+        x0, y0, x1, y1 = self._grid_bounds
+        if not (x0 <= pose[0] < x1 and y0 <= pose[1] < y1):
+            return False, 0.0
+        gain = self.mapper.update(
+            pose[:2], rssi.astype(np.float64), bumped=bumped, heading_rad=pose[2]
+        )
+        self.tracker.apply(self.mapper.last_changed_cells, self.mapper.occupancy_u8)
+        return True, gain
+
+    def _remap(self, poses: np.ndarray, first: int) -> None:
+        """Rebuild the map along corrected ``poses`` of the steps so far, from the last mapper
+        snapshot at or before step ``first`` (the earliest pose that moved)."""
+        assert self.map_history is not None and self.scene is not None
+        self.mapper, start = self.map_history.restore(first)
+        rssi, bumps = self.rssi_history.view, self.map_history.bumps
+        for t in range(start, len(poses)):
+            self.map_history.snapshot(t, self.mapper)
+            x0, y0, x1, y1 = self._grid_bounds
+            x, y, theta = poses[t]
+            if x0 <= x < x1 and y0 <= y < y1:
+                self.mapper.update((x, y), rssi[t].astype(np.float64), bumps[t], theta)
+        self.tracker.apply(np.arange(self.mapper.occupancy_u8.size), self.mapper.occupancy_u8)
+        self.odometry_trajectory = AppendOnlyArray(2, np.float64, len(poses) + 1024)
+        self.pose_estimates = AppendOnlyArray(3, np.float64, len(poses) + 1024)
+        self.obs_builder.clear_visited()
+        for x, y, theta in poses.tolist():
+            self.odometry_trajectory.append((x, y))
+            self.pose_estimates.append((x, y, theta))
+            self.obs_builder.mark_visited(x, y)
+        truth = np.asarray(self.trajectory, np.float64)
+        self._squared_pose_errors = float(np.sum((poses[:, :2] - truth) ** 2))
 
     def _info(self, *, terminal: bool) -> dict[str, Any]:
         s = self.scene
@@ -346,6 +415,9 @@ class SfWExploreEnv(gym.Env):
             "collisions": self.collisions,
             "true_pose": np.array(s.robot.pose, np.float64),
             "odometry_pose": np.array(s.robot.odometry_pose, np.float64),
+            "pose_estimate": np.array(self.pose_estimate, np.float64),  # where it maps
+            "pose_error_m": math.dist(self.pose_estimate[:2], s.robot.pose[:2]),
+            "ate_m": math.sqrt(self._squared_pose_errors / len(self.trajectory)),
             "entropy_bits": self.mapper.entropy_bits,
             "info_gain_bits": self.last_gain_bits,
             "steps_to_coverage_50": self.steps_to[0.5],
@@ -375,7 +447,7 @@ class SfWExploreEnv(gym.Env):
         if s is None:
             raise gym.error.ResetNeeded("call reset() before robot_view()")
         cfg = self.robot_config
-        odom_x, odom_y, odom_theta = s.robot.odometry_pose
+        odom_x, odom_y, odom_theta = self.pose_estimate
         return RobotView(
             belief_u8=self.mapper.occupancy_u8,
             log_odds=self.mapper.log_odds,
@@ -423,7 +495,7 @@ class SfWExploreEnv(gym.Env):
             grid=self.grid,
             routers_xy=s.radio.routers,
             pose=s.robot.pose,
-            odometry_pose=s.robot.odometry_pose,
+            odometry_pose=self.pose_estimate,
             trajectory=self.trajectory,
             odometry_trajectory=self.odometry_trajectory.view,
             robot_radius_m=self.robot_config.radius_m,

@@ -92,6 +92,10 @@ class ObservationBuilder:
         c = math.floor((x - ox) / res / self.cells_per_px + self._pad_c)
         return min(max(r, 0), self.map_px - 1), min(max(c, 0), self.map_px - 1)
 
+    def clear_visited(self) -> None:
+        """Empty the trajectory channel (before drawing a corrected trajectory)."""
+        self._trajectory.fill(0)
+
     def mark_visited(self, x: float, y: float) -> None:
         """Add a pose to the trajectory channel."""
         r, c = self.pixel_of(x, y)

@@ -188,21 +188,3 @@ class PoseGraph:
             if np.abs(step).max() < tolerance or cost - new_cost < relative_decrease * cost:
                 break
         return x
-
-
-def absolute_trajectory_error(estimate: np.ndarray, truth: np.ndarray) -> float:
-    """RMSE (m) of the estimated positions after the rigid 2-D motion that best aligns them to
-    the true ones (Kabsch / Umeyama without scale)."""
-    p, q = np.asarray(estimate, np.float64)[:, :2], np.asarray(truth, np.float64)[:, :2]
-    if p.shape != q.shape or len(p) == 0:
-        raise ConfigError(
-            f"trajectories must have the same (N, 2+) shape, got {p.shape}, {q.shape}"
-        )
-    mp, mq = p.mean(0), q.mean(0)
-    u, _, vt = np.linalg.svd((p - mp).T @ (q - mq))
-    rot = (u @ vt).T
-    if np.linalg.det(rot) < 0:  # a reflection: flip the smaller axis
-        vt[-1] *= -1
-        rot = (u @ vt).T
-    aligned = (p - mp) @ rot.T + mq
-    return float(np.sqrt(np.mean(np.sum((aligned - q) ** 2, axis=1))))

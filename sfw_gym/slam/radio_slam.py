@@ -36,6 +36,7 @@ class RadioSlamConfig(Config):
     odometry_sigma_m: float = setting(0.02, gt=0.0)  # per step
     odometry_sigma_rad: float = setting(0.02, gt=0.0)  # per step
     robust: str = setting("cauchy", choices=("none", "huber", "cauchy"))
+    solve_every: int = setting(100, integer=True, ge=1)  # online (the env): poses between solves
 
 
 @dataclass
@@ -48,10 +49,14 @@ class RadioSlamResult:
 
 
 def radio_slam(
-    odometry: np.ndarray, fingerprints: np.ndarray, config: RadioSlamConfig | None = None
+    odometry: np.ndarray,
+    fingerprints: np.ndarray,
+    config: RadioSlamConfig | None = None,
+    initial: np.ndarray | None = None,
 ) -> RadioSlamResult:
     """Correct ``odometry`` ``(N, 3)`` with radio loop closures between ``fingerprints``
-    ``(N, L)`` (dBm, NaN where not heard)."""
+    ``(N, L)`` (dBm, NaN where not heard); the optimisation starts from ``initial`` ``(N, 3)``
+    (default: the odometry)."""
     cfg = config or RadioSlamConfig()
     odo = np.asarray(odometry, np.float64)
     fp = np.asarray(fingerprints, np.float64)
@@ -85,4 +90,5 @@ def radio_slam(
         )
     for (i, j), m, v in zip(pairs.tolist(), mean.tolist(), var.tolist(), strict=True):
         graph.add_range(i, j, m, max(math.sqrt(v), cfg.min_sigma_m))
-    return RadioSlamResult(graph.optimize(odo), pairs, mean)
+    start = odo if initial is None else np.asarray(initial, np.float64)
+    return RadioSlamResult(graph.optimize(start), pairs, mean)

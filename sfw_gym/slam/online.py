@@ -1,0 +1,87 @@
+"""Radio SLAM as the robot drives: poses and fingerprints arrive one at a time, and every
+``every`` poses the whole pose graph is solved again, warm-started from the last solution."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sfw_gym.core.buffers import AppendOnlyArray
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.slam.radio_slam import RadioSlamConfig, radio_slam
+
+
+def chain(anchor_estimate: np.ndarray, anchor_odometry: np.ndarray, odometry: np.ndarray):
+    """Poses ``(K, 3)`` that follow ``anchor_estimate`` as ``odometry`` ``(K, 3)`` follows
+    ``anchor_odometry``: the odometry increments since the anchor, applied to its estimate."""
+    d = odometry[:, :2] - anchor_odometry[:2]
+    turn = anchor_estimate[2] - anchor_odometry[2]
+    c, s = np.cos(turn), np.sin(turn)
+    out = np.empty_like(odometry)
+    out[:, 0] = anchor_estimate[0] + c * d[:, 0] - s * d[:, 1]
+    out[:, 1] = anchor_estimate[1] + s * d[:, 0] + c * d[:, 1]
+    out[:, 2] = np.remainder(odometry[:, 2] + turn + np.pi, 2 * np.pi) - np.pi
+    return out
+
+
+class OnlineRadioSlam:
+    """Odometry poses and fingerprints in, the current best trajectory out.
+
+    Args:
+        config: Radio SLAM's settings.
+        every: Solve again after this many new poses.
+        moved_m: A pose counts as corrected when a solution moves it further than this.
+    """
+
+    def __init__(
+        self, config: RadioSlamConfig | None = None, every: int = 100, moved_m: float = 0.05
+    ) -> None:
+        if isinstance(every, bool) or not isinstance(every, int) or every < 1:
+            raise ConfigError(f"every must be an integer >= 1, got {every!r}")
+        self.config = config or RadioSlamConfig()
+        self.every = every
+        self.moved_m = float(moved_m)
+        self._odometry = AppendOnlyArray(3)
+        self._fingerprints: AppendOnlyArray | None = None
+        self._solved = np.zeros((0, 3))  # the last solution, for the poses it covered
+        self.n_solves = 0
+
+    def __len__(self) -> int:
+        return len(self._odometry)
+
+    def add(self, odometry_pose, fingerprint) -> int | None:
+        """Take one pose's odometry ``(x, y, θ)`` and fingerprint ``(L,)`` (dBm, NaN: not
+        heard); returns the first pose that a new solution moved by more than ``moved_m``, or
+        None when nothing was solved or moved."""
+        fingerprint = np.asarray(fingerprint, np.float64)
+        if self._fingerprints is None:
+            self._fingerprints = AppendOnlyArray(len(fingerprint))
+        self._odometry.append(odometry_pose)
+        self._fingerprints.append(fingerprint)
+        n = len(self)
+        if n % self.every or n < 2:
+            return None
+        before = self.estimate()
+        after = radio_slam(
+            self._odometry.view, self._fingerprints.view, self.config, initial=before
+        ).poses
+        self._solved = after
+        self.n_solves += 1
+        moved = np.flatnonzero(np.hypot(*(after[:, :2] - before[:, :2]).T) > self.moved_m)
+        return int(moved[0]) if len(moved) else None
+
+    def estimate(self) -> np.ndarray:
+        """``(N, 3)`` poses: the last solution, then odometry chained on from its last pose."""
+        odometry = self._odometry.view
+        m = len(self._solved)
+        if m == 0:
+            return odometry.copy()
+        tail = chain(self._solved[-1], odometry[m - 1], odometry[m:])
+        return np.concatenate([self._solved, tail])
+
+    def latest(self) -> np.ndarray:
+        """The current pose ``(3,)``."""
+        odometry = self._odometry.view
+        m = len(self._solved)
+        if m == 0:
+            return odometry[-1].copy()
+        return chain(self._solved[-1], odometry[m - 1], odometry[-1:])[0]
