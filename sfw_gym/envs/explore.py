@@ -189,7 +189,16 @@ class SfWExploreEnv(gym.Env):
 
         self.n_background_aps = cfg.n_background_aps
         self.pose_source = cfg.pose_source
-        self.slam_config = RadioSlamConfig.from_dict(slam, "slam")
+        # Radio SLAM weighs odometry by the robot's own noise model (per step, at full speed).
+        rc = self.robot_config
+        full_step_m = rc.max_linear_speed_m_s * rc.control_period_s
+        slam_defaults = {
+            "odometry_sigma_m": max(rc.odometry_translation_std * full_step_m, 1e-3),
+            "odometry_sigma_rad": max(rc.odometry_heading_std_rad, 1e-3),
+        }
+        self.slam_config = RadioSlamConfig.from_dict(
+            {**slam_defaults, **_overrides("slam", slam)}, "slam"
+        )
         self.observation_space = observation_space(n_routers, map_px, crop_px, cfg.n_background_aps)
         if action_type == "continuous":
             self.action_space = spaces.Box(-1.0, 1.0, (2,), np.float32)

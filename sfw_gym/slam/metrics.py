@@ -10,11 +10,13 @@ from sfw_gym.core.errors import ConfigError
 def _pair(estimate: np.ndarray, truth: np.ndarray, columns: int) -> tuple[np.ndarray, np.ndarray]:
     p = np.asarray(estimate, np.float64)
     q = np.asarray(truth, np.float64)
-    if p.ndim != 2 or p.shape != q.shape or p.shape[1] < columns or len(p) == 0:
+    if p.ndim != 2 or q.ndim != 2 or len(p) != len(q) or len(p) == 0:
+        raise ConfigError(f"trajectories must have the same N rows, got {p.shape}, {q.shape}")
+    if min(p.shape[1], q.shape[1]) < columns:
         raise ConfigError(
             f"trajectories must have the same (N, {columns}+) shape, got {p.shape}, {q.shape}"
         )
-    return p, q
+    return p[:, :columns], q[:, :columns]
 
 
 def absolute_trajectory_error(estimate: np.ndarray, truth: np.ndarray, align: bool = True) -> float:
@@ -22,7 +24,6 @@ def absolute_trajectory_error(estimate: np.ndarray, truth: np.ndarray, align: bo
     after the rigid 2-D motion that best aligns them (Kabsch / Umeyama without scale), without
     it as they are (a run whose estimate starts at the true pose shares the truth's frame)."""
     p, q = _pair(estimate, truth, 2)
-    p, q = p[:, :2], q[:, :2]
     if align:
         mp, mq = p.mean(0), q.mean(0)
         u, _, vt = np.linalg.svd((p - mp).T @ (q - mq))

@@ -7,20 +7,9 @@ import numpy as np
 
 from sfw_gym.core.buffers import AppendOnlyArray
 from sfw_gym.core.errors import ConfigError
-from sfw_gym.slam.radio_slam import RadioSlamConfig, radio_slam
-
-
-def chain(anchor_estimate: np.ndarray, anchor_odometry: np.ndarray, odometry: np.ndarray):
-    """Poses ``(K, 3)`` that follow ``anchor_estimate`` as ``odometry`` ``(K, 3)`` follows
-    ``anchor_odometry``: the odometry increments since the anchor, applied to its estimate."""
-    d = odometry[:, :2] - anchor_odometry[:2]
-    turn = anchor_estimate[2] - anchor_odometry[2]
-    c, s = np.cos(turn), np.sin(turn)
-    out = np.empty_like(odometry)
-    out[:, 0] = anchor_estimate[0] + c * d[:, 0] - s * d[:, 1]
-    out[:, 1] = anchor_estimate[1] + s * d[:, 0] + c * d[:, 1]
-    out[:, 2] = np.remainder(odometry[:, 2] + turn + np.pi, 2 * np.pi) - np.pi
-    return out
+from sfw_gym.slam.pose_graph import chain
+from sfw_gym.slam.radio_slam import RadioSlamConfig, fit_range_model, radio_slam
+from sfw_gym.slam.range_model import SimilarityRangeModel
 
 
 class OnlineRadioSlam:
@@ -43,6 +32,7 @@ class OnlineRadioSlam:
         self._odometry = AppendOnlyArray(3)
         self._fingerprints: AppendOnlyArray | None = None
         self._solved = np.zeros((0, 3))  # the last solution, for the poses it covered
+        self.model = SimilarityRangeModel()  # Eq. 3, fit online on the pairs of each new pose
         self.n_solves = 0
 
     def __len__(self) -> int:
@@ -60,10 +50,10 @@ class OnlineRadioSlam:
         n = len(self)
         if n % self.every or n < 2:
             return None
+        odometry, fingerprints = self._odometry.view, self._fingerprints.view
+        fit_range_model(self.model, odometry, fingerprints, self.config, since=n - self.every)
         before = self.estimate()
-        after = radio_slam(
-            self._odometry.view, self._fingerprints.view, self.config, initial=before
-        ).poses
+        after = radio_slam(odometry, fingerprints, self.config, before, self.model).poses
         self._solved = after
         self.n_solves += 1
         moved = np.flatnonzero(np.hypot(*(after[:, :2] - before[:, :2]).T) > self.moved_m)

@@ -36,6 +36,22 @@ def compose_pose(a: np.ndarray, delta: tuple[float, float, float]) -> np.ndarray
     return np.array([a[0] + c * dx - s * dy, a[1] + s * dx + c * dy, a[2] + dth])
 
 
+def chain(anchor_estimate: np.ndarray, anchor_odometry: np.ndarray, odometry: np.ndarray):
+    """Poses ``(K, 3)`` that follow ``anchor_estimate`` as ``odometry`` ``(K, 3)`` follows
+    ``anchor_odometry`` (each ``(3,)``, or ``(K, 3)``: one anchor per pose): the odometry
+    increments since the anchor, applied to its estimate."""
+    anchor_estimate = np.asarray(anchor_estimate, np.float64)
+    anchor_odometry = np.asarray(anchor_odometry, np.float64)
+    d = odometry[:, :2] - anchor_odometry[..., :2]
+    turn = anchor_estimate[..., 2] - anchor_odometry[..., 2]
+    c, s = np.cos(turn), np.sin(turn)
+    out = np.empty_like(odometry)
+    out[:, 0] = anchor_estimate[..., 0] + c * d[:, 0] - s * d[:, 1]
+    out[:, 1] = anchor_estimate[..., 1] + s * d[:, 0] + c * d[:, 1]
+    out[:, 2] = _wrap(odometry[:, 2] + turn)
+    return out
+
+
 @dataclass
 class PoseGraph:
     """Edges between poses ``0 … n_poses-1``; :meth:`optimize` moves the poses.
@@ -168,7 +184,7 @@ class PoseGraph:
             g = jt @ r
             diag = np.maximum(h.diagonal(), 1e-9)
             while True:
-                step = spsolve(h + sp.diags(lam * diag), -g)
+                step = spsolve(h + sp.diags(lam * diag), -g, permc_spec="MMD_AT_PLUS_A")
                 trial = x + step.reshape(-1, 3)
                 trial[:, 2] = _wrap(trial[:, 2])
                 r_new, _, _ = self._linearize(trial, anchor, weights, edges)

@@ -16,7 +16,7 @@ import numpy as np
 
 from sfw_gym.core.config import Config, setting
 from sfw_gym.slam.fingerprints import closure_candidates, kernel_similarity
-from sfw_gym.slam.pose_graph import PoseGraph, relative_pose
+from sfw_gym.slam.pose_graph import PoseGraph, chain, relative_pose
 from sfw_gym.slam.range_model import SimilarityRangeModel
 
 
@@ -32,10 +32,11 @@ class RadioSlamConfig(Config):
     radius_db: float = setting(12.0, gt=0.0)  # closure candidates: fingerprints this close
     threshold: float = setting(0.8, ge=0.0, le=1.0)  # … and at least this similar
     max_closures: int = setting(2000, integer=True, ge=1)  # an even subsample beyond this
-    min_sigma_m: float = setting(0.3, gt=0.0)  # a closure's standard deviation at least
+    min_sigma_m: float = setting(1.0, gt=0.0)  # a closure's standard deviation at least
     odometry_sigma_m: float = setting(0.02, gt=0.0)  # per step
     odometry_sigma_rad: float = setting(0.02, gt=0.0)  # per step
     robust: str = setting("cauchy", choices=("none", "huber", "cauchy"))
+    keyframe_every: int = setting(5, integer=True, ge=1)  # the graph's nodes: every k-th pose
     solve_every: int = setting(100, integer=True, ge=1)  # online (the env): poses between solves
 
 
@@ -48,30 +49,59 @@ class RadioSlamResult:
     closure_distance_m: np.ndarray
 
 
+def travelled_m(odometry: np.ndarray) -> np.ndarray:
+    """The odometry distance driven up to each pose ``(N,)``."""
+    steps = np.linalg.norm(np.diff(odometry[:, :2], axis=0), axis=1)
+    return np.r_[0.0, np.cumsum(steps)]
+
+
+def fit_range_model(
+    model: SimilarityRangeModel,
+    odometry: np.ndarray,
+    fingerprints: np.ndarray,
+    config: RadioSlamConfig,
+    since: int = 0,
+) -> None:
+    """Add to ``model`` the pairs a short drive apart (Eq. 3's training pairs) whose later pose
+    is ``since`` or after: called on a growing run, each pair is added once."""
+    n = len(odometry)
+    along = travelled_m(odometry)
+    for lag in range(1, min(config.train_lag, n - 1) + 1):
+        j = np.arange(max(since, lag), n)
+        i = j - lag
+        short = along[j] - along[i] <= config.train_travel_m
+        i, j = i[short], j[short]
+        d = np.linalg.norm(odometry[j, :2] - odometry[i, :2], axis=1)
+        model.update(kernel_similarity(fingerprints[i], fingerprints[j], config.sigma_db), d)
+
+
 def radio_slam(
     odometry: np.ndarray,
     fingerprints: np.ndarray,
     config: RadioSlamConfig | None = None,
     initial: np.ndarray | None = None,
+    model: SimilarityRangeModel | None = None,
 ) -> RadioSlamResult:
     """Correct ``odometry`` ``(N, 3)`` with radio loop closures between ``fingerprints``
     ``(N, L)`` (dBm, NaN where not heard); the optimisation starts from ``initial`` ``(N, 3)``
-    (default: the odometry)."""
+    (default: the odometry); ``model``: an Eq. 3 model already fit on this run (default: fit
+    here)."""
     cfg = config or RadioSlamConfig()
     odo = np.asarray(odometry, np.float64)
     fp = np.asarray(fingerprints, np.float64)
     n = len(odo)
-    travelled = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(odo[:, :2], axis=0), axis=1))]
-    model = SimilarityRangeModel()
-    for lag in range(1, min(cfg.train_lag, n - 1) + 1):
-        i = np.arange(n - lag)
-        j = i + lag
-        short = travelled[j] - travelled[i] <= cfg.train_travel_m
-        d = np.linalg.norm(odo[j[short], :2] - odo[i[short], :2], axis=1)
-        model.update(kernel_similarity(fp[i[short]], fp[j[short]], cfg.sigma_db), d)
-    pairs = closure_candidates(
-        fp, travelled, min_travel_m=cfg.min_travel_m, radius_db=cfg.radius_db
-    )
+    travelled = travelled_m(odo)
+    if model is None:
+        model = SimilarityRangeModel()
+        fit_range_model(model, odo, fp, cfg)
+    # The graph's nodes: every keyframe_every-th pose and the last (the poses between follow
+    # their keyframe's odometry); closures between keyframes only.
+    keys = np.unique(np.r_[np.arange(0, n, cfg.keyframe_every), n - 1])
+    pairs = keys[
+        closure_candidates(
+            fp[keys], travelled[keys], min_travel_m=cfg.min_travel_m, radius_db=cfg.radius_db
+        )
+    ].reshape(-1, 2)
     similarity = kernel_similarity(fp[pairs[:, 0]], fp[pairs[:, 1]], cfg.sigma_db)
     mean, var = model.predict(similarity)
     keep = (similarity >= cfg.threshold) & np.isfinite(mean)
@@ -79,16 +109,22 @@ def radio_slam(
     if len(pairs) > cfg.max_closures:
         pick = np.linspace(0, len(pairs) - 1, cfg.max_closures).astype(int)
         pairs, mean, var = pairs[pick], mean[pick], var[pick]
-    graph = PoseGraph(n, robust=cfg.robust)
-    for k in range(n - 1):
+    node = np.full(n, -1)
+    node[keys] = np.arange(len(keys))
+    graph = PoseGraph(len(keys), robust=cfg.robust)
+    for k, (a, b) in enumerate(zip(keys[:-1].tolist(), keys[1:].tolist(), strict=True)):
+        spread = math.sqrt(b - a)  # independent per-step errors add up
         graph.add_odometry(
             k,
             k + 1,
-            relative_pose(odo[k], odo[k + 1]),
-            cfg.odometry_sigma_m,
-            cfg.odometry_sigma_rad,
+            relative_pose(odo[a], odo[b]),
+            cfg.odometry_sigma_m * spread,
+            cfg.odometry_sigma_rad * spread,
         )
-    for (i, j), m, v in zip(pairs.tolist(), mean.tolist(), var.tolist(), strict=True):
+    for (i, j), m, v in zip(node[pairs].tolist(), mean.tolist(), var.tolist(), strict=True):
         graph.add_range(i, j, m, max(math.sqrt(v), cfg.min_sigma_m))
     start = odo if initial is None else np.asarray(initial, np.float64)
-    return RadioSlamResult(graph.optimize(start), pairs, mean)
+    solved = graph.optimize(start[keys])
+    anchor = keys[np.searchsorted(keys, np.arange(n), side="right") - 1]
+    poses = chain(solved[node[anchor]], odo[anchor], odo)
+    return RadioSlamResult(poses, pairs, mean)

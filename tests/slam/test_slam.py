@@ -170,7 +170,8 @@ def test_radio_slam_on_a_drifting_run_with_background_aps_beats_odometry():
     apart = np.linalg.norm(
         truth[result.closures[:, 0], :2] - truth[result.closures[:, 1], :2], axis=1
     )
-    assert len(apart) > 100 and np.mean(apart < 2.0) > 0.9  # closures are real revisits
+    # closures (between every 5th pose, the default keyframes) are real revisits
+    assert len(apart) >= 10 and np.mean(apart < 2.0) > 0.9
     before = absolute_trajectory_error(odometry, truth)
     after = absolute_trajectory_error(result.poses, truth)
     assert after < 0.7 * before, (before, after)
