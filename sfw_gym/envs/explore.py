@@ -27,7 +27,7 @@ from sfw_gym.envs.observation import (
 from sfw_gym.mapping import GridSpec, MapperConfig, SparseInverseKVisibility
 from sfw_gym.navigation.view import RobotView
 from sfw_gym.slam import OnlineRadioSlam, RadioSlamConfig
-from sfw_gym.world import Floorplan, RadioConfig, RobotConfig
+from sfw_gym.world import Floorplan, Pose, RadioConfig, RobotConfig
 from sfw_gym.world.generator import GeneratorConfig
 
 
@@ -254,7 +254,7 @@ class SfWExploreEnv(gym.Env):
         self.trajectory: list[tuple[float, float]] = []
         self.odometry_trajectory = AppendOnlyArray(2, np.float64)  # of the pose estimate
         self.pose_estimates = AppendOnlyArray(3, np.float64)
-        self.pose_estimate = tuple(s.robot.odometry_pose)
+        self.pose_estimate = s.robot.odometry_pose
         self._squared_pose_errors = 0.0
         self.slam: OnlineRadioSlam | None = None
         self.map_history: MapHistory | None = None
@@ -358,23 +358,21 @@ class SfWExploreEnv(gym.Env):
             obs.update(fingerprint_observation(self.fingerprint))
         return obs
 
-    def _estimate_pose(self, true_pose: tuple[float, float, float]) -> tuple[float, float, float]:
+    def _estimate_pose(self, true_pose: Pose) -> Pose:
         """This step's pose estimate from the env's pose source (Radio SLAM: after a solve that
         moved past poses, the map is rebuilt along them first)."""
         assert self.scene is not None
         if self.pose_source == "true":
-            return tuple(true_pose)
+            return true_pose
         odometry = self.scene.robot.odometry_pose
         if self.slam is None:
-            return tuple(odometry)
+            return odometry
         moved_from = self.slam.add(odometry, self.fingerprint)
         if moved_from is not None:
             self._remap(self.slam.estimate()[:-1], moved_from)
-        return tuple(self.slam.latest().tolist())
+        return Pose(*self.slam.latest().tolist())
 
-    def _map_at(
-        self, pose: tuple[float, float, float], rssi: np.ndarray, bumped: bool
-    ) -> tuple[bool, float]:
+    def _map_at(self, pose: Pose, rssi: np.ndarray, bumped: bool) -> tuple[bool, float]:
         """Fuse a reading at ``pose``: whether it was fused, and the information gain (bits).
         Nothing is fused where the estimate lies off the map (odometry drifted out of it)."""
         x0, y0, x1, y1 = self._grid_bounds
