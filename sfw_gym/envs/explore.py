@@ -386,26 +386,28 @@ class SfWExploreEnv(gym.Env):
 
     def _remap(self, poses: np.ndarray, first: int) -> None:
         """Rebuild the map along corrected ``poses`` of the steps so far, from the last mapper
-        snapshot at or before step ``first`` (the earliest pose that moved)."""
+        snapshot at or before step ``first`` (the earliest pose that moved); the poses before
+        that snapshot stay as the map has them."""
         assert self.map_history is not None and self.scene is not None
         self.mapper, start = self.map_history.restore(first)
         rssi, bumps = self.rssi_history.view, self.map_history.bumps
+        x0, y0, x1, y1 = self._grid_bounds
         for t in range(start, len(poses)):
             self.map_history.snapshot(t, self.mapper)
-            x0, y0, x1, y1 = self._grid_bounds
             x, y, theta = poses[t]
             if x0 <= x < x1 and y0 <= y < y1:
                 self.mapper.update((x, y), rssi[t].astype(np.float64), bumps[t], theta)
         self.tracker.apply(np.arange(self.mapper.occupancy_u8.size), self.mapper.occupancy_u8)
-        self.odometry_trajectory = AppendOnlyArray(2, np.float64, len(poses) + 1024)
+        kept = self.pose_estimates.view[:start]
         self.pose_estimates = AppendOnlyArray(3, np.float64, len(poses) + 1024)
+        self.odometry_trajectory = AppendOnlyArray(2, np.float64, len(poses) + 1024)
         self.obs_builder.clear_visited()
-        for x, y, theta in poses.tolist():
-            self.odometry_trajectory.append((x, y))
+        for x, y, theta in np.concatenate([kept, poses[start:]]).tolist():
             self.pose_estimates.append((x, y, theta))
+            self.odometry_trajectory.append((x, y))
             self.obs_builder.mark_visited(x, y)
-        truth = np.asarray(self.trajectory, np.float64)
-        self._squared_pose_errors = float(np.sum((poses[:, :2] - truth) ** 2))
+        errors = self.pose_estimates.view[:, :2] - np.asarray(self.trajectory, np.float64)
+        self._squared_pose_errors = float(np.sum(errors**2))
 
     def _info(self, *, terminal: bool) -> dict[str, Any]:
         s = self.scene

@@ -15,6 +15,7 @@ from typing import ClassVar
 import numpy as np
 
 from sfw_gym.core.config import Config, setting
+from sfw_gym.core.errors import ConfigError
 from sfw_gym.slam.fingerprints import closure_candidates, kernel_similarity
 from sfw_gym.slam.pose_graph import PoseGraph, chain, relative_pose
 from sfw_gym.slam.range_model import SimilarityRangeModel
@@ -29,7 +30,9 @@ class RadioSlamConfig(Config):
     train_travel_m: float = setting(3.0, gt=0.0)  # pairs this short a drive apart fit the model
     train_lag: int = setting(40, integer=True, ge=1)  # … at most this many poses apart
     min_travel_m: float = setting(10.0, ge=0.0)  # closures: at least this long a drive apart
-    radius_db: float = setting(12.0, gt=0.0)  # closure candidates: fingerprints this close
+    # closure candidates: fingerprints within this RMS difference per AP (the KD-tree's
+    # Euclidean radius is this × √APs, so that it means the same at any AP density)
+    radius_db_per_ap: float = setting(3.0, gt=0.0)
     threshold: float = setting(0.8, ge=0.0, le=1.0)  # … and at least this similar
     max_closures: int = setting(2000, integer=True, ge=1)  # an even subsample beyond this
     min_sigma_m: float = setting(1.0, gt=0.0)  # a closure's standard deviation at least
@@ -81,11 +84,14 @@ def radio_slam(
     config: RadioSlamConfig | None = None,
     initial: np.ndarray | None = None,
     model: SimilarityRangeModel | None = None,
+    extra_closures: np.ndarray | None = None,
 ) -> RadioSlamResult:
     """Correct ``odometry`` ``(N, 3)`` with radio loop closures between ``fingerprints``
     ``(N, L)`` (dBm, NaN where not heard); the optimisation starts from ``initial`` ``(N, 3)``
     (default: the odometry); ``model``: an Eq. 3 model already fit on this run (default: fit
-    here)."""
+    here); ``extra_closures``: rows ``(i, j, distance_m)`` between keyframes (poses whose index
+    is a multiple of ``keyframe_every``) added as range edges of ``min_sigma_m`` beside the
+    radio ones (another detector's, or false ones to test the robust kernel)."""
     cfg = config or RadioSlamConfig()
     odo = np.asarray(odometry, np.float64)
     fp = np.asarray(fingerprints, np.float64)
@@ -99,7 +105,10 @@ def radio_slam(
     keys = np.unique(np.r_[np.arange(0, n, cfg.keyframe_every), n - 1])
     pairs = keys[
         closure_candidates(
-            fp[keys], travelled[keys], min_travel_m=cfg.min_travel_m, radius_db=cfg.radius_db
+            fp[keys],
+            travelled[keys],
+            min_travel_m=cfg.min_travel_m,
+            radius_db=cfg.radius_db_per_ap * math.sqrt(fp.shape[1]),
         )
     ].reshape(-1, 2)
     similarity = kernel_similarity(fp[pairs[:, 0]], fp[pairs[:, 1]], cfg.sigma_db)
@@ -109,6 +118,14 @@ def radio_slam(
     if len(pairs) > cfg.max_closures:
         pick = np.linspace(0, len(pairs) - 1, cfg.max_closures).astype(int)
         pairs, mean, var = pairs[pick], mean[pick], var[pick]
+    if extra_closures is not None:
+        extra = np.asarray(extra_closures, np.float64).reshape(-1, 3)
+        ends = extra[:, :2].astype(np.int64)
+        if not np.isin(ends, keys).all():
+            raise ConfigError("extra_closures must join keyframes (indices k * keyframe_every)")
+        pairs = np.concatenate([pairs, ends])
+        mean = np.concatenate([mean, extra[:, 2]])
+        var = np.concatenate([var, np.zeros(len(extra))])
     node = np.full(n, -1)
     node[keys] = np.arange(len(keys))
     graph = PoseGraph(len(keys), robust=cfg.robust)
