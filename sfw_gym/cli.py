@@ -8,10 +8,14 @@ import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from sfw_gym.core.errors import ConfigError, SfwGymError
+
+if TYPE_CHECKING:
+    from sfw_gym.slam import RadioSlamConfig
 
 
 def checked(convert: Callable, ok: Callable, what: str) -> Callable:
@@ -117,6 +121,65 @@ def _cmd_map(args: argparse.Namespace) -> int:
     )
     print(f"wrote {paths['png']}, {paths['npy']}, {paths['json']}")
     return 0
+
+
+def _cmd_slam(args: argparse.Namespace) -> int:
+    from sfw_gym.slam import RadioSlamConfig
+    from sfw_gym.slam.offline import slam_log, trajectory_errors
+
+    if args.record is not None:
+        _record_slam_log(args.log, args.env, args.record, args.steps)
+        print(
+            f"recorded {args.steps} frontier steps on {args.env} (seed {args.record}) to {args.log}"
+        )
+    out = args.out or str(Path(args.log).with_suffix("")) + "_slam"
+    start = time.perf_counter()
+    log, result, paths = slam_log(args.log, out, RadioSlamConfig(keyframe_every=args.keyframes))
+    print(
+        f"{log.path}: {len(log.odometry)} poses, {len(log.access_points)} access points, "
+        f"{len(result.closures)} radio loop closures; {time.perf_counter() - start:.1f} s"
+    )
+    errors = trajectory_errors(log, result)
+    if errors:
+        print(
+            f"ATE (against the log's truth): odometry {errors[0]:.2f} m, "
+            f"Radio SLAM {errors[1]:.2f} m"
+        )
+    print(f"wrote {paths['trajectory']}, {paths['fingerprint_map']}, {paths['figure']}")
+    return 0
+
+
+def _record_slam_log(path: str, env_id: str, seed: int, steps: int) -> RadioSlamConfig:
+    """A frontier run on ``env_id`` written as a Radio SLAM log with its truth; returns the
+    env's Radio SLAM settings (its odometry weights follow the robot's noise)."""
+    import gymnasium as gym
+
+    import sfw_gym  # noqa: F401  (registration)
+    from sfw_gym.agents import FrontierAgent
+    from sfw_gym.envs.explore import unwrap_sfw
+    from sfw_gym.slam.offline import write_slam_log
+
+    env = gym.make(env_id, max_steps=steps)
+    sfw = unwrap_sfw(env)
+    if not sfw.n_background_aps:
+        raise ConfigError(f"--env {env_id}: has no background access points to fingerprint")
+    obs, info = env.reset(seed=seed)
+    agent = FrontierAgent()
+    agent.reset(env, seed=seed)
+    period = sfw.robot_config.control_period_s
+    infos, done = [info], False
+    while not done:
+        obs, _, terminated, truncated, info = env.step(agent.act(obs))
+        infos.append(info)
+        done = terminated or truncated
+    write_slam_log(
+        path,
+        period * np.arange(len(infos)),
+        np.array([i["odometry_pose"] for i in infos]),
+        np.array([i["fingerprint"] for i in infos]),
+        np.array([i["true_pose"] for i in infos]),
+    )
+    return sfw.slam_config
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
@@ -316,6 +379,43 @@ def build_parser() -> argparse.ArgumentParser:
     )
     mp.add_argument("--out", default="map.png", help="output PNG; .npy and .json beside it")
     mp.set_defaults(func=_cmd_map)
+    slam = sub.add_parser(
+        "slam", help="Radio SLAM on a recorded log (CSV): corrected trajectory, fingerprint map"
+    )
+    slam.add_argument(
+        "log", help="CSV: time, odom_x, odom_y, odom_theta, one column per AP [, true_x, true_y]"
+    )
+    slam.add_argument(
+        "--record",
+        type=seed_int,
+        default=None,
+        metavar="SEED",
+        help="first record LOG: a frontier run on --env from this seed",
+    )
+    slam.add_argument(
+        "--env", default="SfW-ExploreDrift-v0", help="env id for --record (needs background APs)"
+    )
+    slam.add_argument(
+        "--steps", type=positive_int, default=1500, help="steps for --record (default 1500)"
+    )
+    slam.add_argument(
+        "--keyframes", type=positive_int, default=5, help="every k-th pose a graph node (default 5)"
+    )
+    slam.add_argument(
+        "--odometry-sigma",
+        type=positive_float,
+        default=None,
+        help="odometry's translation error per pose, metres (default 0.02; --record: the env's)",
+    )
+    slam.add_argument(
+        "--heading-sigma",
+        type=positive_float,
+        default=None,
+        help="odometry's heading error per pose, radians (default 0.02; --record: the env's)",
+    )
+    slam.add_argument("--out", type=folder, default=None, help="output folder (default LOG_slam/)")
+    slam.set_defaults(func=_cmd_slam)
+
     bench = sub.add_parser("bench", help="env steps/s and reset ms beside CartPole-v1")
     bench.add_argument("--env", default="SfW-Explore-v0", help="env id (default SfW-Explore-v0)")
     bench.add_argument("--steps", type=positive_int, default=5000, help="random steps to time")

@@ -53,7 +53,9 @@ def test_radio_slam_rebuilds_the_map_exactly_along_its_corrected_trajectory():
     # ...and so do the metrics tracked on the way, and the trajectory error
     from sfw_gym.mapping import metrics
 
-    assert info["free_iou"] == pytest.approx(metrics.free_iou(mapper.occupancy_u8, env.scene.truth_u8))
+    assert info["free_iou"] == pytest.approx(
+        metrics.free_iou(mapper.occupancy_u8, env.scene.truth_u8)
+    )
     truth = np.asarray(env.trajectory)
     assert info["ate_m"] == pytest.approx(
         absolute_trajectory_error(estimates, truth, align=False), rel=1e-9
@@ -79,7 +81,7 @@ def test_the_true_pose_maps_without_error_and_odometry_reports_its_drift():
 
 
 def test_radio_slam_without_access_points_is_refused_by_name():
-    with pytest.raises(ConfigError, match="pose_source='radio_slam'.*n_background_aps"):
+    with pytest.raises(ConfigError, match=r"pose_source='radio_slam'.*n_background_aps"):
         gym.make("SfW-Explore-v0", pose_source="radio_slam")
     with pytest.raises(ConfigError, match="pose_source"):
         gym.make("SfW-Explore-v0", pose_source="gps")

@@ -20,6 +20,7 @@ OPTIONS = {
     "world": ["--seed", "--resolution", "--preset", "--band", "--floorplan", "--routers"],
     "map": ["--routers", "--scale", "--px-per-m", "--resolution", "--margin", "--rssi-column"],
     "bench": ["--env", "--steps", "--resets", "--memory-steps"],
+    "slam": ["--keyframes", "--odometry-sigma", "--heading-sigma"],
     "evaluate": ["--agents", "--episodes", "--seed", "--env", "--env-kwargs", "--agent-params"],
 }
 
@@ -30,6 +31,8 @@ def argvs(draw) -> list[str]:
     argv = [command]
     if command == "map":
         argv.append(draw(st.sampled_from(["{tmp}/log.csv", "{tmp}/none.csv", ""])))
+    if command == "slam":
+        argv.append(draw(st.sampled_from(["{tmp}/slam.csv", "{tmp}/log.csv", "{tmp}", ""])))
     for option in draw(st.lists(st.sampled_from(OPTIONS[command]), max_size=3, unique=True)):
         argv += [option, draw(values)]
     return argv
@@ -39,6 +42,9 @@ def argvs(draw) -> list[str]:
 def test_command_lines(tmp_path_factory, argv):
     tmp = tmp_path_factory.mktemp("cli")
     (tmp / "log.csv").write_text("x,y,rssi\n1,1,-40\n2,1,-45\n3,1,-60\n")
+    (tmp / "slam.csv").write_text(
+        "time,odom_x,odom_y,odom_theta,a,b\n0,0,0,0,-40,-70\n1,1,0,0,-45,\n2,2,0,0.1,-60,-65\n"
+    )
     argv = [a.replace("{tmp}", str(tmp)) for a in argv]
     if argv[0] in ("bench", "evaluate"):  # keep the valid ones short
         argv += ["--env", "SfW-ExploreSmall-v0"]
@@ -49,6 +55,8 @@ def test_command_lines(tmp_path_factory, argv):
         argv += ["--env-kwargs", '{"max_steps": 5}']
     if argv[0] in ("world", "map"):
         argv += ["--out", str(tmp / "out.png")]
+    if argv[0] == "slam":
+        argv += ["--out", str(tmp / "slam_out")]
     err = io.StringIO()
 
     def run() -> None:
