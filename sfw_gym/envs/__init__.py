@@ -27,7 +27,7 @@ ENV_IDS: dict[str, dict[str, Any]] = {
     # Candidate-goal actions: pick one of K goals of the navigation menu, the robot drives there.
     "SfW-ExploreGoals-v0": {},
     # Drifting odometry (5 % of each step's travel, 0.02 rad of heading per step: about 1 m of
-    # ATE over 1,500 frontier steps, scripts/bench_radio_slam.py) and 16 background access
+    # ATE over 1,500 frontier steps, scripts/slam_study.py) and 16 background access
     # points whose fingerprint Radio SLAM (sfw_gym.slam.radio_slam) can close loops with.
     "SfW-ExploreDrift-v0": {
         "robot": {"odometry_translation_std": 0.05, "odometry_heading_std_rad": 0.02},
