@@ -35,10 +35,14 @@ class RadioSlamConfig(Config):
     radius_db_per_ap: float = setting(3.0, gt=0.0)
     threshold: float = setting(0.8, ge=0.0, le=1.0)  # … and at least this similar
     max_closures: int = setting(2000, integer=True, ge=1)  # an even subsample beyond this
-    min_sigma_m: float = setting(1.0, gt=0.0)  # a closure's standard deviation at least
+    min_sigma_m: float = setting(0.3, gt=0.0)  # a closure's standard deviation at least
     odometry_sigma_m: float = setting(0.02, gt=0.0)  # per step
     odometry_sigma_rad: float = setting(0.02, gt=0.0)  # per step
     robust: str = setting("cauchy", choices=("none", "huber", "cauchy"))
+    robust_scale: float = setting(0.5, gt=0.0)  # the kernel's scale, in closure sigmas
+    # after a first solve, closures off by more than this many sigmas are dropped and the
+    # graph solved again (0: keep all)
+    outlier_sigma: float = setting(3.0, ge=0.0)
     keyframe_every: int = setting(5, integer=True, ge=1)  # the graph's nodes: every k-th pose
     solve_every: int = setting(100, integer=True, ge=1)  # online (the env): poses between solves
 
@@ -90,8 +94,8 @@ def radio_slam(
     ``(N, L)`` (dBm, NaN where not heard); the optimisation starts from ``initial`` ``(N, 3)``
     (default: the odometry); ``model``: an Eq. 3 model already fit on this run (default: fit
     here); ``extra_closures``: rows ``(i, j, distance_m)`` between keyframes (poses whose index
-    is a multiple of ``keyframe_every``) added as range edges of ``min_sigma_m`` beside the
-    radio ones (another detector's, or false ones to test the robust kernel)."""
+    is a multiple of ``keyframe_every``) added beside the radio ones with their median variance
+    (another detector's, or false ones to test the robust kernel)."""
     cfg = config or RadioSlamConfig()
     odo = np.asarray(odometry, np.float64)
     fp = np.asarray(fingerprints, np.float64)
@@ -123,25 +127,41 @@ def radio_slam(
         ends = extra[:, :2].astype(np.int64)
         if not np.isin(ends, keys).all():
             raise ConfigError("extra_closures must join keyframes (indices k * keyframe_every)")
+        typical = float(np.median(var)) if len(var) else 0.0  # as sure as a radio closure
         pairs = np.concatenate([pairs, ends])
         mean = np.concatenate([mean, extra[:, 2]])
-        var = np.concatenate([var, np.zeros(len(extra))])
+        var = np.concatenate([var, np.full(len(extra), typical)])
     node = np.full(n, -1)
     node[keys] = np.arange(len(keys))
-    graph = PoseGraph(len(keys), robust=cfg.robust)
-    for k, (a, b) in enumerate(zip(keys[:-1].tolist(), keys[1:].tolist(), strict=True)):
-        spread = math.sqrt(b - a)  # independent per-step errors add up
-        graph.add_odometry(
-            k,
-            k + 1,
-            relative_pose(odo[a], odo[b]),
-            cfg.odometry_sigma_m * spread,
-            cfg.odometry_sigma_rad * spread,
-        )
-    for (i, j), m, v in zip(node[pairs].tolist(), mean.tolist(), var.tolist(), strict=True):
-        graph.add_range(i, j, m, max(math.sqrt(v), cfg.min_sigma_m))
-    start = odo if initial is None else np.asarray(initial, np.float64)
-    solved = graph.optimize(start[keys])
+    sigma = np.maximum(np.sqrt(var), cfg.min_sigma_m)
+    start = (odo if initial is None else np.asarray(initial, np.float64))[keys]
+
+    def solve(use: np.ndarray, start: np.ndarray) -> np.ndarray:
+        graph = PoseGraph(len(keys), robust=cfg.robust, robust_scale=cfg.robust_scale)
+        for k, (a, b) in enumerate(zip(keys[:-1].tolist(), keys[1:].tolist(), strict=True)):
+            spread = math.sqrt(b - a)  # independent per-step errors add up
+            graph.add_odometry(
+                k,
+                k + 1,
+                relative_pose(odo[a], odo[b]),
+                cfg.odometry_sigma_m * spread,
+                cfg.odometry_sigma_rad * spread,
+            )
+        for (i, j), m, sd in zip(
+            node[pairs[use]].tolist(), mean[use].tolist(), sigma[use].tolist(), strict=True
+        ):
+            graph.add_range(i, j, m, sd)
+        return graph.optimize(start)
+
+    use = np.ones(len(pairs), bool)
+    solved = solve(use, start)
+    if cfg.outlier_sigma and len(pairs):  # drop the closures the solution disagrees with
+        ends = solved[node[pairs]]
+        apart = np.linalg.norm(ends[:, 1, :2] - ends[:, 0, :2], axis=1)
+        use = np.abs(apart - mean) <= cfg.outlier_sigma * sigma
+        if not use.all():
+            solved = solve(use, solved)
+    pairs, mean = pairs[use], mean[use]
     anchor = keys[np.searchsorted(keys, np.arange(n), side="right") - 1]
     poses = chain(solved[node[anchor]], odo[anchor], odo)
     return RadioSlamResult(poses, pairs, mean)

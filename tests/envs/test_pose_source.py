@@ -40,7 +40,7 @@ def test_radio_slam_rebuilds_the_map_exactly_along_its_corrected_trajectory():
     assert env.slam.n_solves == 12
     estimates = env.pose_estimates.view
     odometry = np.array([info["odometry_pose"]])
-    assert np.abs(estimates[-1, :2] - odometry[-1, :2]).max() > 0.2  # corrections happened
+    assert np.abs(estimates[-1, :2] - odometry[-1, :2]).max() > 0.1  # corrections happened
     # the live map equals one built from scratch along the final estimate...
     mapper = SparseInverseKVisibility(env.grid, env.scene.radio.routers, env.mapper_config)
     x0, y0, x1, y1 = env.grid.bounds
