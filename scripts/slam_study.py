@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import multiprocessing as mp
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -191,7 +190,8 @@ def main() -> None:
     def rows(**match: Any) -> list[dict[str, Any]]:
         return [r for r in records if all(r[k] == v for k, v in match.items())]
 
-    lines = [f"Frontier agent, {args.plans} held-out plans (seeds {FIRST_SEED:,}+), 3,000 steps.", ""]
+    lines = [f"Frontier agent, {args.plans} held-out plans (seeds {FIRST_SEED:,}+), 3,000 steps."]
+    lines.append("")
     lines += [
         "| drift (trans, heading) | pose source | ATE [m] | coverage | free-IoU | wall precision "
         "| env ms/step |",
@@ -214,10 +214,14 @@ def main() -> None:
         slam = {r["seed"]: r for r in rows(drift=d, source="radio_slam", aps=16)}
         odo = {r["seed"]: r for r in rows(drift=d, source="odometry", aps=16)}
         true = {r["seed"]: r for r in rows(drift=d, source="true", aps=16)}
+
+        def diff(key: str, a: dict, b: dict, fmt: str) -> str:
+            return ci([a[k][key] - b[k][key] for k in seeds], fmt)
+
         lines.append(
-            f"| {d} | {ci([slam[k]['ate_m'] - odo[k]['ate_m'] for k in seeds])} | "
-            f"{ci([slam[k]['free_iou'] - true[k]['free_iou'] for k in seeds], '{:+.3f}')} | "
-            f"{ci([slam[k]['wall_precision'] - true[k]['wall_precision'] for k in seeds], '{:+.3f}')} |"
+            f"| {d} | {diff('ate_m', slam, odo, '{:.2f}')} | "
+            f"{diff('free_iou', slam, true, '{:+.3f}')} | "
+            f"{diff('wall_precision', slam, true, '{:+.3f}')} |"
         )
 
     lines += ["", "AP density (mid drift; Radio SLAM offline on the odometry runs):", ""]
@@ -227,7 +231,9 @@ def main() -> None:
     for n in AP_COUNTS:
         rs = rows(drift="mid", source="odometry", aps=n)
         results = [offline_slam(r) for r in rs]
-        slam_times += [(len(r["log"]["odometry"]), w) for r, (_, w, _) in zip(rs, results)]
+        slam_times += [
+            (len(r["log"]["odometry"]), w) for r, (_, w, _) in zip(rs, results, strict=True)
+        ]
         lines.append(
             f"| {n} | {ci([r['ate_m'] for r in rs])} | {ci([a for a, _, _ in results])} | "
             f"{np.mean([c for _, _, c in results]):.0f} |"
@@ -250,7 +256,7 @@ def main() -> None:
     dirty = [offline_slam(r, 0.10, r["seed"])[0] for r in rs]
     lines += [
         f"ATE without {ci(clean)} m, with {ci(dirty)} m; ratio (paired) "
-        f"{ci([b / a for a, b in zip(clean, dirty)], '{:.3f}')}.",
+        f"{ci([b / a for a, b in zip(clean, dirty, strict=True)], '{:.3f}')}.",
         "",
         f"Offline Radio SLAM time per run: {np.mean([w for _, w in slam_times]):.2f} s mean, "
         f"{max(w for _, w in slam_times):.2f} s max, at up to "

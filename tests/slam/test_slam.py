@@ -185,7 +185,7 @@ def test_the_pose_graph_reaches_gtsams_optimum():
     truth = square_loop()
     n = len(truth)
     sxy, sth, srange = 0.005, 0.02, 0.3  # SfW-ExploreDrift-v0: 5 % of a 0.1 m step
-    graph, factors, initial = PoseGraph(n, robust="none"), gtsam.NonlinearFactorGraph(), []
+    graph, factors = PoseGraph(n, robust="none"), gtsam.NonlinearFactorGraph()
     odometry = [truth[0]]
     for k in range(n - 1):
         dx, dy, dth = relative_pose(truth[k], truth[k + 1])
