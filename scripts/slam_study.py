@@ -2,6 +2,7 @@
 closures, speed. Frontier agent, held-out generated plans (seeds 2,000,000+), mean [95 % CI].
 
     python scripts/slam_study.py [--plans 20] [--workers 2] [--out runs/slam_study]
+    python scripts/slam_study.py --speed 3      # env ms/step by pose source, one process
 
 Writes ``OUT/tables.md`` (the tables for BENCHMARKS.md) and ``OUT/records.json``. Every table
 pairs its rows on the same plans and start poses (the pose source changes where the robot maps,
@@ -166,7 +167,19 @@ def main() -> None:
     p.add_argument("--plans", type=int, default=20)
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--out", default="runs/slam_study")
+    p.add_argument("--speed", type=int, default=0, metavar="PLANS", help="only the speed table")
     args = p.parse_args()
+    if args.speed:  # side by side in this process, mid drift
+        print("| pose source | env ms/step | env steps/s | agent ms/step |\n|---|---:|---:|---:|")
+        for source in SOURCES:
+            rs = [
+                episode({"drift": "mid", "source": source, "aps": 16, "seed": seed})
+                for seed in range(FIRST_SEED, FIRST_SEED + args.speed)
+            ]
+            ms = float(np.mean([r["env_ms"] for r in rs]))
+            agent = float(np.mean([r["agent_ms"] for r in rs]))
+            print(f"| {source} | {ms:.3f} | {1e3 / ms:,.0f} | {agent:.3f} |")
+        return
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     seeds = range(FIRST_SEED, FIRST_SEED + args.plans)

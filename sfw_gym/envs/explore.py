@@ -55,8 +55,8 @@ class SfWExploreEnv(gym.Env):
     - ``local``: ``uint8 (1, C, C)``, C = ``crop_px`` (48): the belief around the robot at full
       resolution (north up);
     - ``state``: ``float32 (2R + 6,)``: per router the normalised RSSI ((dBm + 100) / 80, 0 when not
-      heard) and a heard flag; bump; odometry x, y in [0, 1] over the map; sin and cos of the
-      odometry heading; the fraction of the map the robot believes known.
+      heard) and a heard flag; bump; the pose estimate's x, y in [0, 1] over the map; sin and cos
+      of its heading; the fraction of the map the robot believes known.
 
     ## Rewards
     ``reward_scale`` × information gain of the map this step (bits; the entropy decrease of the
@@ -92,7 +92,11 @@ class SfWExploreEnv(gym.Env):
     budget is ``min(max_steps, ceil(steps_per_m2 × free area))``), ``n_background_aps`` (0:
     access points beyond the routers, half in the building and half in its neighbourhood, whose
     RSSI the robot hears as a fingerprint: ``obs["fingerprint"]``, ``obs["fingerprint_heard"]``
-    and ``info["fingerprint"]``; Radio SLAM's input), ``render_mode`` (None |
+    and ``info["fingerprint"]``; Radio SLAM's input), ``pose_source`` ("odometry": the robot maps
+    where its odometry says it is; "radio_slam": odometry corrected by radio loop closures
+    between background-AP fingerprints, solved every ``slam["solve_every"]`` steps, the map
+    rebuilt along each correction; "true": the true pose), ``slam`` (dict of `RadioSlamConfig`
+    overrides; the odometry weights default to the robot's noise model), ``render_mode`` (None |
     "rgb_array" | "human"), ``render_size`` ((960, 480): every frame is ``width × height``, the
     plan letterboxed into it, so video writers work across plans; None: the plan's own size).
     ``reset(options=…)``: ``floorplan`` (a Floorplan, a path or a generator seed), ``routers``

@@ -24,10 +24,12 @@ class RobotView:
         belief_u8: The belief map (0 wall, 255 free, 127 unknown), ``[row, col]``.
         log_odds: Log-odds of "occupied" per cell (float32); :attr:`probability` from it.
         grid: The map's geometry.
-        odometry_pose: ``(x, y, θ)`` from odometry (m, rad), not the true pose.
+        odometry_pose: ``(x, y, θ)`` where the robot believes it is (m, rad), never the true
+            pose: its odometry, or Radio SLAM's estimate (the env's ``pose_source``).
         routers_xy: ``(R, 2)`` router positions (the robot knows its routers).
         rssi_history: ``(T, R)`` readings so far, dBm (``NOT_HEARD_DBM`` when not heard).
-        odometry_trajectory: ``(T, 2)`` odometry positions where those readings were taken.
+        odometry_trajectory: ``(T, 2)`` positions (of that estimate) where those readings were
+            taken.
         bumped: Whether the last step bumped into something.
         radius_m: The robot's radius.
         max_linear_speed_m_s, max_angular_speed_rad_s, control_period_s: Its motion limits.
