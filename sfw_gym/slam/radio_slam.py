@@ -43,6 +43,8 @@ class RadioSlamConfig(Config):
     # after a first solve, closures off by more than this many sigmas are dropped and the
     # graph solved again (0: keep all)
     outlier_sigma: float = setting(3.0, ge=0.0)
+    # Levenberg–Marquardt stops once a step lowers the cost by less than this fraction of it
+    stop_decrease: float = setting(1e-4, gt=0.0, lt=1.0)
     keyframe_every: int = setting(5, integer=True, ge=1)  # the graph's nodes: every k-th pose
     solve_every: int = setting(100, integer=True, ge=1)  # online (the env): poses between solves
 
@@ -151,7 +153,7 @@ def radio_slam(
             node[pairs[use]].tolist(), mean[use].tolist(), sigma[use].tolist(), strict=True
         ):
             graph.add_range(i, j, m, sd)
-        return graph.optimize(start)
+        return graph.optimize(start, relative_decrease=cfg.stop_decrease)
 
     use = np.ones(len(pairs), bool)
     solved = solve(use, start)
