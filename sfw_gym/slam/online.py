@@ -38,6 +38,11 @@ class OnlineRadioSlam:
     def __len__(self) -> int:
         return len(self._odometry)
 
+    @property
+    def odometry(self) -> np.ndarray:
+        """``(N, 3)`` the odometry poses so far (read-only)."""
+        return self._odometry.view
+
     def add(self, odometry_pose, fingerprint) -> int | None:
         """Take one pose's odometry ``(x, y, θ)`` and fingerprint ``(L,)`` (dBm, NaN: not
         heard); returns the first pose that a new solution moved by more than ``moved_m``, or

@@ -39,8 +39,7 @@ def test_radio_slam_rebuilds_the_map_exactly_along_its_corrected_trajectory():
     env, info = run("radio_slam", slam={"solve_every": 50})
     assert env.slam.n_solves == 12
     estimates = env.pose_estimates.view
-    odometry = np.array([info["odometry_pose"]])
-    assert np.abs(estimates[-1, :2] - odometry[-1, :2]).max() > 0.1  # corrections happened
+    assert np.abs(estimates[:, :2] - env.slam.odometry[:, :2]).max() > 0.2  # it corrected
     # the live map equals one built from scratch along the final estimate...
     mapper = SparseInverseKVisibility(env.grid, env.scene.radio.routers, env.mapper_config)
     x0, y0, x1, y1 = env.grid.bounds
@@ -65,10 +64,11 @@ def test_radio_slam_rebuilds_the_map_exactly_along_its_corrected_trajectory():
 
 
 def test_radio_slam_corrects_the_drift_that_odometry_leaves():
-    _, odometry = run("odometry", steps=1500)
-    _, slam = run("radio_slam", steps=1500)
-    assert odometry["ate_m"] > 1.0
-    assert slam["ate_m"] < 0.5 * odometry["ate_m"]  # on this plan; not on every one (BENCHMARKS)
+    seeds = (2_000_005, 2_000_006, 2_000_007)
+    odometry = np.mean([run("odometry", steps=1500, seed=s)[1]["ate_m"] for s in seeds])
+    slam = np.mean([run("radio_slam", steps=1500, seed=s)[1]["ate_m"] for s in seeds])
+    assert odometry > 2.0  # measured 2.9 m
+    assert slam < 0.6 * odometry  # measured 0.9 m
 
 
 def test_the_true_pose_maps_without_error_and_odometry_reports_its_drift():
