@@ -65,7 +65,8 @@ class GaussianGridmaps:
             v = np.clip(np.rint(var / scale[:, None, None] * _U8_MAX), 1, 255).astype(np.uint8)
         else:
             m, v = mean.astype(dtype), var.astype(dtype)
-        return cls(m, v, tuple(origin_xy), float(resolution_m), np.asarray(scale, np.float64))
+        origin = (float(origin_xy[0]), float(origin_xy[1]))
+        return cls(m, v, origin, float(resolution_m), np.asarray(scale, np.float64))
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -125,7 +126,7 @@ class GaussianGridmaps:
                 return cls(
                     data["mean"],
                     data["variance"],
-                    tuple(float(v) for v in data["origin_xy"]),
+                    (float(data["origin_xy"][0]), float(data["origin_xy"][1])),
                     float(data["resolution_m"]),
                     data["variance_scale"],
                 )

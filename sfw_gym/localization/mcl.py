@@ -41,7 +41,7 @@ def log_likelihood(z: np.ndarray, mean: np.ndarray, var: np.ndarray) -> np.ndarr
 
 
 def low_variance_indices(weights: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
-    """The low-variance (systematic) resampler: ``n`` indices drawn by ``weights`` (summing to 1)."""
+    """The low-variance (systematic) resampler: ``n`` indices drawn by ``weights`` (sum 1)."""
     positions = rng.uniform(0.0, 1.0 / n) + np.arange(n) / n
     cumulative = np.cumsum(weights)
     cumulative[-1] = 1.0
@@ -131,8 +131,7 @@ class WifiMCL:
         log_l = log_likelihood(z, mean, var)
         if self.allowed is not None:
             row, col = self.maps.cells(self.particles[:, :2])
-            h, w = self.maps.shape
-            log_l = np.where(self.allowed[row * w + col], log_l, log_l - 50.0)
+            log_l = np.where(self.allowed[row * self.maps.shape[1] + col], log_l, log_l - 50.0)
         top = float(log_l.max())
         like = np.exp(log_l - top)
         average = float(np.mean(like)) * np.exp(top)

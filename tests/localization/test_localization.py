@@ -1,4 +1,5 @@
-"""WiFi localisation on Gaussian gridmaps: surveys, GP models, gridmaps, Monte-Carlo localisation."""
+"""WiFi localisation on Gaussian gridmaps: surveys, GP models, gridmaps, Monte-Carlo
+localisation."""
 
 from __future__ import annotations
 
