@@ -20,8 +20,8 @@ _U8_MAX = 255.0
 @dataclass(frozen=True)
 class GaussianGridmaps:
     """Mean and variance gridmaps ``(L, h, w)`` of L access points over cells of ``resolution_m``
-    whose bottom-left corner is ``origin_xy``; stored as ``dtype`` (uint8: the mean × 255 and the
-    variance × 255 / its maximum, at least 1, as the paper does)."""
+    whose bottom-left corner is ``origin_xy``; each stored as float64, float16 or uint8 (uint8: the
+    mean × 255 and the variance × 255 / its maximum, at least 1, as the paper does)."""
 
     mean: np.ndarray
     variance: np.ndarray
@@ -35,11 +35,10 @@ class GaussianGridmaps:
         model: SignalModel,
         bounds: tuple[float, float, float, float],
         resolution_m: float,
-        dtype: str = "float64",
+        dtype: str | tuple[str, str] = "float64",
     ) -> GaussianGridmaps:
-        """Predict ``model`` at every cell centre of ``bounds`` ``(x0, y0, x1, y1)``."""
-        if dtype not in DTYPES:
-            raise ConfigError(f"dtype must be one of {DTYPES}, got {dtype!r}")
+        """Predict ``model`` at every cell centre of ``bounds`` ``(x0, y0, x1, y1)``; ``dtype``:
+        one for both maps, or ``(mean's, variance's)``."""
         if not resolution_m > 0:
             raise ConfigError(f"resolution_m must be > 0, got {resolution_m!r}")
         x0, y0, x1, y1 = map(float, bounds)
@@ -59,12 +58,20 @@ class GaussianGridmaps:
 
     @classmethod
     def quantised(cls, mean, var, origin_xy, resolution_m, scale, dtype) -> GaussianGridmaps:
-        """Store float maps as ``dtype``."""
-        if dtype == "uint8":
+        """Store float maps ``(L, h, w)`` as ``dtype`` (one, or ``(mean's, variance's)``)."""
+        mean_dtype, var_dtype = (dtype, dtype) if isinstance(dtype, str) else dtype
+        for d in (mean_dtype, var_dtype):
+            if d not in DTYPES:
+                raise ConfigError(f"dtype must be one of {DTYPES}, got {d!r}")
+        scale = np.asarray(scale, np.float64)
+        if mean_dtype == "uint8":
             m = np.clip(np.rint(mean * _U8_MAX), 0, 255).astype(np.uint8)
+        else:
+            m = mean.astype(mean_dtype)
+        if var_dtype == "uint8":
             v = np.clip(np.rint(var / scale[:, None, None] * _U8_MAX), 1, 255).astype(np.uint8)
         else:
-            m, v = mean.astype(dtype), var.astype(dtype)
+            v = var.astype(var_dtype)
         origin = (float(origin_xy[0]), float(origin_xy[1]))
         return cls(m, v, origin, float(resolution_m), np.asarray(scale, np.float64))
 
@@ -94,6 +101,7 @@ class GaussianGridmaps:
         var = self.variance[:, row, col].T.astype(np.float64)
         if self.mean.dtype == np.uint8:
             mean /= _U8_MAX
+        if self.variance.dtype == np.uint8:
             var *= self.variance_scale / _U8_MAX
         return mean, var
 

@@ -11,6 +11,7 @@ import numpy as np
 
 from sfw_gym.core.config import Config, setting
 from sfw_gym.core.errors import ConfigError
+from sfw_gym.localization.gp import SignalModel
 from sfw_gym.localization.gridmaps import GaussianGridmaps
 from sfw_gym.localization.survey import normalise_rssi
 
@@ -56,6 +57,9 @@ class WifiMCL:
         config: Particles and noise.
         rng: All randomness (pass the env's ``np_random``).
         allowed: Optional ``(h, w)`` mask of the cells a robot can be in (free space).
+        direct: Optional GP model: the sensor model predicts each particle's signals with it
+            (Eqs. 8–9, the paper's baseline) instead of reading the gridmaps; global
+            localisation still samples the gridmaps (Alg. 1).
     """
 
     def __init__(
@@ -64,8 +68,10 @@ class WifiMCL:
         config: MclConfig | None = None,
         rng: np.random.Generator | None = None,
         allowed: np.ndarray | None = None,
+        direct: SignalModel | None = None,
     ) -> None:
         self.maps = gridmaps
+        self._predict = direct.predict if direct is not None else gridmaps.lookup
         self.config = config or MclConfig()
         self.rng = rng if rng is not None else np.random.default_rng()
         if allowed is not None and np.shape(allowed) != gridmaps.shape:
@@ -127,7 +133,7 @@ class WifiMCL:
         z = normalise_rssi(rssi_dbm)
         if z.sum() <= 0:
             return  # nothing heard: nothing learned
-        mean, var = self.maps.lookup(self.particles[:, :2])
+        mean, var = self._predict(self.particles[:, :2])
         log_l = log_likelihood(z, mean, var)
         if self.allowed is not None:
             row, col = self.maps.cells(self.particles[:, :2])

@@ -87,6 +87,10 @@ def test_gridmaps_store_the_direct_prediction_at_cell_centres(models):
     m8, v8 = u8.lookup(centres)
     assert np.abs(m8 - direct_mean).max() <= 0.5 / 255 + 1e-12
     assert np.abs(v8 - direct_var).max() <= np.max(u8.variance_scale) / 255
+    mixed = GaussianGridmaps.from_model(mgp, (0, 0, 10, 10), 0.5, ("uint8", "float64"))
+    m, v = mixed.lookup(centres)
+    np.testing.assert_array_equal(m, m8)
+    np.testing.assert_allclose(v, direct_var)
 
 
 def test_gridmaps_round_trip_through_npz(tmp_path, models):
@@ -170,3 +174,14 @@ def test_a_kidnapped_robot_is_found_again():
     errors = drive(mcl, np.vstack([path[-1:], elsewhere]), rng, kidnap_at=1)
     assert errors[0] > 2.0  # lost at first
     assert errors[-20:].mean() < 0.7  # found again
+
+
+def test_mcl_on_direct_gp_prediction_tracks_like_on_its_gridmaps(models):
+    mgp = models[0]
+    maps = GaussianGridmaps.from_model(mgp, (0, 0, 10, 10), 0.25)
+    path = loop_path(60)
+    for direct in (None, mgp):
+        rng = np.random.default_rng(4)
+        mcl = WifiMCL(maps, MclConfig(particles=300), rng, direct=direct)
+        mcl.init_at(path[0])
+        assert drive(mcl, path, rng)[10:].mean() < 0.6
