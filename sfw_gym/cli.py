@@ -182,6 +182,24 @@ def _record_slam_log(path: str, env_id: str, seed: int, steps: int) -> RadioSlam
     return sfw.slam_config
 
 
+def _cmd_localize(args: argparse.Namespace) -> int:
+    from sfw_gym.evaluation.localization import run_localization_study
+
+    summary = run_localization_study(
+        args.json,
+        plans=args.plans,
+        runs=args.runs,
+        survey_steps=args.survey_steps,
+        test_steps=args.test_steps,
+        particles=args.particles,
+        direct=not args.no_direct,
+        workers=args.workers,
+    )
+    print(summary["markdown"])
+    print(f"wrote {args.json}/results.json, tables.md, gridmaps.png, error_over_time.png")
+    return 0
+
+
 def _cmd_bench(args: argparse.Namespace) -> int:
     from sfw_gym.bench import main_bench
 
@@ -415,6 +433,30 @@ def build_parser() -> argparse.ArgumentParser:
     )
     slam.add_argument("--out", type=folder, default=None, help="output folder (default LOG_slam/)")
     slam.set_defaults(func=_cmd_slam)
+
+    loc = sub.add_parser(
+        "localize",
+        help="WiFi Monte-Carlo localisation on Gaussian gridmaps: the paper's tables → OUT/",
+    )
+    loc.add_argument("--plans", type=positive_int, default=10, help="held-out plans (default 10)")
+    loc.add_argument(
+        "--runs", type=positive_int, default=3, help="MCL runs per plan and setting (default 3)"
+    )
+    loc.add_argument(
+        "--survey-steps", type=positive_int, default=2000, help="steps of each survey drive"
+    )
+    loc.add_argument(
+        "--test-steps", type=positive_int, default=400, help="steps of each test drive"
+    )
+    loc.add_argument("--particles", type=positive_int, default=500, help="particles (default 500)")
+    loc.add_argument(
+        "--no-direct", action="store_true", help="skip MCL on direct GP prediction (the slow part)"
+    )
+    loc.add_argument("--workers", type=positive_int, default=2, help="worker processes")
+    loc.add_argument(
+        "--json", type=folder, default="localize", help="output folder (default localize/)"
+    )
+    loc.set_defaults(func=_cmd_localize)
 
     bench = sub.add_parser("bench", help="env steps/s and reset ms beside CartPole-v1")
     bench.add_argument("--env", default="SfW-Explore-v0", help="env id (default SfW-Explore-v0)")

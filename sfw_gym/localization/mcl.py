@@ -5,6 +5,7 @@ average likelihood collapses (augmented MCL). Vectorised over particles."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -111,7 +112,7 @@ class WifiMCL:
         self.weights.fill(1.0 / n)
 
     # -- the filter ------------------------------------------------------------------------------
-    def predict(self, delta: np.ndarray) -> None:
+    def predict(self, delta: Sequence[float] | np.ndarray) -> None:
         """Move every particle by an odometry increment ``(dx, dy, dθ)`` in the robot's frame,
         with noise proportional to it."""
         dx, dy, dth = map(float, delta)
