@@ -263,7 +263,7 @@ class SfWExploreEnv(gym.Env):
         self.slam: OnlineRadioSlam | None = None
         self.map_history: MapHistory | None = None
         if self.pose_source == "radio_slam":
-            self.slam = OnlineRadioSlam(self.slam_config, self.slam_config.solve_every)
+            self.slam = OnlineRadioSlam(self.slam_config)
             self.map_history = MapHistory(self.slam_config.solve_every)
         self.last_gain_bits = 0.0
         self.last_rays: np.ndarray = np.zeros(0, np.int64)

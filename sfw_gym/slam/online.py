@@ -1,12 +1,12 @@
 """Radio SLAM as the robot drives: poses and fingerprints arrive one at a time, and every
-``every`` poses the whole pose graph is solved again, warm-started from the last solution."""
+``config.solve_every`` poses the whole pose graph is solved again, warm-started from the last
+solution."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from sfw_gym.core.buffers import AppendOnlyArray
-from sfw_gym.core.errors import ConfigError
 from sfw_gym.slam.pose_graph import chain
 from sfw_gym.slam.radio_slam import RadioSlamConfig, fit_range_model, radio_slam
 from sfw_gym.slam.range_model import SimilarityRangeModel
@@ -16,18 +16,12 @@ class OnlineRadioSlam:
     """Odometry poses and fingerprints in, the current best trajectory out.
 
     Args:
-        config: Radio SLAM's settings.
-        every: Solve again after this many new poses.
+        config: Radio SLAM's settings (``solve_every``: poses between solves).
         moved_m: A pose counts as corrected when a solution moves it further than this.
     """
 
-    def __init__(
-        self, config: RadioSlamConfig | None = None, every: int = 100, moved_m: float = 0.05
-    ) -> None:
-        if isinstance(every, bool) or not isinstance(every, int) or every < 1:
-            raise ConfigError(f"every must be an integer >= 1, got {every!r}")
+    def __init__(self, config: RadioSlamConfig | None = None, moved_m: float = 0.05) -> None:
         self.config = config or RadioSlamConfig()
-        self.every = every
         self.moved_m = float(moved_m)
         self._odometry = AppendOnlyArray(3)
         self._fingerprints: AppendOnlyArray | None = None
@@ -52,11 +46,11 @@ class OnlineRadioSlam:
             self._fingerprints = AppendOnlyArray(len(fingerprint))
         self._odometry.append(odometry_pose)
         self._fingerprints.append(fingerprint)
-        n = len(self)
-        if n % self.every or n < 2:
+        n, every = len(self), self.config.solve_every
+        if n % every or n < 2:
             return None
         odometry, fingerprints = self._odometry.view, self._fingerprints.view
-        fit_range_model(self.model, odometry, fingerprints, self.config, since=n - self.every)
+        fit_range_model(self.model, odometry, fingerprints, self.config, since=n - every)
         before = self.estimate()
         after = radio_slam(odometry, fingerprints, self.config, before, self.model).poses
         self._solved = after

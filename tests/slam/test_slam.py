@@ -222,3 +222,27 @@ def test_the_pose_graph_reaches_gtsams_optimum():
     ours = graph.optimize(odometry, iterations=200, relative_decrease=1e-12)[:, :2]
     assert np.abs(ours - odometry[:, :2]).max() > 0.1  # the closures did move the poses
     assert np.abs(ours - theirs).max() < 0.01
+
+
+def test_the_online_solver_fits_the_distance_model_as_the_offline_one_does():
+    from sfw_gym.slam import OnlineRadioSlam, RadioSlamConfig
+    from sfw_gym.slam.radio_slam import fit_range_model
+
+    rng = np.random.default_rng(0)
+    truth = square_loop(n_side=25, laps=3)
+    aps = rng.uniform(-5, 15, (8, 2))
+    d = np.linalg.norm(truth[:, None, :2] - aps[None], axis=2)
+    prints = -40 - 20 * np.log10(1 + d) + rng.normal(0, 2, d.shape)
+    config = RadioSlamConfig(solve_every=50)
+    online = OnlineRadioSlam(config)
+    moved = [online.add(pose, f) for pose, f in zip(truth, prints, strict=True)]
+    assert online.n_solves == len(truth) // 50
+    assert all(m is None for k, m in enumerate(moved) if (k + 1) % 50)  # solves only on schedule
+    offline = SimilarityRangeModel()
+    fit_range_model(offline, truth[: 50 * online.n_solves], prints[: 50 * online.n_solves], config)
+    np.testing.assert_array_equal(online.model._n, offline._n)
+    np.testing.assert_allclose(online.model._sum, offline._sum)
+    # between solves the estimate follows odometry from the last solved pose
+    estimate = online.estimate()
+    assert estimate.shape == truth.shape
+    np.testing.assert_allclose(online.latest(), estimate[-1])
