@@ -40,9 +40,18 @@ ENV_IDS: dict[str, dict[str, Any]] = {
         "n_background_aps": 16,
         "pose_source": "radio_slam",
     },
+    # Find yourself on a known plan: a survey's GP gridmaps and WiFi Monte-Carlo localisation
+    # from an unknown start (sfw_gym.envs.localize), the same drift and APs.
+    "SfW-Localize-v0": {
+        "robot": {"odometry_translation_std": 0.05, "odometry_heading_std_rad": 0.02},
+        "n_background_aps": 16,
+    },
 }
 #: Ids whose env is not the explore env itself.
-ENTRY_POINTS: dict[str, str] = {"SfW-ExploreGoals-v0": "sfw_gym.envs.goals:SfWGoalsEnv"}
+ENTRY_POINTS: dict[str, str] = {
+    "SfW-ExploreGoals-v0": "sfw_gym.envs.goals:SfWGoalsEnv",
+    "SfW-Localize-v0": "sfw_gym.envs.localize:SfWLocalizeEnv",
+}
 
 
 def register_envs() -> None:

@@ -103,7 +103,7 @@ def build_scene(
             f"(its observation has {max_routers} router slots; pass n_routers to gym.make)"
         )
     radio = RadioModel(plan, routers, radio_config, rng)
-    pose = _start_pose(plan, truth, origin, resolution_m, robot_config.radius_m, start_pose, rng)
+    pose = start_pose_in(plan, truth, origin, resolution_m, robot_config.radius_m, start_pose, rng)
     robot = Robot(plan.edges, robot_config, pose, rng)
     background = None
     if n_background_aps:
@@ -112,7 +112,7 @@ def build_scene(
     return EpisodeScene(plan, radio, robot, truth, origin, background)
 
 
-def _start_pose(
+def start_pose_in(
     plan: Floorplan,
     truth: np.ndarray,
     origin: tuple[float, float],
@@ -121,6 +121,7 @@ def _start_pose(
     start_pose: Any,
     rng: np.random.Generator,
 ) -> tuple[float, float, float]:
+    """``start_pose`` checked, or (None) a random free pose with clearance for the robot."""
     if start_pose is not None:
         pose = float_array("start_pose", start_pose)
         if pose.shape != (3,) or not np.isfinite(pose).all():

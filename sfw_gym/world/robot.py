@@ -323,6 +323,14 @@ class Robot:
         self._bumped = False
         return self.pose
 
+    def carry_to(self, pose: Sequence[float]) -> Pose:
+        """Move the robot to ``pose`` at rest as if carried there: its odometry does not see
+        the move (a kidnapping). Raises ConfigError as :meth:`reset` does."""
+        odometry = self._odometry
+        self.reset(pose)
+        self._odometry = odometry
+        return self.pose
+
     # ------------------------------------------------------------------ motion
 
     def step(self, linear_m_s: float, angular_rad_s: float) -> StepResult:
