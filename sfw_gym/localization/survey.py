@@ -3,6 +3,9 @@ that a GP fit stays affordable."""
 
 from __future__ import annotations
 
+import csv
+import math
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,6 +43,38 @@ class Survey:
     def from_dbm(cls, positions: np.ndarray, rssi_dbm: np.ndarray) -> Survey:
         """From readings in dBm (NaN or ≤ −100: not heard)."""
         return cls(np.asarray(positions, np.float64), normalise_rssi(rssi_dbm))
+
+    @classmethod
+    def from_csv(cls, path: str | os.PathLike[str]) -> Survey:
+        """A CSV with a header ``x, y`` (metres), then one column per access point (dBm; empty,
+        ``nan`` or ≤ −100: not heard); ConfigError naming the file and line otherwise."""
+        try:
+            with open(path, encoding="utf-8-sig", newline="") as fh:
+                rows = [
+                    (n, r) for n, r in enumerate(csv.reader(fh), 1) if any(c.strip() for c in r)
+                ]
+        except (OSError, UnicodeDecodeError, csv.Error) as exc:
+            raise ConfigError(f"{path}: cannot read the survey: {exc}") from None
+        header = [c.strip() for c in rows[0][1]] if rows else []
+        if header[:2] != ["x", "y"] or len(header) < 3:
+            raise ConfigError(
+                f"{path}: a survey's header is x, y, then one column per access point; "
+                f"found {header[:6]}"
+            )
+        values = np.empty((len(rows) - 1, len(header)))
+        for k, (line, row) in enumerate(rows[1:]):
+            if len(row) != len(header):
+                raise ConfigError(f"{path}:{line}: {len(row)} values, the header has {len(header)}")
+            for c, text in enumerate(row):
+                try:
+                    values[k, c] = float(text) if text.strip() else math.nan
+                except ValueError:
+                    raise ConfigError(
+                        f"{path}:{line}: {header[c]} is not a number: {text!r}"
+                    ) from None
+        if not len(values) or not np.isfinite(values[:, :2]).all():
+            raise ConfigError(f"{path}: no rows, or a position that is not a finite number")
+        return cls.from_dbm(values[:, :2], values[:, 2:])
 
     @property
     def n_access_points(self) -> int:

@@ -42,6 +42,20 @@ def test_binning_averages_the_readings_of_each_cell():
         Survey(np.zeros((3, 3)), np.zeros((3, 2)))
 
 
+def test_a_survey_reads_from_csv_and_a_bad_one_is_named(tmp_path):
+    path = tmp_path / "survey.csv"
+    path.write_text("x,y,ap_a,ap_b\n0,0,-50,\n1,2,-100,-30\n")
+    survey = Survey.from_csv(path)
+    np.testing.assert_allclose(survey.positions, [[0, 0], [1, 2]])
+    np.testing.assert_allclose(survey.signals, [[0.5, 0.0], [0.0, 0.7]])
+    path.write_text("x,y,ap_a\n0,0,-50\n1,oops,-40\n")
+    with pytest.raises(ConfigError, match=r"survey\.csv:3: y is not a number"):
+        Survey.from_csv(path)
+    path.write_text("a,b,c\n1,2,3\n")
+    with pytest.raises(ConfigError, match="header is x, y"):
+        Survey.from_csv(path)
+
+
 @pytest.fixture(scope="module")
 def survey() -> Survey:
     rng = np.random.default_rng(0)
