@@ -23,7 +23,14 @@ from sfw_gym.core.config import Config, setting
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.episode import start_pose_in
 from sfw_gym.envs.explore import SfWExploreEnv
-from sfw_gym.localization import GaussianGridmaps, MclConfig, SignalModel, Survey, WifiMCL
+from sfw_gym.localization import (
+    MEANS,
+    GaussianGridmaps,
+    MclConfig,
+    SignalModel,
+    Survey,
+    WifiMCL,
+)
 from sfw_gym.slam import relative_pose
 
 #: The belief summary's spread is divided by this (and clipped to 1) in the observation.
@@ -37,6 +44,7 @@ class LocalizeConfig(Config):
     prefix: ClassVar[str | None] = "localize"
     survey_spacing_m: float = setting(1.0, ge=0.1, le=10.0)
     per_ap: bool = setting(False, choices=(False, True))  # mGP: a model per AP, not one GP
+    mean: str = setting("zero", choices=MEANS)  # the GP's mean: zero, or a path-loss curve
     resolution_m: float = setting(0.25, ge=0.05, le=10.0)  # of the gridmaps
     particles: int = setting(500, integer=True, ge=10, le=100_000)
     kidnap_step: int = setting(0, integer=True, ge=0)  # 0: never
@@ -125,7 +133,8 @@ class SfWLocalizeEnv(gym.Env):
         points = np.column_stack([gx.ravel(), gy.ravel()])
         points = points[truth.floorplan.is_free(points)]
         readings = np.array([scene.background.measure(p) for p in points], np.float64)
-        model = SignalModel(Survey.from_dbm(points, readings), per_ap=self.config.per_ap)
+        survey = Survey.from_dbm(points, readings)
+        model = SignalModel(survey, per_ap=self.config.per_ap, mean=self.config.mean)
         return GaussianGridmaps.from_model(model, (x0, y0, x1, y1), self.config.resolution_m)
 
     def _kidnap(self) -> None:

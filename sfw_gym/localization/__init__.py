@@ -5,13 +5,14 @@ localisation with the paper's sensor model, global localisation and kidnapping r
 
 from __future__ import annotations
 
-from sfw_gym.localization.gp import SignalModel
+from sfw_gym.localization.gp import MEANS, SignalModel
 from sfw_gym.localization.gridmaps import DTYPES, GaussianGridmaps
 from sfw_gym.localization.mcl import MclConfig, WifiMCL, log_likelihood, low_variance_indices
 from sfw_gym.localization.survey import Survey, normalise_rssi
 
 __all__ = [
     "DTYPES",
+    "MEANS",
     "GaussianGridmaps",
     "MclConfig",
     "SignalModel",
