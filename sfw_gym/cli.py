@@ -266,6 +266,8 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         workers=args.workers,
         gif_episodes=args.gif_episodes if args.gif else 0,
         progress=not args.no_progress,
+        backend=args.backend,
+        address=args.address,
     )
     print((Path(args.out) / "results.md").read_text(encoding="utf-8"), end="")
     paired = Path(args.out) / "paired.md"
@@ -536,6 +538,15 @@ def build_parser() -> argparse.ArgumentParser:
         "--out", type=folder, default="evaluation", help="output folder (resumes from it)"
     )
     ev.add_argument("--workers", type=positive_int, default=2, help="worker processes (default 2)")
+    ev.add_argument(
+        "--backend",
+        choices=["local", "ray"],
+        default="local",
+        help="run episodes in local worker processes or as Ray tasks (pip install sfw-gym[ray])",
+    )
+    ev.add_argument(
+        "--address", default=None, help="with --backend ray: a cluster's address ('auto')"
+    )
     ev.add_argument("--gif", action="store_true", help="also write GIFs of the first episodes")
     ev.add_argument(
         "--gif-episodes", type=non_negative_int, default=1, help="episodes per agent with a GIF"

@@ -295,6 +295,8 @@ def evaluate(
     gif_episodes: int = 0,
     curve_every: int = 10,
     progress: bool = True,
+    backend: str = "local",
+    address: str | None = None,
 ) -> dict[str, Any]:
     """Run (or resume) an evaluation and write its table, curves and trajectory figures.
 
@@ -312,6 +314,9 @@ def evaluate(
         gif_episodes: Write GIFs of the first this many episodes of every agent.
         curve_every: Curve sampling interval, steps.
         progress: Show a tqdm progress bar.
+        backend: ``"local"`` (worker processes) or ``"ray"`` (episodes as Ray tasks, at most
+            ``workers`` at a time; a task whose worker dies runs again); the same records.
+        address: Ray's address (``"auto"``: a running cluster); None starts a local Ray.
 
     Returns:
         ``{"rows": summary rows, "records": episode records, "files": written paths}``; with
@@ -337,6 +342,10 @@ def evaluate(
         raise ConfigError(f"--episodes must be an int >= 1, got {episodes!r}")
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ConfigError(f"--workers must be an int >= 1, got {workers!r}")
+    if backend not in BACKENDS:
+        raise ConfigError(f"--backend must be one of {list(BACKENDS)}, got {backend!r}")
+    if backend == "ray":
+        _require_ray()
     for name, params in (agent_params or {}).items():  # fail early on bad parameters
         if not isinstance(params, dict):
             raise ConfigError(f"--agent-params: {name!r}: expected a JSON object, got {params!r}")
@@ -371,7 +380,16 @@ def evaluate(
     done = {r["key"] for r in records}
     todo = [s for s in specs if s.key not in done]
     write_text_atomic(out / "config.json", json.dumps(manifest, indent=2) + "\n")
-    _run_all(todo, records, ckpt, workers, progress, total=len(specs), done=len(specs) - len(todo))
+    _run_all(
+        todo,
+        records,
+        ckpt,
+        workers,
+        progress,
+        total=len(specs),
+        done=len(specs) - len(todo),
+        ray_address=address if backend == "ray" else _LOCAL,
+    )
     keys = {s.key for s in specs}
     mine = [r for r in records if r["key"] in keys]
     rows = summarize(mine, agents)
@@ -448,6 +466,50 @@ def _manifest(
     }
 
 
+#: Where episodes run.
+BACKENDS = ("local", "ray")
+_LOCAL = "local"
+#: A Ray task whose worker died runs again this many times (nothing lost, nothing twice: the
+#: checkpoint takes each episode's record once, when its task returns).
+RAY_RETRIES = 3
+
+
+def _require_ray() -> Any:
+    try:
+        import ray
+    except ImportError:
+        raise ConfigError("--backend ray needs Ray: pip install 'sfw-gym[ray]'") from None
+    return ray
+
+
+def _run_on_ray(todo: list[EpisodeSpec], finish: Any, workers: int, address: str | None) -> None:
+    """Episodes as Ray tasks, at most ``workers`` in flight, each record taken as it returns."""
+    ray = _require_ray()
+    started = not ray.is_initialized()
+    if started:
+        ray.init(
+            address=address,
+            num_cpus=workers if address is None else None,
+            include_dashboard=False,
+            log_to_driver=False,
+        )
+    task = ray.remote(max_retries=RAY_RETRIES)(run_episode)
+    queue: list[EpisodeSpec] = list(todo)
+    pending: list[Any] = []
+    try:
+        while queue or pending:
+            while queue and len(pending) < workers:
+                pending.append(task.remote(queue.pop(0)))
+            finished, pending = ray.wait(pending, num_returns=1)
+            for ref in finished:
+                finish(ray.get(ref))
+    finally:  # on an interrupt, drop the queued episodes; the checkpoint holds the done ones
+        for ref in pending:
+            ray.cancel(ref, force=True)
+        if started:
+            ray.shutdown()
+
+
 def _run_all(
     todo: list[EpisodeSpec],
     records: list[dict[str, Any]],
@@ -456,6 +518,7 @@ def _run_all(
     progress: bool,
     total: int,
     done: int,
+    ray_address: str | None = None,
 ) -> None:
     from tqdm.auto import tqdm
 
@@ -468,6 +531,9 @@ def _run_all(
         bar.update(1)
 
     try:
+        if ray_address != _LOCAL:
+            _run_on_ray(todo, finish, workers, ray_address)
+            return
         if workers == 1:
             for spec in todo:
                 finish(run_episode(spec))
