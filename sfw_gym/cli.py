@@ -154,32 +154,21 @@ def _record_slam_log(path: str, env_id: str, seed: int, steps: int) -> RadioSlam
     env's Radio SLAM settings (its odometry weights follow the robot's noise)."""
     import gymnasium as gym
 
-    import sfw_gym  # noqa: F401  (registration)
-    from sfw_gym.agents import FrontierAgent
     from sfw_gym.envs.explore import unwrap_sfw
+    from sfw_gym.evaluation.drives import record_frontier_drive
     from sfw_gym.slam.offline import write_slam_log
 
-    env = gym.make(env_id, max_steps=steps)
-    sfw = unwrap_sfw(env)
-    if not sfw.n_background_aps:
+    if not unwrap_sfw(gym.make(env_id)).n_background_aps:
         raise ConfigError(f"--env {env_id}: has no background access points to fingerprint")
-    obs, info = env.reset(seed=seed)
-    agent = FrontierAgent()
-    agent.reset(env, seed=seed)
-    period = sfw.robot_config.control_period_s
-    infos, done = [info], False
-    while not done:
-        obs, _, terminated, truncated, info = env.step(agent.act(obs))
-        infos.append(info)
-        done = terminated or truncated
+    drive = record_frontier_drive(env_id, seed, steps)
     write_slam_log(
         path,
-        period * np.arange(len(infos)),
-        np.array([i["odometry_pose"] for i in infos]),
-        np.array([i["fingerprint"] for i in infos]),
-        np.array([i["true_pose"] for i in infos]),
+        drive["period_s"] * np.arange(len(drive["truth"])),
+        drive["odometry"],
+        drive["fingerprints"],
+        drive["truth"],
     )
-    return sfw.slam_config
+    return drive["slam_config"]
 
 
 def _cmd_localize(args: argparse.Namespace) -> int:

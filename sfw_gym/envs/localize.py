@@ -90,6 +90,7 @@ class SfWLocalizeEnv(gym.Env):
         super().reset(seed=seed)
         obs, info = self.explore.reset(seed=seed, options=options)
         truth = self.explore.ground_truth()
+        self._bounds = truth.floorplan.bounds
         self.maps = self._survey_maps(truth)
         self.mcl = WifiMCL(self.maps, MclConfig(particles=self.config.particles), self.np_random)
         self.mcl.global_init(info["fingerprint"])
@@ -127,7 +128,7 @@ class SfWLocalizeEnv(gym.Env):
         """Fingerprints on a grid over the free space → the signal model → its gridmaps."""
         scene = self.explore.scene
         assert scene is not None and scene.background is not None
-        x0, y0, x1, y1 = truth.floorplan.bounds
+        x0, y0, x1, y1 = self._bounds
         step = self.config.survey_spacing_m
         gx, gy = np.meshgrid(np.arange(x0 + step / 2, x1, step), np.arange(y0 + step / 2, y1, step))
         points = np.column_stack([gx.ravel(), gy.ravel()])
@@ -158,7 +159,7 @@ class SfWLocalizeEnv(gym.Env):
         assert self.mcl is not None
         estimate, spread = self.mcl.estimate()
         self._spread = spread
-        x0, y0, x1, y1 = self.explore.ground_truth().floorplan.bounds
+        x0, y0, x1, y1 = self._bounds
         belief = np.array(
             [
                 np.clip((estimate[0] - x0) / (x1 - x0), 0.0, 1.0),

@@ -24,6 +24,7 @@ import numpy as np
 
 from sfw_gym.core.atomic import atomic_path, write_text_atomic
 from sfw_gym.core.processes import die_with_parent
+from sfw_gym.evaluation.drives import record_frontier_drive
 from sfw_gym.evaluation.stats import mean_ci95
 from sfw_gym.localization import GaussianGridmaps, MclConfig, SignalModel, Survey, WifiMCL
 from sfw_gym.slam import relative_pose
@@ -36,30 +37,9 @@ FIRST_SEED = 2_000_000
 
 
 def record_drive(seed: int, survey_steps: int, test_steps: int) -> dict[str, Any]:
-    """A frontier episode on ``SfW-ExploreDrift-v0``: truth, odometry, fingerprints, bounds, and
-    where the survey ends."""
-    import gymnasium as gym
-
-    import sfw_gym  # noqa: F401  (registration)
-    from sfw_gym.agents import FrontierAgent
-    from sfw_gym.envs.explore import unwrap_sfw
-
-    env = gym.make("SfW-ExploreDrift-v0", max_steps=survey_steps + test_steps)
-    obs, info = env.reset(seed=seed)
-    agent = FrontierAgent()
-    agent.reset(env, seed=seed)
-    infos, done = [info], False
-    while not done:
-        obs, _, terminated, truncated, info = env.step(agent.act(obs))
-        infos.append(info)
-        done = terminated or truncated
-    return {
-        "truth": np.array([i["true_pose"] for i in infos]),
-        "odometry": np.array([i["odometry_pose"] for i in infos]),
-        "fingerprints": np.array([i["fingerprint"] for i in infos]),
-        "bounds": unwrap_sfw(env).ground_truth().floorplan.bounds,
-        "survey_steps": survey_steps,
-    }
+    """A frontier drive on ``SfW-ExploreDrift-v0`` and where its survey ends."""
+    drive = record_frontier_drive("SfW-ExploreDrift-v0", seed, survey_steps + test_steps)
+    return {**drive, "survey_steps": survey_steps}
 
 
 def localise(
