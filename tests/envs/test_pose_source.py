@@ -87,3 +87,12 @@ def test_radio_slam_without_access_points_is_refused_by_name():
         gym.make("SfW-Explore-v0", pose_source="gps")
     with pytest.raises(ConfigError, match="slam"):
         gym.make("SfW-ExploreRadioSLAM-v0", slam={"keyframes": 3})
+
+
+def test_radio_slam_weighs_odometry_by_the_robots_noise_unless_told_otherwise():
+    env = gym.make("SfW-ExploreRadioSLAM-v0").unwrapped
+    # 5 % of a full-speed step (0.5 m/s x 0.2 s), 0.02 rad per step
+    assert env.slam_config.odometry_sigma_m == pytest.approx(0.005)
+    assert env.slam_config.odometry_sigma_rad == pytest.approx(0.02)
+    own = gym.make("SfW-ExploreRadioSLAM-v0", slam={"odometry_sigma_m": 0.03}).unwrapped
+    assert own.slam_config.odometry_sigma_m == 0.03

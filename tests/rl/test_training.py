@@ -288,6 +288,8 @@ def test_a_resumed_run_keeps_its_evaluations_and_survives_a_cut_monitor_line(tmp
     train_ppo("SfW-ExploreSmall-v0", 128, tmp_path, eval_episodes=1, progress_bar=False, **run)
     with (tmp_path / "train_0.monitor.csv").open("a") as fh:
         fh.write("0.71,30,")  # a line cut short by a kill
+    stale = tmp_path / "checkpoints" / ".ppo_192_steps.abc.tmp.zip"  # a save cut short by a kill
+    stale.write_bytes(b"PK half")
     assert _monitored_seconds(tmp_path) > 0
     train_ppo(
         "SfW-ExploreSmall-v0", 256, tmp_path, eval_episodes=1, resume=True, progress_bar=False,
@@ -295,6 +297,7 @@ def test_a_resumed_run_keeps_its_evaluations_and_survives_a_cut_monitor_line(tmp
     )  # fmt: skip
     steps = np.load(tmp_path / "eval" / "evaluations.npz")["timesteps"].tolist()
     assert steps == [64, 128, 192, 256]  # the first segment's evaluations are still there
+    assert not stale.exists()
     with pytest.raises(ConfigError, match="checkpoint_every must be an integer ≥ 1, got 0"):
         train_ppo("SfW-ExploreSmall-v0", 8, tmp_path / "x", **{**run, "checkpoint_every": 0})
 

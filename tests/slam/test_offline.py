@@ -26,6 +26,26 @@ def test_a_recorded_drifting_run_is_corrected_and_its_outputs_written(tmp_path, 
         assert fmap["positions"].shape == (1501, 2) and fmap["fingerprints_dbm"].shape == (1501, 16)
         np.testing.assert_allclose(fmap["positions"], trajectory[:, 1:3], atol=1e-5)
     assert (folder / "slam.png").stat().st_size > 10_000
+    # the odometry weights given on the command line are the ones used
+    loose = tmp_path / "loose"
+    assert (
+        main(
+            [
+                "slam",
+                str(log),
+                "--odometry-sigma",
+                "0.2",
+                "--heading-sigma",
+                "0.2",
+                "--out",
+                str(loose),
+            ]
+        )
+        == 0
+    )
+    assert not np.array_equal(
+        np.loadtxt(loose / "trajectory.csv", delimiter=",", skiprows=1), trajectory
+    )
     recorded = read_slam_log(log)
     assert np.isnan(recorded.fingerprints).any()  # not heard stays not heard
     assert recorded.truth is not None and recorded.odometry.shape == (1501, 3)

@@ -246,3 +246,47 @@ def test_the_online_solver_fits_the_distance_model_as_the_offline_one_does():
     estimate = online.estimate()
     assert estimate.shape == truth.shape
     np.testing.assert_allclose(online.latest(), estimate[-1])
+
+
+def test_rpe_measures_drift_per_step_and_the_metrics_module_has_every_score():
+    from sfw_gym import metrics
+    from sfw_gym.slam import relative_pose_error
+
+    truth = square_loop()
+    assert relative_pose_error(truth, truth) == (0.0, 0.0)
+    # every step 0.1 m too long along the robot's heading: 0.1 m of translation error per step
+    steps = np.diff(truth[:, :2], axis=0)
+    longer = steps * (1 + 0.1 / np.linalg.norm(steps, axis=1))[:, None]
+    stretched = truth.copy()
+    stretched[1:, :2] = truth[0, :2] + np.cumsum(longer, axis=0)
+    translation, rotation = relative_pose_error(stretched, truth)
+    assert translation == pytest.approx(0.1) and rotation == pytest.approx(0.0, abs=1e-12)
+    assert relative_pose_error(stretched, truth, delta=2)[0] == pytest.approx(0.2, rel=0.05)
+    with pytest.raises(ConfigError, match="delta"):
+        relative_pose_error(truth, truth, delta=0)
+    assert metrics.absolute_trajectory_error is absolute_trajectory_error
+    assert {"free_iou", "wall_precision", "relative_pose_error"} <= set(metrics.__all__)
+
+
+def test_false_closures_the_first_solve_disagrees_with_are_dropped():
+    from sfw_gym.slam import RadioSlamConfig, radio_slam
+
+    rng = np.random.default_rng(1)
+    truth = square_loop(n_side=25, laps=3)
+    aps = rng.uniform(-5, 15, (12, 2))
+    prints = -40 - 20 * np.log10(1 + np.linalg.norm(truth[:, None, :2] - aps[None], axis=2))
+    prints = prints + rng.normal(0, 1, prints.shape)
+    odometry = [truth[0]]
+    for k in range(len(truth) - 1):  # odometry with a heading bias
+        dx, dy, dth = relative_pose(truth[k], truth[k + 1])
+        odometry.append(compose_pose(odometry[-1], (dx, dy, dth + 0.01)))
+    odometry = np.array(odometry)
+    false = np.array([[0, 150, 0.5], [25, 175, 0.5], [10, 260, 0.3]])
+    apart = np.linalg.norm(
+        truth[false[:, 0].astype(int), :2] - truth[false[:, 1].astype(int), :2], axis=1
+    )
+    assert apart.min() > 5.0  # claimed 0.3-0.5 m: false
+    cfg = RadioSlamConfig(odometry_sigma_m=0.01)
+    kept = radio_slam(odometry, prints, cfg, extra_closures=false).closures.tolist()
+    assert not {(0, 150), (25, 175), (10, 260)} & {tuple(c) for c in kept}
+    assert len(kept) > 10  # the true ones stay
