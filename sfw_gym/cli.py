@@ -127,14 +127,20 @@ def _cmd_slam(args: argparse.Namespace) -> int:
     from sfw_gym.slam import RadioSlamConfig
     from sfw_gym.slam.offline import slam_log, trajectory_errors
 
-    if args.record is not None:
-        _record_slam_log(args.log, args.env, args.record, args.steps)
+    settings = {"keyframe_every": args.keyframes}
+    if args.record is not None:  # odometry weighted by the recording robot's noise model
+        recorded = _record_slam_log(args.log, args.env, args.record, args.steps)
+        settings |= {k: getattr(recorded, k) for k in ("odometry_sigma_m", "odometry_sigma_rad")}
         print(
             f"recorded {args.steps} frontier steps on {args.env} (seed {args.record}) to {args.log}"
         )
+    if args.odometry_sigma is not None:
+        settings["odometry_sigma_m"] = args.odometry_sigma
+    if args.heading_sigma is not None:
+        settings["odometry_sigma_rad"] = args.heading_sigma
     out = args.out or str(Path(args.log).with_suffix("")) + "_slam"
     start = time.perf_counter()
-    log, result, paths = slam_log(args.log, out, RadioSlamConfig(keyframe_every=args.keyframes))
+    log, result, paths = slam_log(args.log, out, RadioSlamConfig(**settings))
     print(
         f"{log.path}: {len(log.odometry)} poses, {len(log.access_points)} access points, "
         f"{len(result.closures)} radio loop closures; {time.perf_counter() - start:.1f} s"
