@@ -212,6 +212,10 @@ def _cmd_train(args: argparse.Namespace) -> int:
 
     if ":" not in args.env:  # ("module:Env-v0" registers on import, in the workers)
         gym.spec(args.env)  # an unknown id: an --env error, not a missing YAML block
+    if args.backend == "rllib":
+        return _train_on_rllib(args)
+    if args.num_env_runners is not None or args.address is not None:
+        raise ConfigError("--num-env-runners and --address need --backend rllib")
     summary = train_ppo(
         args.env,
         args.timesteps,
@@ -230,6 +234,33 @@ def _cmd_train(args: argparse.Namespace) -> int:
     print(
         f"trained {args.env} to "
         f"{summary['steps']:,} steps in {summary['wall_time_s']:.0f} s; model: {summary['model']}"
+    )
+    return 0
+
+
+def _train_on_rllib(args: argparse.Namespace) -> int:
+    from sfw_gym.rl.rllib import RLLIB_HYPERPARAMS, train_rllib
+
+    if args.algo != "ppo":
+        raise ConfigError(f"--backend rllib trains ppo only, got {args.algo!r}")
+    if args.n_envs is not None:
+        raise ConfigError("--n-envs is the stable-baselines3 backend's; RLlib: --num-env-runners")
+    summary = train_rllib(
+        args.env,
+        args.timesteps,
+        args.out or f"runs/rllib_ppo/{args.env}",
+        num_env_runners=args.num_env_runners or 0,
+        seed=args.seed,
+        hyperparams_path=args.hyperparams or RLLIB_HYPERPARAMS,
+        checkpoint_every=args.checkpoint_every,
+        resume=args.resume,
+        progress_bar=not args.no_progress,
+        address=args.address,
+    )
+    print(
+        f"trained {args.env} with RLlib to {summary['steps']:,} steps "
+        f"({summary['iterations']} iterations) in {summary['wall_time_s']:.0f} s; "
+        f"model: {summary['model']}"
     )
     return 0
 
@@ -476,7 +507,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     bench.set_defaults(func=_cmd_bench)
 
-    train = sub.add_parser("train", help="train an agent (PPO, stable-baselines3)")
+    train = sub.add_parser(
+        "train", help="train an agent (PPO: stable-baselines3, or RLlib with --backend rllib)"
+    )
     train.add_argument(
         "algo",
         choices=["ppo", "ppo_mask"],
@@ -502,6 +535,21 @@ def build_parser() -> argparse.ArgumentParser:
         type=non_negative_int,
         default=1,
         help="PyTorch CPU threads (default 1: small networks; 0: PyTorch's default)",
+    )
+    train.add_argument(
+        "--backend",
+        choices=["sb3", "rllib"],
+        default="sb3",
+        help="sb3 (stable-baselines3, default) or rllib (Ray RLlib; pip install 'sfw-gym[ray]')",
+    )
+    train.add_argument(
+        "--num-env-runners",
+        type=non_negative_int,
+        default=None,
+        help="with --backend rllib: Ray processes collecting episodes (default 0: the driver)",
+    )
+    train.add_argument(
+        "--address", default=None, help="with --backend rllib: a Ray cluster's address ('auto')"
     )
     train.add_argument("--resume", action="store_true", help="continue from the last checkpoint")
     train.add_argument("--no-progress", action="store_true", help="no progress bar")

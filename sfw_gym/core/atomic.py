@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -28,6 +29,21 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
         raise
 
 
+@contextmanager
+def atomic_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
+    """Yield a temporary folder beside ``path``; rename it onto ``path`` (which must not exist)
+    when the block succeeds, delete it when the block fails."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp"))
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
+
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:
     """Write UTF-8 ``text`` to ``path`` atomically; returns the path."""
     with atomic_path(path) as tmp:
@@ -36,11 +52,15 @@ def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:
 
 
 def remove_stale_temps(folder: str | os.PathLike[str]) -> list[Path]:
-    """Delete the temporary files that :func:`atomic_path` left under ``folder`` when its
-    process was killed mid-write (call when no writer is running there); returns them."""
-    stale = [p for p in Path(folder).rglob(".*.tmp*") if p.is_file()]
+    """Delete the temporary files and folders that :func:`atomic_path` and :func:`atomic_dir`
+    left under ``folder`` when their process was killed mid-write (call when no writer is
+    running there); returns them."""
+    stale = [p for p in Path(folder).rglob(".*.tmp*") if p.is_file() or p.is_dir()]
     for path in stale:
-        path.unlink(missing_ok=True)
+        if path.is_dir():
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            path.unlink(missing_ok=True)
     return stale
 
 

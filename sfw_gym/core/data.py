@@ -32,7 +32,7 @@ DEFAULT_HYPERPARAMS = data_path("agents", "hyperparams", "ppo.yml")
 
 
 def default_hyperparams(algo: str) -> Path:
-    """rl-zoo's hyperparameter file of ``algo`` (``ppo``, ``ppo_mask``)."""
+    """rl-zoo's hyperparameter file of ``algo`` (``ppo``, ``ppo_mask``, ``rllib_ppo``)."""
     return data_path("agents", "hyperparams", f"{algo}.yml")
 
 
