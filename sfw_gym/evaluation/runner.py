@@ -234,6 +234,16 @@ def _save_checkpoint(path: Path, records: Iterable[dict[str, Any]]) -> None:
     write_text_atomic(path, "".join(json.dumps(r) + "\n" for r in records))
 
 
+def _append_record(path: Path, record: dict[str, Any]) -> None:
+    """One record onto the checkpoint, on disk before returning (O(1) per episode: a study of
+    16,000 episodes must not rewrite the file each time). A line cut by a kill is dropped by
+    :func:`load_checkpoint`, and the resume rewrites the file clean before appending again."""
+    with path.open("a", encoding="utf-8") as fh:
+        fh.write(json.dumps(record) + "\n")
+        fh.flush()
+        os.fsync(fh.fileno())
+
+
 # ---------------------------------------------------------------------------------- the runner
 def episode_specs(
     agents: Sequence[str],
@@ -374,6 +384,7 @@ def evaluate(
     remove_stale_temps(out)  # of a run killed mid-write
     ckpt = out / CHECKPOINT
     records = load_checkpoint(ckpt)
+    _save_checkpoint(ckpt, records)  # clean: no line cut by a kill before the next appends
     manifest = _manifest(
         out, records, agents, episodes, seed, env_id, floorplans, env_kwargs, agent_params
     )
@@ -526,7 +537,7 @@ def _run_all(
 
     def finish(record: dict[str, Any]) -> None:
         records.append(record)
-        _save_checkpoint(ckpt, records)
+        _append_record(ckpt, record)
         bar.set_postfix_str(f"{record['agent']} #{record['episode']} cov {record['coverage']:.2f}")
         bar.update(1)
 

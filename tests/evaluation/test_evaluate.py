@@ -129,7 +129,7 @@ def test_interrupted_run_resumes_without_redoing_episodes(tmp_path, monkeypatch)
         ev.evaluate(["frontier", "random"], 2, seed=0, out=tmp_path, **TINY)
     done = ev.load_checkpoint(tmp_path / ev.CHECKPOINT)
     assert [r["key"] for r in done] == calls
-    # A torn last line (a crash mid-write of an older, non-atomic writer) is ignored.
+    # A torn last line (a kill mid-append) is ignored, and the appends after it stay readable.
     with (tmp_path / ev.CHECKPOINT).open("a") as fh:
         fh.write('{"key": "trunc')
     rerun: list[str] = []
@@ -142,6 +142,10 @@ def test_interrupted_run_resumes_without_redoing_episodes(tmp_path, monkeypatch)
     result = ev.evaluate(["frontier", "random"], 2, seed=0, out=tmp_path, **TINY)
     assert len(rerun) == 2 and not set(rerun) & set(calls)
     assert len(result["records"]) == 4
+    lines = (tmp_path / ev.CHECKPOINT).read_text().splitlines()
+    assert sorted(json.loads(line)["key"] for line in lines) == sorted(
+        r["key"] for r in result["records"]
+    )
     # Asking for more episodes later runs only the new ones.
     rerun.clear()
     ev.evaluate(["frontier", "random"], 3, seed=0, out=tmp_path, **TINY)
