@@ -40,6 +40,15 @@ ENV_IDS: dict[str, dict[str, Any]] = {
         "n_background_aps": 16,
         "pose_source": "radio_slam",
     },
+    # A 2-D LiDAR on the robot (360 beams, 8 m), the same drift and APs, mapped along
+    # Radio+LiDAR SLAM's trajectory (the Radio SLAM paper's second system): the reference for
+    # how close WiFi-only mapping comes (sfw_gym.slam.radio_lidar).
+    "SfW-ExploreLidar-v0": {
+        "robot": {"odometry_translation_std": 0.05, "odometry_heading_std_rad": 0.02},
+        "n_background_aps": 16,
+        "lidar": {},
+        "pose_source": "radio_lidar",
+    },
     # Find yourself on a known plan: a survey's GP gridmaps and WiFi Monte-Carlo localisation
     # from an unknown start (sfw_gym.envs.localize), the same drift and APs.
     "SfW-Localize-v0": {

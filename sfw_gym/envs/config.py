@@ -11,8 +11,9 @@ from sfw_gym.world.radio import BANDS, PRESETS
 
 ACTION_TYPES = ("continuous", "discrete")
 #: Where the robot believes it is, and so where it maps: its odometry, Radio SLAM (odometry
-#: corrected by radio loop closures, the map rebuilt along each correction), or the truth.
-POSE_SOURCES = ("odometry", "radio_slam", "true")
+#: corrected by radio loop closures, the map rebuilt along each correction), Radio+LiDAR SLAM
+#: (also LiDAR scan matching; needs the LiDAR), or the truth.
+POSE_SOURCES = ("odometry", "radio_slam", "radio_lidar", "true")
 #: Keys of ``reset(options=...)``.
 RESET_OPTIONS = ("floorplan", "routers", "start_pose")
 
@@ -50,8 +51,8 @@ class ExploreConfig(Config):
     pose_source: str = setting("odometry", choices=POSE_SOURCES)
 
     def validate(self) -> None:
-        if self.pose_source == "radio_slam" and self.n_background_aps < 1:
+        if self.pose_source in ("radio_slam", "radio_lidar") and self.n_background_aps < 1:
             raise ConfigError(
-                "pose_source='radio_slam' closes loops with background access points: "
+                f"pose_source={self.pose_source!r} closes loops with background access points: "
                 "pass n_background_aps >= 1 (SfW-ExploreRadioSLAM-v0 has 16)"
             )

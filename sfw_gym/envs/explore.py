@@ -22,13 +22,15 @@ from sfw_gym.envs.map_tracker import MapTracker
 from sfw_gym.envs.observation import (
     ObservationBuilder,
     fingerprint_observation,
+    lidar_observation,
     observation_space,
 )
 from sfw_gym.mapping import GridSpec, MapperConfig, SparseInverseKVisibility
 from sfw_gym.navigation.view import RobotView
-from sfw_gym.slam import OnlineRadioSlam, RadioSlamConfig
+from sfw_gym.slam import OnlineRadioLidarSlam, OnlineRadioSlam, RadioSlamConfig
 from sfw_gym.world import Floorplan, Pose, RadioConfig, RobotConfig
 from sfw_gym.world.generator import GeneratorConfig
+from sfw_gym.world.lidar import Lidar, LidarConfig
 
 
 class SfWExploreEnv(gym.Env):
@@ -95,8 +97,11 @@ class SfWExploreEnv(gym.Env):
     and ``info["fingerprint"]``; Radio SLAM's input), ``pose_source`` ("odometry": the robot maps
     where its odometry says it is; "radio_slam": odometry corrected by radio loop closures
     between background-AP fingerprints, solved every ``slam["solve_every"]`` steps, the map
-    rebuilt along each correction; "true": the true pose), ``slam`` (dict of `RadioSlamConfig`
-    overrides; the odometry weights default to the robot's noise model), ``render_mode`` (None |
+    rebuilt along each correction; "radio_lidar": Radio+LiDAR SLAM, the same with LiDAR scan
+    matching; "true": the true pose), ``slam`` (dict of `RadioSlamConfig` overrides; the
+    odometry weights default to the robot's noise model), ``lidar`` (None: no LiDAR, the
+    default; a dict of `LidarConfig` overrides, ``{}`` for the defaults: a simulated 2-D LiDAR,
+    ``obs["lidar"]`` and ``info["lidar_ranges"]``), ``render_mode`` (None |
     "rgb_array" | "human"), ``render_size`` ((960, 480): every frame is ``width × height``, the
     plan letterboxed into it, so video writers work across plans; None: the plan's own size).
     ``reset(options=…)``: ``floorplan`` (a Floorplan, a path or a generator seed), ``routers``
@@ -130,6 +135,7 @@ class SfWExploreEnv(gym.Env):
         n_background_aps: int = 0,
         pose_source: str = "odometry",
         slam: dict[str, Any] | None = None,
+        lidar: dict[str, Any] | None = None,
         render_mode: str | None = None,
         render_size: tuple[int, int] | None = (960, 480),
         **unknown: Any,
@@ -203,7 +209,16 @@ class SfWExploreEnv(gym.Env):
         self.slam_config = RadioSlamConfig.from_dict(
             {**slam_defaults, **_overrides("slam", slam)}, "slam"
         )
-        self.observation_space = observation_space(n_routers, map_px, crop_px, cfg.n_background_aps)
+        self.lidar_config = None if lidar is None else LidarConfig.from_dict(lidar, "lidar")
+        if self.pose_source == "radio_lidar" and self.lidar_config is None:
+            raise ConfigError("pose_source='radio_lidar' matches LiDAR scans: pass lidar={} (on)")
+        self.observation_space = observation_space(
+            n_routers,
+            map_px,
+            crop_px,
+            cfg.n_background_aps,
+            self.lidar_config.beams if self.lidar_config else 0,
+        )
         if action_type == "continuous":
             self.action_space = spaces.Box(-1.0, 1.0, (2,), np.float32)
         else:
@@ -260,10 +275,14 @@ class SfWExploreEnv(gym.Env):
         self.pose_estimates = AppendOnlyArray(3, np.float64)
         self.pose_estimate = s.robot.odometry_pose
         self._squared_pose_errors = 0.0
+        self.lidar = None if self.lidar_config is None else Lidar(s.floorplan, self.lidar_config)
         self.slam: OnlineRadioSlam | None = None
         self.map_history: MapHistory | None = None
         if self.pose_source == "radio_slam":
             self.slam = OnlineRadioSlam(self.slam_config)
+        elif self.pose_source == "radio_lidar":
+            self.slam = OnlineRadioLidarSlam(self.slam_config)
+        if self.slam is not None:
             self.map_history = MapHistory(self.slam_config.solve_every)
         self.last_gain_bits = 0.0
         self.last_rays: np.ndarray = np.zeros(0, np.int64)
@@ -332,6 +351,8 @@ class SfWExploreEnv(gym.Env):
         rssi, true_k = s.radio.measure_with_k(np.array(true_pose[:2]))
         if s.background is not None:  # the fingerprint of the access points beyond the routers
             self.fingerprint = s.background.measure(np.array(true_pose[:2])).astype(np.float64)
+        if self.lidar is not None:
+            self.lidar_ranges = self.lidar.scan(true_pose, self.np_random)
         entropy_before = self.mapper.entropy_bits
         pose = self._estimate_pose(true_pose)
         self.pose_estimate = pose
@@ -360,6 +381,8 @@ class SfWExploreEnv(gym.Env):
         )
         if s.background is not None:
             obs.update(fingerprint_observation(self.fingerprint))
+        if self.lidar is not None:
+            obs["lidar"] = lidar_observation(self.lidar_ranges, self.lidar.config.max_range_m)
         return obs
 
     def _estimate_pose(self, true_pose: Pose) -> Pose:
@@ -371,7 +394,12 @@ class SfWExploreEnv(gym.Env):
         odometry = self.scene.robot.odometry_pose
         if self.slam is None:
             return odometry
-        moved_from = self.slam.add(odometry, self.fingerprint)
+        if isinstance(self.slam, OnlineRadioLidarSlam):
+            assert self.lidar is not None
+            points = self.lidar.points((0.0, 0.0, 0.0), self.lidar_ranges)
+            moved_from = self.slam.add_with_scan(odometry, self.fingerprint, points)
+        else:
+            moved_from = self.slam.add(odometry, self.fingerprint)
         if moved_from is not None:
             self._remap(self.slam.estimate()[:-1], moved_from)
         return Pose(*self.slam.latest().tolist())
@@ -442,6 +470,8 @@ class SfWExploreEnv(gym.Env):
             info["fingerprint"] = np.where(
                 self.fingerprint > NOT_HEARD_DBM, self.fingerprint, np.nan
             )
+        if self.lidar is not None:  # metres per beam, inf where nothing returned
+            info["lidar_ranges"] = self.lidar_ranges.copy()
         if terminal:
             info["summary"] = {k: v for k, v in info.items() if np.isscalar(v)} | {
                 "steps": self.steps,

@@ -22,11 +22,12 @@ TRAJECTORY_U8, ROBOT_U8 = 128, 255
 
 
 def observation_space(
-    n_routers: int, map_px: int, crop_px: int, n_background_aps: int = 0
+    n_routers: int, map_px: int, crop_px: int, n_background_aps: int = 0, lidar_beams: int = 0
 ) -> spaces.Dict:
     """The Dict space: ``map`` (3, map_px, map_px), ``local`` (1, crop_px, crop_px), ``state``;
     with background access points also ``fingerprint`` (their RSSI scaled as the routers' in
-    ``state``, 0 where not heard) and ``fingerprint_heard`` (1 where heard)."""
+    ``state``, 0 where not heard) and ``fingerprint_heard`` (1 where heard); with a LiDAR,
+    ``lidar`` (each beam's range ÷ max range, 1 where nothing returned)."""
     entries: dict[str, spaces.Space] = {
         "map": spaces.Box(0, 255, (len(MAP_CHANNELS), map_px, map_px), np.uint8),
         "local": spaces.Box(0, 255, (1, crop_px, crop_px), np.uint8),
@@ -35,7 +36,14 @@ def observation_space(
     if n_background_aps:
         entries["fingerprint"] = spaces.Box(0.0, 1.0, (n_background_aps,), np.float32)
         entries["fingerprint_heard"] = spaces.Box(0, 1, (n_background_aps,), np.int8)
+    if lidar_beams:
+        entries["lidar"] = spaces.Box(0.0, 1.0, (lidar_beams,), np.float32)
     return spaces.Dict(entries)
+
+
+def lidar_observation(ranges_m: np.ndarray, max_range_m: float) -> np.ndarray:
+    """The ``lidar`` entry: ranges ÷ ``max_range_m``, 1 where a beam returned nothing."""
+    return np.minimum(ranges_m / max_range_m, 1.0).astype(np.float32)
 
 
 def fingerprint_observation(rssi_dbm: np.ndarray) -> dict[str, np.ndarray]:

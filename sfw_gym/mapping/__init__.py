@@ -10,12 +10,14 @@ from sfw_gym.mapping.config import MapperConfig
 from sfw_gym.mapping.dense import dense_inverse_k_visibility
 from sfw_gym.mapping.grid import GridSpec, belief_classes
 from sfw_gym.mapping.k_estimation import KEstimator
+from sfw_gym.mapping.lidar_map import LidarOccupancyMap
 from sfw_gym.mapping.raycast import ray_cells, traverse_grid
 from sfw_gym.mapping.sparse import SparseInverseKVisibility
 
 __all__ = [
     "GridSpec",
     "KEstimator",
+    "LidarOccupancyMap",
     "MapperConfig",
     "SparseInverseKVisibility",
     "belief_classes",

@@ -8,8 +8,10 @@ import numpy as np
 
 from sfw_gym.core.buffers import AppendOnlyArray
 from sfw_gym.slam.pose_graph import chain
+from sfw_gym.slam.radio_lidar import LidarSlamConfig, lidar_slam
 from sfw_gym.slam.radio_slam import RadioSlamConfig, fit_range_model, radio_slam
 from sfw_gym.slam.range_model import SimilarityRangeModel
+from sfw_gym.slam.scan_matching import IcpConfig, IcpResult
 
 
 class OnlineRadioSlam:
@@ -52,11 +54,14 @@ class OnlineRadioSlam:
         odometry, fingerprints = self._odometry.view, self._fingerprints.view
         fit_range_model(self.model, odometry, fingerprints, self.config, since=n - every)
         before = self.estimate()
-        after = radio_slam(odometry, fingerprints, self.config, before, self.model).poses
+        after = self._solve(odometry, fingerprints, before)
         self._solved = after
         self.n_solves += 1
         moved = np.flatnonzero(np.hypot(*(after[:, :2] - before[:, :2]).T) > self.moved_m)
         return int(moved[0]) if len(moved) else None
+
+    def _solve(self, odometry: np.ndarray, fingerprints: np.ndarray, before: np.ndarray):
+        return radio_slam(odometry, fingerprints, self.config, before, self.model).poses
 
     def estimate(self) -> np.ndarray:
         """``(N, 3)`` poses: the last solution, then odometry chained on from its last pose."""
@@ -74,3 +79,43 @@ class OnlineRadioSlam:
         if m == 0:
             return odometry[-1].copy()
         return chain(self._solved[-1], odometry[m - 1], odometry[-1:])[0]
+
+
+class OnlineRadioLidarSlam(OnlineRadioSlam):
+    """Radio+LiDAR SLAM as the robot drives: as :class:`OnlineRadioSlam`, with each pose's LiDAR
+    scan (points in the robot's frame; kept at keyframes) and :func:`lidar_slam` as the solver
+    (consecutive registrations cached between solves)."""
+
+    def __init__(
+        self,
+        config: RadioSlamConfig | None = None,
+        lidar_config: LidarSlamConfig | None = None,
+        icp_config: IcpConfig | None = None,
+        moved_m: float = 0.05,
+    ) -> None:
+        super().__init__(config, moved_m)
+        self.lidar_config = lidar_config or LidarSlamConfig()
+        self.icp_config = icp_config or IcpConfig()
+        self._scans: dict[int, np.ndarray] = {}
+        self._registrations: dict[tuple[int, int], IcpResult] = {}
+
+    def add_with_scan(self, odometry_pose, fingerprint, points: np.ndarray) -> int | None:
+        """:meth:`OnlineRadioSlam.add` with this pose's scan points ``(M, 2)``."""
+        index = len(self)
+        self._scans[index] = np.asarray(points, np.float64)
+        if index > 0 and (index - 1) % self.config.keyframe_every:
+            del self._scans[index - 1]  # kept only while it was the latest pose
+        return self.add(odometry_pose, fingerprint)
+
+    def _solve(self, odometry: np.ndarray, fingerprints: np.ndarray, before: np.ndarray):
+        return lidar_slam(
+            odometry,
+            self._scans,
+            fingerprints,
+            radio=self.config,
+            config=self.lidar_config,
+            icp_config=self.icp_config,
+            initial=before,
+            model=self.model,
+            cache=self._registrations,
+        ).poses

@@ -51,11 +51,18 @@ class RadioSlamConfig(Config):
 
 @dataclass
 class RadioSlamResult:
-    """Corrected poses ``(N, 3)``, the closures used ``(C, 2)`` with their distance estimates."""
+    """Corrected poses ``(N, 3)``, the closures used ``(C, 2)`` with their distance estimates
+    and standard deviations."""
 
     poses: np.ndarray
     closures: np.ndarray
     closure_distance_m: np.ndarray
+    closure_sigma_m: np.ndarray
+
+
+def keyframes(n: int, every: int) -> np.ndarray:
+    """The pose graph's nodes among ``n`` poses: every ``every``-th pose and the last."""
+    return np.unique(np.r_[np.arange(0, n, every), n - 1])
 
 
 def travelled_m(odometry: np.ndarray) -> np.ndarray:
@@ -100,15 +107,69 @@ def radio_slam(
     (another detector's, or false ones to test the robust kernel)."""
     cfg = config or RadioSlamConfig()
     odo = np.asarray(odometry, np.float64)
-    fp = np.asarray(fingerprints, np.float64)
     n = len(odo)
+    # The graph's nodes: every keyframe_every-th pose and the last (the poses between follow
+    # their keyframe's odometry); closures between keyframes only.
+    keys = keyframes(n, cfg.keyframe_every)
+    pairs, mean, sigma = radio_closures(odo, fingerprints, cfg, model, extra_closures)
+    node = np.full(n, -1)
+    node[keys] = np.arange(len(keys))
+    start = (odo if initial is None else np.asarray(initial, np.float64))[keys]
+
+    def solve(use: np.ndarray, start: np.ndarray) -> np.ndarray:
+        graph = PoseGraph(len(keys), robust=cfg.robust, robust_scale=cfg.robust_scale)
+        for k, (a, b) in enumerate(zip(keys[:-1].tolist(), keys[1:].tolist(), strict=True)):
+            spread = math.sqrt(b - a)  # independent per-step errors add up
+            graph.add_odometry(
+                k,
+                k + 1,
+                relative_pose(odo[a], odo[b]),
+                cfg.odometry_sigma_m * spread,
+                cfg.odometry_sigma_rad * spread,
+            )
+        for (i, j), m, sd in zip(
+            node[pairs[use]].tolist(), mean[use].tolist(), sigma[use].tolist(), strict=True
+        ):
+            graph.add_range(i, j, m, sd)
+        return graph.optimize(start, relative_decrease=cfg.stop_decrease)
+
+    use = np.ones(len(pairs), bool)
+    solved = solve(use, start)
+    if cfg.outlier_sigma and len(pairs):  # drop the closures the solution disagrees with
+        use = consistent_closures(solved[node[pairs]], mean, sigma, cfg.outlier_sigma)
+        if not use.all():
+            solved = solve(use, solved)
+    anchor = keys[np.searchsorted(keys, np.arange(n), side="right") - 1]
+    poses = chain(solved[node[anchor]], odo[anchor], odo)
+    return RadioSlamResult(poses, pairs[use], mean[use], sigma[use])
+
+
+def consistent_closures(
+    ends: np.ndarray, distance_m: np.ndarray, sigma_m: np.ndarray, outlier_sigma: float
+) -> np.ndarray:
+    """Which range closures a solution agrees with: its poses ``ends`` ``(C, 2, 3)`` lie within
+    ``outlier_sigma`` standard deviations of each closure's distance."""
+    apart = np.linalg.norm(ends[:, 1, :2] - ends[:, 0, :2], axis=1)
+    return np.abs(apart - distance_m) <= outlier_sigma * sigma_m
+
+
+def radio_closures(
+    odometry: np.ndarray,
+    fingerprints: np.ndarray,
+    config: RadioSlamConfig | None = None,
+    model: SimilarityRangeModel | None = None,
+    extra_closures: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Radio loop closures between keyframes: pose pairs ``(C, 2)``, their distance estimates
+    and standard deviations (m); the arguments as :func:`radio_slam`'s."""
+    cfg = config or RadioSlamConfig()
+    odo = np.asarray(odometry, np.float64)
+    fp = np.asarray(fingerprints, np.float64)
     travelled = travelled_m(odo)
     if model is None:
         model = SimilarityRangeModel()
         fit_range_model(model, odo, fp, cfg)
-    # The graph's nodes: every keyframe_every-th pose and the last (the poses between follow
-    # their keyframe's odometry); closures between keyframes only.
-    keys = np.unique(np.r_[np.arange(0, n, cfg.keyframe_every), n - 1])
+    keys = keyframes(len(odo), cfg.keyframe_every)
     pairs = keys[
         closure_candidates(
             fp[keys],
@@ -133,37 +194,4 @@ def radio_slam(
         pairs = np.concatenate([pairs, ends])
         mean = np.concatenate([mean, extra[:, 2]])
         var = np.concatenate([var, np.full(len(extra), typical)])
-    node = np.full(n, -1)
-    node[keys] = np.arange(len(keys))
-    sigma = np.maximum(np.sqrt(var), cfg.min_sigma_m)
-    start = (odo if initial is None else np.asarray(initial, np.float64))[keys]
-
-    def solve(use: np.ndarray, start: np.ndarray) -> np.ndarray:
-        graph = PoseGraph(len(keys), robust=cfg.robust, robust_scale=cfg.robust_scale)
-        for k, (a, b) in enumerate(zip(keys[:-1].tolist(), keys[1:].tolist(), strict=True)):
-            spread = math.sqrt(b - a)  # independent per-step errors add up
-            graph.add_odometry(
-                k,
-                k + 1,
-                relative_pose(odo[a], odo[b]),
-                cfg.odometry_sigma_m * spread,
-                cfg.odometry_sigma_rad * spread,
-            )
-        for (i, j), m, sd in zip(
-            node[pairs[use]].tolist(), mean[use].tolist(), sigma[use].tolist(), strict=True
-        ):
-            graph.add_range(i, j, m, sd)
-        return graph.optimize(start, relative_decrease=cfg.stop_decrease)
-
-    use = np.ones(len(pairs), bool)
-    solved = solve(use, start)
-    if cfg.outlier_sigma and len(pairs):  # drop the closures the solution disagrees with
-        ends = solved[node[pairs]]
-        apart = np.linalg.norm(ends[:, 1, :2] - ends[:, 0, :2], axis=1)
-        use = np.abs(apart - mean) <= cfg.outlier_sigma * sigma
-        if not use.all():
-            solved = solve(use, solved)
-    pairs, mean = pairs[use], mean[use]
-    anchor = keys[np.searchsorted(keys, np.arange(n), side="right") - 1]
-    poses = chain(solved[node[anchor]], odo[anchor], odo)
-    return RadioSlamResult(poses, pairs, mean)
+    return pairs, mean, np.maximum(np.sqrt(var), cfg.min_sigma_m)

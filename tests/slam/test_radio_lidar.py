@@ -1,0 +1,122 @@
+"""Radio+LiDAR SLAM and the LiDAR-only baseline (sfw_gym.slam.radio_lidar) on recorded drives,
+and SfW-ExploreLidar-v0, which maps along it as the robot drives."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+from sfw_gym.agents import FrontierAgent
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.slam import (
+    LidarSlamConfig,
+    OnlineRadioLidarSlam,
+    RadioSlamConfig,
+    absolute_trajectory_error,
+    lidar_slam,
+    radio_slam,
+)
+from sfw_gym.slam.radio_slam import keyframes
+
+DRIFT = {"odometry_translation_std": 0.05, "odometry_heading_std_rad": 0.02}
+
+
+@pytest.fixture(scope="module")
+def drive():
+    """A 900-step frontier drive with drift, 16 background APs and the LiDAR (seed 7)."""
+    env = gym.make("SfW-Explore-v0", robot=DRIFT, n_background_aps=16, lidar={}, max_steps=900)
+    obs, info = env.reset(seed=7)
+    agent = FrontierAgent()
+    agent.reset(env, seed=7)
+    infos, done = [info], False
+    while not done:
+        obs, _, terminated, truncated, info = env.step(agent.act(obs))
+        infos.append(info)
+        done = terminated or truncated
+    u = env.unwrapped
+    odometry = np.array([i["odometry_pose"] for i in infos])
+    keys = keyframes(len(odometry), u.slam_config.keyframe_every)
+    return {
+        "truth": np.array([i["true_pose"] for i in infos]),
+        "odometry": odometry,
+        "fingerprints": np.array([i["fingerprint"] for i in infos]),
+        "scans": {int(k): u.lidar.points((0, 0, 0), infos[k]["lidar_ranges"]) for k in keys},
+        "radio": u.slam_config,
+    }
+
+
+def ate(poses, drive):
+    return absolute_trajectory_error(poses, drive["truth"], align=False)
+
+
+def test_lidar_only_slam_removes_most_of_the_odometrys_drift(drive):
+    result = lidar_slam(drive["odometry"], drive["scans"], radio=drive["radio"])
+    assert result.consecutive_registered > 0.8  # walls in view nearly everywhere indoors
+    assert ate(result.poses, drive) < 0.3 * ate(drive["odometry"], drive)
+
+
+def test_radio_lidar_slam_beats_radio_slam_and_closes_lidar_loops(drive):
+    radio = ate(radio_slam(drive["odometry"], drive["fingerprints"], drive["radio"]).poses, drive)
+    both = lidar_slam(
+        drive["odometry"], drive["scans"], drive["fingerprints"], radio=drive["radio"]
+    )
+    assert len(both.lidar_closures) > 0
+    # every accepted LiDAR closure joins poses that are truly close
+    ends = drive["truth"][both.lidar_closures]
+    assert (
+        np.hypot(*(ends[:, 0, :2] - ends[:, 1, :2]).T).max()
+        < LidarSlamConfig().closure_radius_m + 1.0
+    )
+    assert ate(both.poses, drive) < 0.5 * radio
+
+
+def test_without_scan_matching_the_pipeline_is_no_better_than_its_first_stage(drive):
+    """Flip side of the tests above: with ICP never accepting (fitness bound ~0) nothing of the
+    LiDAR stage is used and Radio+LiDAR returns Radio SLAM's trajectory."""
+    from sfw_gym.slam import IcpConfig
+
+    never = IcpConfig(max_fitness=1e-12)
+    both = lidar_slam(
+        drive["odometry"],
+        drive["scans"],
+        drive["fingerprints"],
+        radio=drive["radio"],
+        icp_config=never,
+    )
+    radio = radio_slam(drive["odometry"], drive["fingerprints"], drive["radio"]).poses
+    assert both.consecutive_registered == 0 and len(both.lidar_closures) == 0
+    assert ate(both.poses, drive) == pytest.approx(ate(radio, drive), abs=0.05)
+
+
+def test_a_missing_keyframe_scan_is_one_clear_error(drive):
+    scans = dict(drive["scans"])
+    del scans[5]
+    with pytest.raises(ConfigError, match=r"no scan for keyframe pose\(s\) \[5\]"):
+        lidar_slam(drive["odometry"], scans, radio=drive["radio"])
+
+
+def test_the_online_solver_keeps_scans_only_at_keyframes_and_the_latest_pose():
+    slam = OnlineRadioLidarSlam(RadioSlamConfig(keyframe_every=5, solve_every=1000))
+    points = np.array([[1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
+    for k in range(23):
+        slam.add_with_scan((0.1 * k, 0.0, 0.0), np.full(4, -50.0), points + k)
+    assert sorted(slam._scans) == [0, 5, 10, 15, 20, 22]
+    np.testing.assert_array_equal(slam._scans[22], points + 22)
+
+
+def test_the_lidar_env_maps_along_a_trajectory_far_better_than_its_odometry():
+    env = gym.make("SfW-ExploreLidar-v0", max_steps=400)
+    drift = gym.make("SfW-ExploreDrift-v0", max_steps=400)
+    errors = []
+    for e in (env, drift):
+        obs, info = e.reset(seed=5)
+        agent = FrontierAgent()
+        agent.reset(e, seed=5)
+        done = False
+        while not done:
+            obs, _, terminated, truncated, info = e.step(agent.act(obs))
+            done = terminated or truncated
+        errors.append(info["ate_m"])
+    assert obs is not None and "lidar" in env.observation_space.spaces
+    assert errors[0] < 0.5 * errors[1], errors
