@@ -41,7 +41,8 @@ def main() -> None:
         args.episodes,
         args.seed,
         out=out,
-        agent_params={"ppo-waypoint": {"path": args.model}},
+        # sampled from the agent's seeded generator, as measured (its default is the mode)
+        agent_params={"ppo-waypoint": {"path": args.model, "deterministic": False}},
         workers=args.workers,
     )
     seen = trained_floorplans(Path(args.model))

@@ -29,7 +29,7 @@ CASES = [
     (
         "bug2b.ppo-continuous-sample",
         "sfw_gym/rl/waypoint_agent.py",
-        "self.model.predict(obs, deterministic=self.deterministic)",
+        "self.model.predict(obs, deterministic=True)",
         "self.model.predict(obs, deterministic=False)",
         "tests/rl/test_waypoint_agent.py",
     ),

@@ -265,20 +265,53 @@ def _train_on_rllib(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_evaluate(args: argparse.Namespace) -> int:
+def _json(option: str, text: str | None) -> dict:
+    """A command-line JSON object (empty when not given), or a one-line error naming ``option``."""
     import json
-    from pathlib import Path
 
+    try:
+        value = json.loads(text) if text else {}
+    except json.JSONDecodeError as exc:
+        raise ConfigError(f"{option}: not valid JSON ({exc})") from None
+    if not isinstance(value, dict):
+        raise ConfigError(f"{option}: expected a JSON object, got {text!r}")
+    return value
+
+
+def _cmd_benchmark(args: argparse.Namespace) -> int:
+    from sfw_gym.evaluation import benchmark
+
+    if args.action == "compare":
+        if len(args.results) != 2:
+            raise ConfigError(f"benchmark compare takes two results files, got {args.results}")
+        a, b = (benchmark.load_results(p) for p in args.results)
+        print(benchmark.compare(a, b), end="")
+        return 0
+    if args.results or args.agent is None:
+        raise ConfigError("sfw-gym benchmark --agent AGENT [...], or benchmark compare A B")
+    # an agent of one's own, importable from the current folder (as `python -m` would)
+    sys.path.insert(0, str(Path.cwd()))
+    out = args.out or f"benchmark/{args.agent.replace(':', '.')}/{args.split}"
+    benchmark.run_benchmark(
+        args.agent,
+        protocol=args.protocol,
+        split=args.split,
+        out=out,
+        agent_params=_json("--agent-params", args.agent_params),
+        agent_seed=args.seed,
+        plans=args.plans,
+        episodes=args.episodes,
+        workers=args.workers,
+        backend=args.backend,
+        progress=not args.no_progress,
+    )
+    print((Path(out) / "results.md").read_text(encoding="utf-8"), end="")
+    print(f"wrote {out}/results.json and results.md")
+    return 0
+
+
+def _cmd_evaluate(args: argparse.Namespace) -> int:
     from sfw_gym.evaluation import evaluate
-
-    def _json(option: str, text: str | None) -> dict:
-        try:
-            value = json.loads(text) if text else {}
-        except json.JSONDecodeError as exc:
-            raise ConfigError(f"{option}: not valid JSON ({exc})") from None
-        if not isinstance(value, dict):
-            raise ConfigError(f"{option}: expected a JSON object, got {text!r}")
-        return value
 
     result = evaluate(
         [a.strip() for a in args.agents.split(",") if a.strip()],
@@ -596,6 +629,36 @@ def build_parser() -> argparse.ArgumentParser:
     )
     ev.add_argument("--no-progress", action="store_true", help="no progress bar")
     ev.set_defaults(func=_cmd_evaluate)
+
+    bm = sub.add_parser(
+        "benchmark",
+        help="run an agent through the benchmark protocol, or compare two results files",
+        description="sfw-gym benchmark --agent AGENT [options] | sfw-gym benchmark compare A B",
+    )
+    bm.add_argument(
+        "action", nargs="?", choices=["compare"], default=None, help="compare two results.json"
+    )
+    bm.add_argument("results", nargs="*", help="with compare: A.json B.json (B − A)")
+    bm.add_argument(
+        "--agent", default=None, help="a shipped agent name or package.module:Class of your own"
+    )
+    bm.add_argument("--protocol", default="benchmark-v1", help="protocol name or YAML path")
+    bm.add_argument(
+        "--split", default="test", choices=["train", "validation", "test"], help="default test"
+    )
+    bm.add_argument("--agent-params", default=None, help="the agent's parameters as JSON")
+    bm.add_argument("--seed", type=seed_int, default=0, help="the agent seed (default 0)")
+    bm.add_argument("--plans", default=None, help="a folder of plan files to add (by the split)")
+    bm.add_argument(
+        "--episodes", type=positive_int, default=None, help="at most this many episodes per env"
+    )
+    bm.add_argument(
+        "--out", type=folder, default=None, help="default benchmark/AGENT/SPLIT (resumes)"
+    )
+    bm.add_argument("--workers", type=positive_int, default=2, help="worker processes (default 2)")
+    bm.add_argument("--backend", choices=["local", "ray"], default="local")
+    bm.add_argument("--no-progress", action="store_true", help="no progress bar")
+    bm.set_defaults(func=_cmd_benchmark)
     return parser
 
 

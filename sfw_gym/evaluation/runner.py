@@ -63,6 +63,7 @@ class EpisodeSpec:
         npz_path: Write the final belief, truth, trajectory and the agent's decision log
             (:func:`~sfw_gym.agents.base.decision_arrays`) here (None: not).
         band_m: Half-width of the zone-border bands of the band metric.
+        agent_seed: The agent's reset seed (None: the env seed).
     """
 
     agent: str
@@ -76,11 +77,13 @@ class EpisodeSpec:
     gif_path: str | None = None
     npz_path: str | None = None
     band_m: float = 0.8
+    agent_seed: int | None = None
 
     @property
     def key(self) -> str:
         """Identity in the checkpoint (an episode with the same key is not run again)."""
-        return f"{self.agent}|{self.episode}|{self.seed}|{self.env_id}|{self.floorplan}"
+        key = f"{self.agent}|{self.episode}|{self.seed}|{self.env_id}|{self.floorplan}"
+        return key if self.agent_seed is None else f"{key}|{self.agent_seed}"
 
 
 # ---------------------------------------------------------------------------------- one episode
@@ -144,7 +147,7 @@ def run_episode(spec: EpisodeSpec) -> dict[str, Any]:
     obs, info = env.reset(seed=spec.seed, options=options)
     entropy_at_start = info["entropy_bits"]
     agent = make_agent(spec.agent, **spec.agent_params)
-    agent.reset(env, seed=spec.seed)
+    agent.reset(env, seed=spec.seed if spec.agent_seed is None else spec.agent_seed)
     frames: list[Any] = [env.render()] if render else []
     curve: list[tuple[int, float, float, float]] = [(0, info["coverage"], info["map_iou"], 0.0)]
     steps, terminated, truncated = 0, False, False
@@ -245,6 +248,40 @@ def _append_record(path: Path, record: dict[str, Any]) -> None:
 
 
 # ---------------------------------------------------------------------------------- the runner
+def run_specs(
+    specs: Sequence[EpisodeSpec],
+    out: Path,
+    *,
+    workers: int = 1,
+    backend: str = "local",
+    address: str | None = None,
+    progress: bool = True,
+) -> list[dict[str, Any]]:
+    """Run the episodes not yet in ``OUT/episodes.jsonl`` (the checkpoint) and return every
+    spec's record, in the order of ``specs``."""
+    if backend not in BACKENDS:
+        raise ConfigError(f"--backend must be one of {list(BACKENDS)}, got {backend!r}")
+    out.mkdir(parents=True, exist_ok=True)
+    remove_stale_temps(out)  # of a run killed mid-write
+    ckpt = out / CHECKPOINT
+    records = load_checkpoint(ckpt)
+    _save_checkpoint(ckpt, records)  # clean: no line cut by a kill before the next appends
+    done = {r["key"] for r in records}
+    todo = [s for s in specs if s.key not in done]
+    _run_all(
+        todo,
+        records,
+        ckpt,
+        workers,
+        progress,
+        total=len(specs),
+        done=len(specs) - len(todo),
+        ray_address=address if backend == "ray" else _LOCAL,
+    )
+    by_key = {r["key"]: r for r in records}
+    return [by_key[s.key] for s in specs]
+
+
 def episode_specs(
     agents: Sequence[str],
     episodes: int,
@@ -381,28 +418,14 @@ def evaluate(
         gif_episodes=gif_episodes,
         curve_every=curve_every,
     )
-    remove_stale_temps(out)  # of a run killed mid-write
-    ckpt = out / CHECKPOINT
-    records = load_checkpoint(ckpt)
-    _save_checkpoint(ckpt, records)  # clean: no line cut by a kill before the next appends
+    records = load_checkpoint(out / CHECKPOINT)
     manifest = _manifest(
         out, records, agents, episodes, seed, env_id, floorplans, env_kwargs, agent_params
     )
-    done = {r["key"] for r in records}
-    todo = [s for s in specs if s.key not in done]
     write_text_atomic(out / "config.json", json.dumps(manifest, indent=2) + "\n")
-    _run_all(
-        todo,
-        records,
-        ckpt,
-        workers,
-        progress,
-        total=len(specs),
-        done=len(specs) - len(todo),
-        ray_address=address if backend == "ray" else _LOCAL,
+    mine = run_specs(
+        specs, out, workers=workers, backend=backend, address=address, progress=progress
     )
-    keys = {s.key for s in specs}
-    mine = [r for r in records if r["key"] in keys]
     rows = summarize(mine, agents)
     files = [
         write_text_atomic(out / "results.csv", results_csv(rows)),

@@ -150,14 +150,14 @@ def lidar_slam(
     if not cfg.radio_in_final:
         ranges = ranges[:0]
     for round_ in range(cfg.rounds):
-        candidates = _closure_candidates(estimate, along, cfg)
+        candidates = [(pair, estimate) for pair in _closure_candidates(estimate, along, cfg)]
         if round_ == 0 and fingerprints is not None:  # where the scans alone would look too
-            candidates += _closure_candidates(matched, along, cfg)
-        for pair in candidates:
+            candidates += [(pair, matched) for pair in _closure_candidates(matched, along, cfg)]
+        for pair, guide in candidates:
             if pair in closures:
                 continue
             i, j = pair
-            result = register(int(keys[i]), int(keys[j]), relative_pose(estimate[i], estimate[j]))
+            result = register(int(keys[i]), int(keys[j]), relative_pose(guide[i], guide[j]))
             n_a, n_b = len(scans[int(keys[i])]), len(scans[int(keys[j])])
             if (
                 result.accepted(n_a, n_b, icfg)
@@ -165,13 +165,22 @@ def lidar_slam(
                 and result.matched > cfg.closure_min_match_fraction * (n_a + n_b) / 2
             ):
                 closures[pair] = result
-        estimate = _solve(estimate, steps, ranges, closures, rcfg, cfg)
+        # the first solve starts from the registered scans chained: locally right everywhere,
+        # where a first stage bent by false radio closures may hold the solver in a wrong basin
+        estimate = _solve(matched if round_ == 0 else estimate, steps, ranges, closures, rcfg, cfg)
         for _ in range(3):  # drop the closures the solution disagrees with, solve again
             missed = [p for p, r in closures.items() if _missed_by(estimate, p, r) > cfg.outlier_m]
-            if not missed:
-                break
             for pair in missed:
                 del closures[pair]
+            agree = np.ones(len(ranges), bool)
+            if rcfg.outlier_sigma and len(ranges):
+                nodes = ranges[:, :2].astype(np.int64)
+                agree = consistent_closures(
+                    estimate[nodes], ranges[:, 2], ranges[:, 3], rcfg.outlier_sigma
+                )
+                ranges = ranges[agree]
+            if not missed and agree.all():
+                break
             estimate = _solve(estimate, steps, ranges, closures, rcfg, cfg)
     anchor = keys[np.searchsorted(keys, np.arange(n), side="right") - 1]
     node_of = np.full(n, -1)

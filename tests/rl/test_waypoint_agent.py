@@ -74,7 +74,7 @@ def test_agent_drives_the_raw_env_exactly_as_the_wrapper_did_in_training(waypoin
 
 def test_sampled_waypoints_are_reproducible_from_the_agent_seed(waypoint_model):
     def goals(seed):
-        agent = WaypointPPOAgent(path=waypoint_model)
+        agent = WaypointPPOAgent(path=waypoint_model, deterministic=False)
         env = gym.make(SMALL, max_steps=60)
         obs, _ = env.reset(seed=3)
         agent.reset(env, seed=seed)
@@ -145,7 +145,7 @@ def test_deterministic_shipped_policy_takes_the_most_likely_waypoint_whatever_th
 
 
 def test_sampling_shipped_policy_repeats_itself_for_one_agent_seed_only():
-    agent = WaypointPPOAgent()
+    agent = WaypointPPOAgent(deterministic=False)
     first = run_ppo(agent, "SfW-Explore-v0", 150, 0)
     assert run_ppo(agent, "SfW-Explore-v0", 150, 0) == first
     assert run_ppo(agent, "SfW-Explore-v0", 150, 1) != first

@@ -1,0 +1,337 @@
+"""The benchmark protocol (``envs/benchmark-v1.yml``): any agent class through fixed splits of
+seeds and plans, the same metrics and bootstrap intervals, into a results file that records the
+protocol, package and agent; and the paired comparison of two results files.
+
+A results file (``OUT/results.json``) holds everything but timing fields under keys that do not
+change between runs of the same agent, protocol and split, so that two runs give the same bytes
+apart from ``timing``; ``OUT/results.md`` has no timing at all.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from sfw_gym.core.atomic import write_text_atomic
+from sfw_gym.core.data import data_path
+from sfw_gym.core.errors import ConfigError
+
+SPLITS = ("train", "validation", "test")
+#: Record fields that are timings (left out of results.json's episodes).
+TIMING_FIELDS = ("wall_s", "steps_per_s")
+#: Each metric's column label and number format.
+METRIC_LABELS = {
+    "coverage": ("coverage", "{:.3f}"),
+    "steps_to_coverage_90": ("steps to 90 %", "{:.0f}"),
+    "info_gain_per_m": ("info gain [bits/m]", "{:.1f}"),
+    "path_length_m": ("path [m]", "{:.0f}"),
+    "free_iou": ("free IoU", "{:.3f}"),
+    "wall_precision": ("wall precision", "{:.3f}"),
+    "interior_wall_recall": ("wall recall", "{:.3f}"),
+    "ate_m": ("ATE [m]", "{:.2f}"),
+}
+
+
+# ---------------------------------------------------------------------------------- protocol
+def load_protocol(name: str | Path = "benchmark-v1") -> dict[str, Any]:
+    """A protocol by name (shipped: ``benchmark-v1``) or path to a YAML file, checked."""
+    path = Path(name)
+    if not path.suffix:
+        path = data_path("envs", f"{name}.yml")
+    try:
+        text = path.read_text(encoding="utf-8")
+        protocol = yaml.safe_load(text)
+    except (OSError, yaml.YAMLError) as exc:
+        raise ConfigError(f"--protocol {name}: cannot read {path}: {exc}") from None
+    where = f"protocol {path}"
+    if not isinstance(protocol, dict):
+        raise ConfigError(f"{where}: expected a mapping")
+    for key in ("name", "version", "envs", "splits", "metrics", "intervals"):
+        if key not in protocol:
+            raise ConfigError(f"{where}: missing {key!r}")
+    seeds = protocol["splits"].get("seeds", {})
+    for split in SPLITS:
+        lo_hi = seeds.get(split)
+        if not (isinstance(lo_hi, list) and len(lo_hi) == 2 and 0 <= lo_hi[0] <= lo_hi[1]):
+            raise ConfigError(f"{where}: splits.seeds.{split} must be [first, last], got {lo_hi}")
+    for env in protocol["envs"]:
+        if not isinstance(env, dict) or "id" not in env or "episodes" not in env:
+            raise ConfigError(f"{where}: each env needs an id and episodes per split: {env}")
+    unknown = set(protocol["metrics"]) - set(METRIC_LABELS)
+    if unknown:
+        known = list(METRIC_LABELS)
+        raise ConfigError(f"{where}: unknown metrics {sorted(unknown)}; known: {known}")
+    protocol["sha256"] = hashlib.sha256(text.encode()).hexdigest()
+    return protocol
+
+
+def split_seeds(protocol: dict[str, Any], split: str) -> tuple[int, int]:
+    """The split's inclusive range of procedural reset seeds."""
+    _check_split(split)
+    first, last = protocol["splits"]["seeds"][split]
+    return int(first), int(last)
+
+
+def split_plan_files(protocol: dict[str, Any], folder: str | Path, split: str) -> list[Path]:
+    """The plan files (``*.json``) of ``folder`` that fall in ``split`` (by name hash)."""
+    _check_split(split)
+    buckets = set(protocol["splits"]["plan_files"][split])
+    files = sorted(Path(folder).glob("*.json"))
+    if not files:
+        raise ConfigError(f"--plans {folder}: no .json floorplan files there")
+    return [f for f in files if _bucket(f.name) in buckets]
+
+
+def _bucket(name: str) -> int:
+    return int(hashlib.sha256(name.encode()).hexdigest(), 16) % 10
+
+
+def _check_split(split: str) -> None:
+    if split not in SPLITS:
+        raise ConfigError(f"--split must be one of {list(SPLITS)}, got {split!r}")
+
+
+def agent_seed_for(env_seed: int, agent_seed: int) -> int:
+    """The seed an agent is reset with: a mix of the episode's env seed and the agent seed."""
+    return int(np.random.SeedSequence([env_seed, agent_seed]).generate_state(1)[0])
+
+
+# ---------------------------------------------------------------------------------- running
+def run_benchmark(
+    agent: str,
+    *,
+    protocol: str | Path = "benchmark-v1",
+    split: str = "test",
+    out: str | Path = "benchmark",
+    agent_params: dict[str, Any] | None = None,
+    agent_seed: int = 0,
+    plans: str | Path | None = None,
+    episodes: int | None = None,
+    workers: int = 1,
+    backend: str = "local",
+    progress: bool = True,
+) -> dict[str, Any]:
+    """Run ``agent`` (a shipped name or ``package.module:Class``) through the protocol's
+    ``split``; writes ``OUT/results.json`` and ``OUT/results.md`` and returns the results.
+    ``episodes`` caps the episodes per env (a quick look; recorded in the results)."""
+    from sfw_gym import __version__
+    from sfw_gym.evaluation.runner import EpisodeSpec, run_specs
+
+    proto = load_protocol(protocol)
+    first, last = split_seeds(proto, split)
+    out = Path(out)
+    specs: list[EpisodeSpec] = []
+    for env in proto["envs"]:
+        n = int(env["episodes"][split])
+        if episodes is not None:
+            n = min(n, episodes)
+        files: list[str | None] = [None] * n
+        if plans is not None:
+            files += [str(p) for p in split_plan_files(proto, plans, split)]
+        if len(files) > last - first + 1:
+            raise ConfigError(f"protocol: {len(files)} episodes exceed the {split} split's seeds")
+        for i, plan in enumerate(files):
+            specs.append(
+                EpisodeSpec(
+                    agent=agent,
+                    episode=len(specs),
+                    seed=first + i,
+                    agent_seed=agent_seed_for(first + i, agent_seed),
+                    env_id=env["id"],
+                    floorplan=plan,
+                    env_kwargs=dict(env.get("kwargs") or {}),
+                    agent_params=dict(agent_params or {}),
+                    npz_path=None,
+                )
+            )
+    _check_same_run(out, proto, agent, agent_params, split, plans)
+    start = time.perf_counter()
+    records = run_specs(specs, out, workers=workers, backend=backend, progress=progress)
+    results = {
+        "protocol": proto["name"],
+        "protocol_version": proto["version"],
+        "protocol_sha256": proto["sha256"],
+        "package_version": __version__,
+        "agent": agent,
+        "agent_params": dict(agent_params or {}),
+        "agent_seed": agent_seed,
+        "split": split,
+        "episodes_cap": episodes,
+        "plans": None if plans is None else Path(plans).name,
+        "episodes": [_episode_row(r, proto) for r in records],
+        "timing": {"wall_s": time.perf_counter() - start, "workers": workers},
+    }
+    results["summary"] = summarize_results(results, proto)
+    write_text_atomic(out / "results.json", json.dumps(results, indent=1, sort_keys=True) + "\n")
+    write_text_atomic(out / "results.md", results_markdown(results))
+    return results
+
+
+def _check_same_run(
+    out: Path,
+    protocol: dict[str, Any],
+    agent: str,
+    agent_params: dict[str, Any] | None,
+    split: str,
+    plans: str | Path | None,
+) -> None:
+    """Resuming in ``out`` is allowed for the same run only (its checkpoint's records would
+    otherwise count as this run's): ``OUT/run.json`` records what ran."""
+    run = {
+        "protocol_sha256": protocol["sha256"],
+        "agent": agent,
+        "agent_params": json.loads(json.dumps(agent_params or {})),
+        "split": split,
+        "plans": None if plans is None else str(plans),
+    }
+    path = out / "run.json"
+    if path.is_file():
+        previous = json.loads(path.read_text(encoding="utf-8"))
+        if previous != run:
+            changed = sorted(k for k in run if previous.get(k) != run[k])
+            raise ConfigError(
+                f"{out} holds another benchmark run (different {', '.join(changed)}): "
+                "choose another --out"
+            )
+    write_text_atomic(path, json.dumps(run, indent=1, sort_keys=True) + "\n")
+
+
+def _episode_row(record: dict[str, Any], protocol: dict[str, Any]) -> dict[str, Any]:
+    row = {k: record[k] for k in ("env_id", "seed", "floorplan", "steps")}
+    for metric in protocol["metrics"]:
+        value = record.get(metric)
+        if metric == "steps_to_coverage_90" and (value is None or value < 0):
+            value = record["max_steps"] + 1  # never got there: censored at the budget
+        row[metric] = value
+    return row
+
+
+def _key(row: dict[str, Any]) -> tuple[str, int, str]:
+    return row["env_id"], row["seed"], row["floorplan"]
+
+
+def bootstrap_ci(values: np.ndarray, protocol: dict[str, Any]) -> tuple[float, float]:
+    """The protocol's bootstrap interval of the mean of ``values`` (equal values: a point)."""
+    from scipy import stats
+
+    iv = protocol["intervals"]
+    if len(values) < 2 or np.ptp(values) == 0:
+        mean = float(np.mean(values)) if len(values) else math.nan
+        return mean, mean
+    res = stats.bootstrap(
+        (values,),
+        np.mean,
+        confidence_level=float(iv["confidence"]),
+        n_resamples=int(iv["resamples"]),
+        method="percentile",
+        random_state=np.random.default_rng(int(iv["random_state"])),
+    )
+    return float(res.confidence_interval.low), float(res.confidence_interval.high)
+
+
+def summarize_results(results: dict[str, Any], protocol: dict[str, Any]) -> dict[str, Any]:
+    """Per env and metric: mean, interval and n over the episodes (metrics all zero, as ATE
+    where the odometry does not drift, are left out)."""
+    summary: dict[str, Any] = {}
+    for env_id in dict.fromkeys(r["env_id"] for r in results["episodes"]):
+        rows = [r for r in results["episodes"] if r["env_id"] == env_id]
+        summary[env_id] = {}
+        for metric in protocol["metrics"]:
+            values = np.array([r[metric] for r in rows if r[metric] is not None], np.float64)
+            if not len(values) or np.allclose(values, 0.0):
+                continue
+            low, high = bootstrap_ci(values, protocol)
+            summary[env_id][metric] = {
+                "mean": float(values.mean()),
+                "ci_low": low,
+                "ci_high": high,
+                "n": len(values),
+            }
+    return summary
+
+
+def format_interval(stats: dict[str, Any], fmt: str) -> str:
+    """``mean [low, high]`` of a summary entry."""
+    return (
+        f"{fmt.format(stats['mean'])} [{fmt.format(stats['ci_low'])}, "
+        f"{fmt.format(stats['ci_high'])}]"
+    )
+
+
+def results_markdown(results: dict[str, Any]) -> str:
+    """The results as a Markdown table per env (no timing)."""
+    lines = [
+        f"# {results['agent']} on {results['protocol']} / {results['split']}",
+        "",
+        f"sfw_gym {results['package_version']}, agent seed {results['agent_seed']}, "
+        f"protocol sha256 {results['protocol_sha256'][:12]}; mean [95 % bootstrap interval].",
+    ]
+    for env_id, metrics in results["summary"].items():
+        n = max((s["n"] for s in metrics.values()), default=0)
+        lines += ["", f"## {env_id} ({n} episodes)", "", "| metric | value |", "|---|---:|"]
+        for metric, stats in metrics.items():
+            label, fmt = METRIC_LABELS[metric]
+            lines.append(f"| {label} | {format_interval(stats, fmt)} |")
+    return "\n".join(lines) + "\n"
+
+
+# ---------------------------------------------------------------------------------- comparing
+def load_results(path: str | Path) -> dict[str, Any]:
+    """A ``results.json`` written by :func:`run_benchmark`."""
+    try:
+        results = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, json.JSONDecodeError) as exc:
+        raise ConfigError(f"{path}: not a benchmark results file: {exc}") from None
+    if not isinstance(results, dict) or "protocol" not in results or "episodes" not in results:
+        raise ConfigError(f"{path}: not a benchmark results file (no protocol or episodes)")
+    return results
+
+
+def compare(a: dict[str, Any], b: dict[str, Any], protocol: str | Path | None = None) -> str:
+    """The paired table ``b − a`` per env and metric over the episodes both ran (the same env,
+    seed and plan), with the protocol's bootstrap interval. Refuses different protocols."""
+    for key in ("protocol", "protocol_version", "protocol_sha256", "split"):
+        if a.get(key) != b.get(key):
+            raise ConfigError(
+                f"cannot compare results of different {key.replace('_', ' ')}s: "
+                f"{a.get(key)!r} vs {b.get(key)!r}"
+            )
+    proto = load_protocol(protocol or a["protocol"])
+    if proto["sha256"] != a["protocol_sha256"]:
+        raise ConfigError(f"the results were made under another text of {a['protocol']}")
+    rows_a = {_key(r): r for r in a["episodes"]}
+    pairs = [(rows_a[_key(r)], r) for r in b["episodes"] if _key(r) in rows_a]
+    if not pairs:
+        raise ConfigError("the two results share no episode (env, seed, plan)")
+    lines = [
+        f"{b['agent']} − {a['agent']} on {a['protocol']} / {a['split']}, paired by episode; "
+        "mean difference [95 % bootstrap interval].",
+        "",
+        "| env | metric | pairs | " + f"{a['agent']} | {b['agent']} | difference |",
+        "|---|---|---:|---:|---:|---:|",
+    ]
+    for env_id in dict.fromkeys(_key(x)[0] for x, _ in pairs):
+        env_pairs = [(x, y) for x, y in pairs if x["env_id"] == env_id]
+        for metric in proto["metrics"]:
+            both = [(x[metric], y[metric]) for x, y in env_pairs]
+            both = [(p, q) for p, q in both if p is not None and q is not None]
+            values = np.array(both, np.float64).reshape(-1, 2)
+            if not len(values) or np.allclose(values, 0.0):
+                continue
+            label, fmt = METRIC_LABELS[metric]
+            diff = values[:, 1] - values[:, 0]
+            low, high = bootstrap_ci(diff, proto)
+            signed = fmt.replace("{:", "{:+")
+            lines.append(
+                f"| {env_id} | {label} | {len(diff)} | {fmt.format(values[:, 0].mean())} | "
+                f"{fmt.format(values[:, 1].mean())} | {signed.format(diff.mean())} "
+                f"[{signed.format(low)}, {signed.format(high)}] |"
+            )
+    return "\n".join(lines) + "\n"
