@@ -145,7 +145,8 @@ def ci(values: list[float], fmt: str = "{:.2f}") -> str:
 def tables(records: list[dict[str, Any]], plans: int) -> list[str]:
     lines = [
         f"Frontier agent, {plans} held-out generated plans (seeds {FIRST_SEED:,}+, 120–200 m²), "
-        f"{STEPS:,} steps, 16 background APs, LiDAR 360 beams / 8 m / 1 cm; mean [95 % CI].",
+        f"{STEPS:,} steps, 16 background APs, the LiDAR as OUT/tables.md's first line says "
+        "(default 360 beams / 8 m / 1 cm); mean [95 % CI].",
         "",
         "| drift (trans, heading) | " + " | ".join(f"ATE {m} [m]" for m in METHODS) + " |",
         "|---|" + "---:|" * len(METHODS),

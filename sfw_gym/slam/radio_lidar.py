@@ -50,6 +50,12 @@ class LidarSlamConfig(Config):
     max_closures: int = setting(400, integer=True, ge=1)  # ICP tries per round, spread evenly
     scan_sigma_m: float = setting(0.05, gt=0.0)  # an accepted ICP edge's standard deviation
     scan_sigma_rad: float = setting(0.01, gt=0.0)
+    # a consecutive registration of a weakly constrained scan pair (observability below
+    # well_constrained: a corridor seen over a few metres) is used only within this many
+    # standard deviations of the odometry's step: one that slid along the corridor is worse
+    # than the odometry it would replace
+    step_gate_sigma: float = setting(3.0, gt=0.0)
+    well_constrained: float = setting(0.1, ge=0.0, le=0.5)
     outlier_m: float = setting(0.3, gt=0.0)  # closures the solution misses by more: dropped
     rounds: int = setting(2, integer=True, ge=1)  # closure search → solve, repeated
     # LiDAR loop closures must also pass these (the paper's 0.1 m² and one half, for real
@@ -117,12 +123,22 @@ def lidar_slam(
         if (a, b) not in cache:
             cache[(a, b)] = register(a, b, guess)
         result = cache[(a, b)]
-        if result.accepted(len(scans[a]), len(scans[b]), icfg):
+        spread = math.sqrt(b - a)  # independent per-step errors add up
+        sigma_xy, sigma_theta = rcfg.odometry_sigma_m * spread, rcfg.odometry_sigma_rad * spread
+        gate_xy = cfg.step_gate_sigma * math.hypot(sigma_xy, cfg.scan_sigma_m)
+        gate_theta = cfg.step_gate_sigma * math.hypot(sigma_theta, cfg.scan_sigma_rad)
+        off = np.asarray(result.delta) - guess
+        near = (
+            math.hypot(off[0], off[1]) <= gate_xy
+            and abs(math.remainder(off[2], 2 * math.pi)) <= gate_theta
+        )
+        if result.accepted(len(scans[a]), len(scans[b]), icfg) and (
+            near or result.observability >= cfg.well_constrained
+        ):
             registered += 1
             steps.append((tuple(result.delta), cfg.scan_sigma_m, cfg.scan_sigma_rad))
         else:
-            spread = math.sqrt(b - a)  # independent per-step errors add up
-            steps.append((guess, rcfg.odometry_sigma_m * spread, rcfg.odometry_sigma_rad * spread))
+            steps.append((guess, sigma_xy, sigma_theta))
 
     # first trajectory: the scan-matched odometry, with radio closures solved in (Radio SLAM
     # on the registered scans), closures the solution disagrees with dropped

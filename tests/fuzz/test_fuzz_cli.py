@@ -22,13 +22,30 @@ OPTIONS = {
     "bench": ["--env", "--steps", "--resets", "--memory-steps"],
     "slam": ["--keyframes", "--odometry-sigma", "--heading-sigma"],
     "evaluate": ["--agents", "--episodes", "--seed", "--env", "--env-kwargs", "--agent-params"],
+    "benchmark": ["--agent", "--split", "--episodes", "--seed", "--agent-params", "--protocol"],
 }
+#: A one-episode protocol of 5 steps per split, so that the valid benchmark runs stay short.
+TINY_PROTOCOL = """
+name: tiny
+version: 1
+envs:
+  - id: SfW-ExploreSmall-v0
+    kwargs: {max_steps: 5}
+    episodes: {train: 1, validation: 1, test: 1}
+splits:
+  seeds: {train: [0, 9], validation: [10, 19], test: [20, 29]}
+  plan_files: {train: [0, 1, 2, 3, 4, 5], validation: [6, 7], test: [8, 9]}
+metrics: [coverage, path_length_m]
+intervals: {confidence: 0.95, resamples: 100, random_state: 0}
+"""
 
 
 @st.composite
 def argvs(draw) -> list[str]:
     command = draw(st.sampled_from(sorted(OPTIONS)))
     argv = [command]
+    if command == "benchmark":
+        argv += ["--agent", "random", "--protocol", "{tmp}/tiny.yml"]  # fuzzed values follow
     if command == "map":
         argv.append(draw(st.sampled_from(["{tmp}/log.csv", "{tmp}/none.csv", ""])))
     if command == "slam":
@@ -45,6 +62,7 @@ def test_command_lines(tmp_path_factory, argv):
     (tmp / "slam.csv").write_text(
         "time,odom_x,odom_y,odom_theta,a,b\n0,0,0,0,-40,-70\n1,1,0,0,-45,\n2,2,0,0.1,-60,-65\n"
     )
+    (tmp / "tiny.yml").write_text(TINY_PROTOCOL)
     argv = [a.replace("{tmp}", str(tmp)) for a in argv]
     if argv[0] in ("bench", "evaluate"):  # keep the valid ones short
         argv += ["--env", "SfW-ExploreSmall-v0"]
@@ -53,6 +71,8 @@ def test_command_lines(tmp_path_factory, argv):
     if argv[0] == "evaluate":
         argv += ["--episodes", "1", "--workers", "1", "--no-progress", "--out", str(tmp / "ev")]
         argv += ["--env-kwargs", '{"max_steps": 5}']
+    if argv[0] == "benchmark":
+        argv += ["--workers", "1", "--no-progress", "--out", str(tmp / "bm")]
     if argv[0] in ("world", "map"):
         argv += ["--out", str(tmp / "out.png")]
     if argv[0] == "slam":

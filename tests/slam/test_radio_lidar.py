@@ -120,3 +120,24 @@ def test_the_lidar_env_maps_along_a_trajectory_far_better_than_its_odometry():
         errors.append(info["ate_m"])
     assert obs is not None and "lidar" in env.observation_space.spaces
     assert errors[0] < 0.5 * errors[1], errors
+
+
+@pytest.mark.parametrize(("observability", "follows"), [(0.03, "odometry"), (0.3, "icp")])
+def test_a_weakly_constrained_registration_far_from_the_odometry_is_not_used(
+    monkeypatch, observability, follows
+):
+    """ICP sliding 0.5 m along a corridor (low observability) loses to the odometry; the same
+    correction from a well-constrained pair is taken."""
+    from sfw_gym.slam import radio_lidar
+    from sfw_gym.slam.scan_matching import IcpResult
+
+    def slid(points_a, points_b, initial, config):
+        delta = np.asarray(initial, np.float64) + np.array([0.5, 0.0, 0.0])
+        return IcpResult(delta, 0.001, 100, 5, True, observability)
+
+    monkeypatch.setattr(radio_lidar, "icp", slid)
+    odometry = np.column_stack([np.arange(11) * 0.1, np.zeros(11), np.zeros(11)])
+    scans = {k: np.ones((100, 2)) for k in (0, 5, 10)}
+    poses = lidar_slam(odometry, scans, radio=RadioSlamConfig(keyframe_every=5)).poses
+    expected = 1.0 if follows == "odometry" else 2.0  # two keyframe steps of 0.5 + 0.5
+    assert poses[-1, 0] == pytest.approx(expected, abs=1e-6)
