@@ -180,6 +180,8 @@ class WaypointPPOAgent(Agent):
             raise ConfigError("WaypointPPOAgent.act(obs) needs the env's (Dict) observation")
         if not self._obs_checked:
             self._check_obs(obs)
+        trained = self.model.observation_space.spaces  # extra keys (fingerprint, lidar) unused
+        obs = {k: v for k, v in obs.items() if k in trained}
         if self.waypoints is None:
             action = (  # the Gaussian's mean, or a draw from it with self.rng
                 self.model.predict(obs, deterministic=True)[0]

@@ -211,3 +211,11 @@ def test_waypoint_policy_scores_every_block_with_one_network():
     permuted = policy.get_distribution(batch).distribution.logits[0]
     # a block's logit depends on its own features only (softmax logits are shift-free)
     torch.testing.assert_close(permuted - permuted.mean(), (logits - logits.mean())[perm])
+
+
+@pytest.mark.parametrize("env_id", ["SfW-ExploreDrift-v0", "SfW-ExploreLidar-v0"])
+def test_the_shipped_policy_acts_on_envs_with_more_observations(env_id):
+    """Extra observation keys (the drift env's fingerprint, the LiDAR) are not the policy's:
+    it acts on its own keys, as the benchmark protocol's drift env needs."""
+    actions = run_ppo(WaypointPPOAgent(), env_id, 80, 0)
+    assert len(actions) == 80 and np.isfinite(actions).all()
