@@ -101,6 +101,7 @@ def run(job: dict[str, Any]) -> dict[str, Any]:
     timings["icp_calls"] = both.icp_calls + only.icp_calls
 
     truth_u8 = u.scene.truth_u8
+    maps: dict[str, np.ndarray] = {}
     record: dict[str, Any] = {
         **{k: job[k] for k in ("drift", "seed")},
         "poses": len(odometry),
@@ -114,9 +115,13 @@ def run(job: dict[str, Any]) -> dict[str, Any]:
         record[f"ate_{name}"] = absolute_trajectory_error(poses, truth, align=False)
         grid = LidarOccupancyMap(u.grid)
         for k in range(0, len(poses), 2):
-            grid.integrate(poses[k], lidar.angles, ranges[k], lidar.config.max_range_m)
+            # a beam that returned nothing: free to the maximum range, unless it may have
+            # dropped out (then it says nothing)
+            keep = np.isfinite(ranges[k]) if lidar.config.dropout else slice(None)
+            grid.integrate(poses[k], lidar.angles[keep], ranges[k][keep], lidar.config.max_range_m)
         est = grid.occupancy_u8()
         record[f"lidar_map_{name}"] = _scores(m, est, truth_u8)
+        maps[f"LiDAR map, {name}"] = est
     for name, poses in (("radio_slam", trajectories["radio_slam"]), ("true", truth)):
         mapper = SparseInverseKVisibility(u.grid, u.scene.radio.routers, u.mapper_config)
         x0, y0, x1, y1 = u.grid.bounds
@@ -124,6 +129,9 @@ def run(job: dict[str, Any]) -> dict[str, Any]:
             if x0 <= x < x1 and y0 <= y < y1:  # as the env: nothing fused off the map
                 mapper.update((x, y), np.asarray(reading, np.float64), bump, theta)
         record[f"wifi_map_{name}"] = _scores(m, mapper.occupancy_u8, truth_u8)
+        maps[f"WiFi-only map, {name} pose"] = mapper.occupancy_u8.copy()
+    if job.get("figure"):  # the maps of this run side by side, beside the truth
+        record["maps"] = {"truth": truth_u8, **maps}
     return record
 
 
@@ -211,6 +219,24 @@ def tables(records: list[dict[str, Any]], plans: int) -> list[str]:
     return lines
 
 
+def save_figure(maps: dict[str, np.ndarray], path: Path, record: dict[str, Any]) -> None:
+    """The run's maps in a row: the truth, the LiDAR map along each trajectory, WiFi-only."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(maps), figsize=(2.6 * len(maps), 3.2))
+    for ax, (title, grid) in zip(axes, maps.items(), strict=True):
+        ax.imshow(grid, cmap="gray", origin="lower", vmin=0, vmax=255)
+        ax.set_title(title, fontsize=7)
+        ax.axis("off")
+    fig.suptitle(f"seed {record['seed']}, {record['drift']} drift (black wall, grey unknown)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--plans", type=int, default=20)
@@ -226,7 +252,13 @@ def main() -> None:
     rng = np.random.default_rng(FIRST_SEED)
     areas = rng.uniform(120.0, 200.0, args.plans).round()
     jobs = [
-        {"drift": d, "seed": FIRST_SEED + i, "area_m2": areas[i], "lidar": lidar}
+        {
+            "drift": d,
+            "seed": FIRST_SEED + i,
+            "area_m2": areas[i],
+            "lidar": lidar,
+            "figure": i == 0 and d == "mid",
+        }
         for d in DRIFT
         for i in range(args.plans)
     ]
@@ -234,6 +266,9 @@ def main() -> None:
     with ProcessPoolExecutor(args.workers, mp_context=mp.get_context("spawn")) as pool:
         records = list(pool.map(run, jobs))
     print(f"{len(records)} runs in {time.perf_counter() - start:.0f} s")
+    for record in records:
+        if "maps" in record:
+            save_figure(record.pop("maps"), out / "maps.png", record)
     (out / "records.json").write_text(json.dumps(records, indent=1))
     text = f"LiDAR overrides: {lidar or 'none'}\n\n" + "\n".join(tables(records, args.plans)) + "\n"
     (out / "tables.md").write_text(text)

@@ -86,14 +86,16 @@ def ppo_config(
 ) -> Any:
     """RLlib's PPOConfig from an rl-zoo block (:func:`load_hyperparams`): one iteration collects
     ``n_steps × n_envs`` env steps, as one SB3 rollout does; the other keys map one to one;
-    ``policy`` names the RLModule class (default :data:`DEFAULT_MODULE`)."""
+    ``policy`` names the RLModule class by dotted path (an SB3 policy name such as
+    ``MultiInputPolicy``, or none: :data:`DEFAULT_MODULE`)."""
     PPOConfig = require_rllib()
     from ray.rllib.core.rl_module.rl_module import RLModuleSpec
 
     n_envs = int(params.get("n_envs", 1))
     batch = int(params.get("n_steps", 2048)) * n_envs
     hidden = _first_layer_width(params.get("policy_kwargs") or {})
-    module = import_dotted(params.get("policy") or DEFAULT_MODULE)
+    policy = params.get("policy") or DEFAULT_MODULE
+    module = import_dotted(policy if "." in policy else DEFAULT_MODULE)  # SB3 names: ours
     kwargs = {**(params.get("env_kwargs") or {}), **(env_kwargs or {})}
     config = (
         PPOConfig()
@@ -170,9 +172,9 @@ def train_rllib(
 
     ``num_env_runners``: Ray processes that collect episodes (0: the driver collects them).
     A checkpoint in ``OUT/checkpoints`` at the first iteration boundary after every
-    ``checkpoint_every`` env steps, and at the end; ``resume=True``
-    loads the latest and continues (the module, optimiser, connector and metrics state and the
-    iteration count; the env episodes in flight start anew). ``address``: a running Ray
+    ``checkpoint_every`` env steps, and at the end; ``resume=True`` loads the latest and
+    continues (the module, optimiser, connector and metrics state and the iteration count; the
+    env episodes in flight start anew). ``address``: a running Ray
     cluster (``"auto"``), else a local Ray with one CPU per runner plus the driver.
     """
     from tqdm.auto import tqdm
@@ -186,9 +188,8 @@ def train_rllib(
     ):
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise ConfigError(f"{name} must be an integer ≥ 1, got {value!r}")
-    if isinstance(num_env_runners, bool) or not isinstance(num_env_runners, int):
-        raise ConfigError(f"num_env_runners must be an integer ≥ 0, got {num_env_runners!r}")
-    if num_env_runners < 0:
+    runners_ok = isinstance(num_env_runners, int) and not isinstance(num_env_runners, bool)
+    if not runners_ok or num_env_runners < 0:
         raise ConfigError(f"num_env_runners must be an integer ≥ 0, got {num_env_runners!r}")
     params = load_hyperparams(env_id, hyperparams_path)
     wrappers = wrapper_specs(params.get("env_wrapper"))
