@@ -27,6 +27,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from scipy.spatial import cKDTree
+
+from sfw_gym.evaluation.stats import mean_ci95_text as ci
+from sfw_gym.slam.radio_slam import travelled_m
 
 DRIFT = {"mid": (0.05, 0.02), "high": (0.10, 0.04)}  # as scripts/slam_study.py
 METHODS = ("odometry", "lidar_only", "radio_slam", "radio_lidar")
@@ -36,9 +40,7 @@ STEPS = 3000
 
 def loop_length_m(truth: np.ndarray, revisit_m: float = 1.0, min_gap: int = 50) -> float:
     """The longest drive between two poses within ``revisit_m`` of each other."""
-    from scipy.spatial import cKDTree
-
-    along = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(truth[:, :2], axis=0), axis=1))]
+    along = travelled_m(truth)
     pairs = cKDTree(truth[::5, :2]).query_pairs(revisit_m, output_type="ndarray") * 5
     pairs = pairs[pairs[:, 1] - pairs[:, 0] >= min_gap]
     return float(np.max(along[pairs[:, 1]] - along[pairs[:, 0]])) if len(pairs) else 0.0
@@ -46,44 +48,26 @@ def loop_length_m(truth: np.ndarray, revisit_m: float = 1.0, min_gap: int = 50) 
 
 def run(job: dict[str, Any]) -> dict[str, Any]:
     """One recorded run and every method on it."""
-    import gymnasium as gym
-
-    import sfw_gym  # noqa: F401  (registration)
-    from sfw_gym.agents import FrontierAgent
+    from sfw_gym.evaluation.drives import record_frontier_drive
     from sfw_gym.mapping import SparseInverseKVisibility
     from sfw_gym.mapping import metrics as m
     from sfw_gym.mapping.lidar_map import LidarOccupancyMap
     from sfw_gym.slam import absolute_trajectory_error, lidar_slam, radio_slam
-    from sfw_gym.slam.radio_slam import keyframes
 
     trans, heading = DRIFT[job["drift"]]
-    env = gym.make(
+    drive = record_frontier_drive(
         "SfW-Explore-v0",
+        job["seed"],
+        STEPS,
         robot={"odometry_translation_std": trans, "odometry_heading_std_rad": heading},
         generator={"area_m2": float(job["area_m2"])},
         n_background_aps=16,
         lidar=job["lidar"],
-        max_steps=STEPS,
     )
-    obs, info = env.reset(seed=job["seed"])
-    u = env.unwrapped
-    agent = FrontierAgent()
-    agent.reset(env, seed=job["seed"])
-    infos, bumps, done = [info], [False], False
-    while not done:
-        obs, _, terminated, truncated, info = env.step(agent.act(obs))
-        infos.append(info)
-        bumps.append(bool(u.scene.robot.bumped))
-        done = terminated or truncated
-    truth = np.array([i["true_pose"] for i in infos])
-    odometry = np.array([i["odometry_pose"] for i in infos])
-    prints = np.array([i["fingerprint"] for i in infos])
-    ranges = [i["lidar_ranges"] for i in infos]
-    rssi = u.rssi_history.view
-    radio = u.slam_config
-    keys = keyframes(len(odometry), radio.keyframe_every)
-    lidar = u.lidar
-    scans = {int(k): lidar.points((0.0, 0.0, 0.0), ranges[k]) for k in keys}
+    u = drive["env"]
+    truth, odometry, prints = drive["truth"], drive["odometry"], drive["fingerprints"]
+    ranges, scans, bumps = drive["lidar_ranges"], drive["keyframe_scans"], drive["bumps"]
+    rssi, radio, lidar = u.rssi_history.view, drive["slam_config"], u.lidar
 
     timings: dict[str, float] = {}
     trajectories: dict[str, np.ndarray] = {"odometry": odometry}
@@ -141,13 +125,6 @@ def _scores(m: Any, est: np.ndarray, truth: np.ndarray) -> dict[str, float]:
         "wall_precision": m.wall_precision(est, truth),
         "wall_recall": m.interior_wall_recall(est, truth),
     }
-
-
-def ci(values: list[float], fmt: str = "{:.2f}") -> str:
-    from sfw_gym.evaluation.stats import mean_ci95
-
-    mean, half, _ = mean_ci95(values)
-    return f"{fmt.format(mean)} [{fmt.format(mean - half)}, {fmt.format(mean + half)}]"
 
 
 def tables(records: list[dict[str, Any]], plans: int) -> list[str]:

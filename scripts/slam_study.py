@@ -32,6 +32,8 @@ from typing import Any
 
 import numpy as np
 
+from sfw_gym.evaluation.stats import mean_ci95_text as ci
+
 DRIFT = {  # translation std (fraction of a step's travel), heading std per step (rad)
     "none": (0.0, 0.0),
     "low": (0.02, 0.01),
@@ -153,13 +155,6 @@ def offline_slam(record: dict[str, Any], false_fraction: float = 0.0, seed: int 
     result = radio_slam(odometry, prints, cfg, extra_closures=extra)
     wall = time.perf_counter() - start
     return absolute_trajectory_error(result.poses, truth, align=False), wall, len(result.closures)
-
-
-def ci(values: list[float], fmt: str = "{:.2f}") -> str:
-    from sfw_gym.evaluation.stats import mean_ci95
-
-    mean, half, _ = mean_ci95(values)
-    return f"{fmt.format(mean)} [{fmt.format(mean - half)}, {fmt.format(mean + half)}]"
 
 
 def main() -> None:

@@ -303,6 +303,7 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
         episodes=args.episodes,
         workers=args.workers,
         backend=args.backend,
+        address=args.address,
         progress=not args.no_progress,
     )
     print((Path(out) / "results.md").read_text(encoding="utf-8"), end="")
@@ -613,21 +614,11 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument(
         "--out", type=folder, default="evaluation", help="output folder (resumes from it)"
     )
-    ev.add_argument("--workers", type=positive_int, default=2, help="worker processes (default 2)")
-    ev.add_argument(
-        "--backend",
-        choices=["local", "ray"],
-        default="local",
-        help="run episodes in local worker processes or as Ray tasks (pip install sfw-gym[ray])",
-    )
-    ev.add_argument(
-        "--address", default=None, help="with --backend ray: a cluster's address ('auto')"
-    )
+    _add_episode_runner_options(ev)
     ev.add_argument("--gif", action="store_true", help="also write GIFs of the first episodes")
     ev.add_argument(
         "--gif-episodes", type=non_negative_int, default=1, help="episodes per agent with a GIF"
     )
-    ev.add_argument("--no-progress", action="store_true", help="no progress bar")
     ev.set_defaults(func=_cmd_evaluate)
 
     bm = sub.add_parser(
@@ -655,11 +646,26 @@ def build_parser() -> argparse.ArgumentParser:
     bm.add_argument(
         "--out", type=folder, default=None, help="default benchmark/AGENT/SPLIT (resumes)"
     )
-    bm.add_argument("--workers", type=positive_int, default=2, help="worker processes (default 2)")
-    bm.add_argument("--backend", choices=["local", "ray"], default="local")
-    bm.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _add_episode_runner_options(bm)
     bm.set_defaults(func=_cmd_benchmark)
     return parser
+
+
+def _add_episode_runner_options(parser: argparse.ArgumentParser) -> None:
+    """Where episodes run: ``--workers``, ``--backend``, ``--address``, ``--no-progress``."""
+    parser.add_argument(
+        "--workers", type=positive_int, default=2, help="worker processes (default 2)"
+    )
+    parser.add_argument(
+        "--backend",
+        choices=["local", "ray"],
+        default="local",
+        help="run episodes in local worker processes or as Ray tasks (pip install sfw-gym[ray])",
+    )
+    parser.add_argument(
+        "--address", default=None, help="with --backend ray: a cluster's address ('auto')"
+    )
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -394,12 +394,8 @@ class SfWExploreEnv(gym.Env):
         odometry = self.scene.robot.odometry_pose
         if self.slam is None:
             return odometry
-        if isinstance(self.slam, OnlineRadioLidarSlam):
-            assert self.lidar is not None
-            points = self.lidar.points((0.0, 0.0, 0.0), self.lidar_ranges)
-            moved_from = self.slam.add_with_scan(odometry, self.fingerprint, points)
-        else:
-            moved_from = self.slam.add(odometry, self.fingerprint)
+        scan = None if self.lidar is None else self.lidar.points((0, 0, 0), self.lidar_ranges)
+        moved_from = self.slam.add(odometry, self.fingerprint, scan)
         if moved_from is not None:
             self._remap(self.slam.estimate()[:-1], moved_from)
         return Pose(*self.slam.latest().tolist())

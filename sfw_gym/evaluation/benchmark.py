@@ -116,11 +116,13 @@ def run_benchmark(
     episodes: int | None = None,
     workers: int = 1,
     backend: str = "local",
+    address: str | None = None,
     progress: bool = True,
 ) -> dict[str, Any]:
     """Run ``agent`` (a shipped name or ``package.module:Class``) through the protocol's
     ``split``; writes ``OUT/results.json`` and ``OUT/results.md`` and returns the results.
-    ``episodes`` caps the episodes per env (a quick look; recorded in the results)."""
+    ``episodes`` caps the episodes per env (a quick look; recorded in the results);
+    ``workers``, ``backend`` and ``address`` as :func:`~sfw_gym.evaluation.evaluate`'s."""
     from sfw_gym import __version__
     from sfw_gym.evaluation.runner import EpisodeSpec, run_specs
 
@@ -153,7 +155,9 @@ def run_benchmark(
             )
     _check_same_run(out, proto, agent, agent_params, split, plans)
     start = time.perf_counter()
-    records = run_specs(specs, out, workers=workers, backend=backend, progress=progress)
+    records = run_specs(
+        specs, out, workers=workers, backend=backend, address=address, progress=progress
+    )
     results = {
         "protocol": proto["name"],
         "protocol_version": proto["version"],

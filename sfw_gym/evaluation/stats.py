@@ -47,6 +47,12 @@ def mean_ci95(values: Sequence[float]) -> tuple[float, float, int]:
     return float(v.mean()), half, len(v)
 
 
+def mean_ci95_text(values: Sequence[float], fmt: str = "{:.2f}") -> str:
+    """``mean [low, high]`` of :func:`mean_ci95`, each number in ``fmt``."""
+    mean, half, _ = mean_ci95(values)
+    return f"{fmt.format(mean)} [{fmt.format(mean - half)}, {fmt.format(mean + half)}]"
+
+
 def summarize(records: list[dict[str, Any]], agents: Sequence[str]) -> list[dict[str, Any]]:
     """Per agent: mean, 95 % CI and n of each table metric, and episode counts."""
     rows = []

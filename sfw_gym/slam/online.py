@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from sfw_gym.core.buffers import AppendOnlyArray
+from sfw_gym.core.errors import ConfigError
 from sfw_gym.slam.pose_graph import chain
 from sfw_gym.slam.radio_lidar import LidarSlamConfig, lidar_slam
 from sfw_gym.slam.radio_slam import RadioSlamConfig, fit_range_model, radio_slam
@@ -39,10 +40,11 @@ class OnlineRadioSlam:
         """``(N, 3)`` the odometry poses so far (read-only)."""
         return self._odometry.view
 
-    def add(self, odometry_pose, fingerprint) -> int | None:
+    def add(self, odometry_pose, fingerprint, scan: np.ndarray | None = None) -> int | None:
         """Take one pose's odometry ``(x, y, θ)`` and fingerprint ``(L,)`` (dBm, NaN: not
-        heard); returns the first pose that a new solution moved by more than ``moved_m``, or
-        None when nothing was solved or moved."""
+        heard) and, where there is a LiDAR, its scan points ``(M, 2)`` in the robot's frame
+        (unused by Radio SLAM); returns the first pose that a new solution moved by more than
+        ``moved_m``, or None when nothing was solved or moved."""
         fingerprint = np.asarray(fingerprint, np.float64)
         if self._fingerprints is None:
             self._fingerprints = AppendOnlyArray(len(fingerprint))
@@ -99,13 +101,14 @@ class OnlineRadioLidarSlam(OnlineRadioSlam):
         self._scans: dict[int, np.ndarray] = {}
         self._registrations: dict[tuple[int, int], IcpResult] = {}
 
-    def add_with_scan(self, odometry_pose, fingerprint, points: np.ndarray) -> int | None:
-        """:meth:`OnlineRadioSlam.add` with this pose's scan points ``(M, 2)``."""
+    def add(self, odometry_pose, fingerprint, scan: np.ndarray | None = None) -> int | None:
+        if scan is None:
+            raise ConfigError("Radio+LiDAR SLAM needs each pose's LiDAR scan")
         index = len(self)
-        self._scans[index] = np.asarray(points, np.float64)
+        self._scans[index] = np.asarray(scan, np.float64)
         if index > 0 and (index - 1) % self.config.keyframe_every:
             del self._scans[index - 1]  # kept only while it was the latest pose
-        return self.add(odometry_pose, fingerprint)
+        return super().add(odometry_pose, fingerprint)
 
     def _solve(self, odometry: np.ndarray, fingerprints: np.ndarray, before: np.ndarray):
         return lidar_slam(

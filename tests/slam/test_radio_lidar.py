@@ -9,6 +9,7 @@ import pytest
 
 from sfw_gym.agents import FrontierAgent
 from sfw_gym.core.errors import ConfigError
+from sfw_gym.evaluation.drives import record_frontier_drive
 from sfw_gym.slam import (
     LidarSlamConfig,
     OnlineRadioLidarSlam,
@@ -17,7 +18,6 @@ from sfw_gym.slam import (
     lidar_slam,
     radio_slam,
 )
-from sfw_gym.slam.radio_slam import keyframes
 
 DRIFT = {"odometry_translation_std": 0.05, "odometry_heading_std_rad": 0.02}
 
@@ -25,25 +25,9 @@ DRIFT = {"odometry_translation_std": 0.05, "odometry_heading_std_rad": 0.02}
 @pytest.fixture(scope="module")
 def drive():
     """A 900-step frontier drive with drift, 16 background APs and the LiDAR (seed 7)."""
-    env = gym.make("SfW-Explore-v0", robot=DRIFT, n_background_aps=16, lidar={}, max_steps=900)
-    obs, info = env.reset(seed=7)
-    agent = FrontierAgent()
-    agent.reset(env, seed=7)
-    infos, done = [info], False
-    while not done:
-        obs, _, terminated, truncated, info = env.step(agent.act(obs))
-        infos.append(info)
-        done = terminated or truncated
-    u = env.unwrapped
-    odometry = np.array([i["odometry_pose"] for i in infos])
-    keys = keyframes(len(odometry), u.slam_config.keyframe_every)
-    return {
-        "truth": np.array([i["true_pose"] for i in infos]),
-        "odometry": odometry,
-        "fingerprints": np.array([i["fingerprint"] for i in infos]),
-        "scans": {int(k): u.lidar.points((0, 0, 0), infos[k]["lidar_ranges"]) for k in keys},
-        "radio": u.slam_config,
-    }
+    return record_frontier_drive(
+        "SfW-Explore-v0", 7, 900, robot=DRIFT, n_background_aps=16, lidar={}
+    )
 
 
 def ate(poses, drive):
@@ -51,15 +35,20 @@ def ate(poses, drive):
 
 
 def test_lidar_only_slam_removes_most_of_the_odometrys_drift(drive):
-    result = lidar_slam(drive["odometry"], drive["scans"], radio=drive["radio"])
+    result = lidar_slam(drive["odometry"], drive["keyframe_scans"], radio=drive["slam_config"])
     assert result.consecutive_registered > 0.8  # walls in view nearly everywhere indoors
     assert ate(result.poses, drive) < 0.3 * ate(drive["odometry"], drive)
 
 
 def test_radio_lidar_slam_beats_radio_slam_and_closes_lidar_loops(drive):
-    radio = ate(radio_slam(drive["odometry"], drive["fingerprints"], drive["radio"]).poses, drive)
+    radio = ate(
+        radio_slam(drive["odometry"], drive["fingerprints"], drive["slam_config"]).poses, drive
+    )
     both = lidar_slam(
-        drive["odometry"], drive["scans"], drive["fingerprints"], radio=drive["radio"]
+        drive["odometry"],
+        drive["keyframe_scans"],
+        drive["fingerprints"],
+        radio=drive["slam_config"],
     )
     assert len(both.lidar_closures) > 0
     # every accepted LiDAR closure joins poses that are truly close
@@ -79,30 +68,32 @@ def test_without_scan_matching_the_pipeline_is_no_better_than_its_first_stage(dr
     never = IcpConfig(max_fitness=1e-12)
     both = lidar_slam(
         drive["odometry"],
-        drive["scans"],
+        drive["keyframe_scans"],
         drive["fingerprints"],
-        radio=drive["radio"],
+        radio=drive["slam_config"],
         icp_config=never,
     )
-    radio = radio_slam(drive["odometry"], drive["fingerprints"], drive["radio"]).poses
+    radio = radio_slam(drive["odometry"], drive["fingerprints"], drive["slam_config"]).poses
     assert both.consecutive_registered == 0 and len(both.lidar_closures) == 0
     assert ate(both.poses, drive) == pytest.approx(ate(radio, drive), abs=0.05)
 
 
 def test_a_missing_keyframe_scan_is_one_clear_error(drive):
-    scans = dict(drive["scans"])
+    scans = dict(drive["keyframe_scans"])
     del scans[5]
     with pytest.raises(ConfigError, match=r"no scan for keyframe pose\(s\) \[5\]"):
-        lidar_slam(drive["odometry"], scans, radio=drive["radio"])
+        lidar_slam(drive["odometry"], scans, radio=drive["slam_config"])
 
 
 def test_the_online_solver_keeps_scans_only_at_keyframes_and_the_latest_pose():
     slam = OnlineRadioLidarSlam(RadioSlamConfig(keyframe_every=5, solve_every=1000))
     points = np.array([[1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
     for k in range(23):
-        slam.add_with_scan((0.1 * k, 0.0, 0.0), np.full(4, -50.0), points + k)
+        slam.add((0.1 * k, 0.0, 0.0), np.full(4, -50.0), points + k)
     assert sorted(slam._scans) == [0, 5, 10, 15, 20, 22]
     np.testing.assert_array_equal(slam._scans[22], points + 22)
+    with pytest.raises(ConfigError, match="needs each pose's LiDAR scan"):
+        slam.add((0.0, 0.0, 0.0), np.full(4, -50.0))
 
 
 def test_the_lidar_env_maps_along_a_trajectory_far_better_than_its_odometry():
