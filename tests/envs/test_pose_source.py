@@ -96,3 +96,22 @@ def test_radio_slam_weighs_odometry_by_the_robots_noise_unless_told_otherwise():
     assert env.slam_config.odometry_sigma_rad == pytest.approx(0.02)
     own = gym.make("SfW-ExploreRadioSLAM-v0", slam={"odometry_sigma_m": 0.03}).unwrapped
     assert own.slam_config.odometry_sigma_m == 0.03
+
+
+def test_radio_lidar_slam_needs_the_lidar_and_access_points_by_name():
+    with pytest.raises(ConfigError, match=r"pose_source='radio_lidar'.*lidar=\{\}"):
+        gym.make("SfW-Explore-v0", pose_source="radio_lidar", n_background_aps=4)
+    with pytest.raises(ConfigError, match=r"pose_source='radio_lidar'.*n_background_aps"):
+        gym.make("SfW-Explore-v0", pose_source="radio_lidar", lidar={})
+    with pytest.raises(ConfigError, match=r"lidar\.max_range_m"):
+        gym.make("SfW-Explore-v0", lidar={"max_range_m": -1})
+
+
+def test_the_lidar_observation_is_each_range_over_the_max_and_one_for_no_return():
+    env = gym.make("SfW-Explore-v0", lidar={"max_range_m": 2.0, "beams": 90})
+    obs, info = env.reset(seed=4)
+    ranges = info["lidar_ranges"]
+    assert obs["lidar"].shape == (90,) and env.observation_space.contains(obs)
+    assert np.isinf(ranges).any() and np.isfinite(ranges).any()  # some walls within 2 m
+    expected = np.where(np.isinf(ranges), 1.0, np.minimum(ranges / 2.0, 1.0))  # noise: ≤ 1
+    np.testing.assert_allclose(obs["lidar"], expected, rtol=1e-6)

@@ -149,3 +149,36 @@ def test_the_shipped_models_never_trained_on_the_test_split(model):
             tested.add(env.reset(seed=first + i)[1]["floorplan"])
     assert first + len(tested) <= last
     assert not trained & tested
+
+
+def test_unreached_90_percent_counts_as_the_budget_and_all_zero_metrics_are_left_out():
+    protocol = bm.load_protocol("benchmark-v1")
+    record = {
+        "env_id": "SfW-Explore-v0",
+        "seed": 5,
+        "floorplan": "gen-5",
+        "steps": 3000,
+        "max_steps": 3000,
+        "steps_to_coverage_90": -1,  # never got there
+        **{m: 0.5 for m in ("coverage", "info_gain_per_m", "path_length_m", "free_iou")},
+        **{m: 0.5 for m in ("wall_precision", "interior_wall_recall")},
+        "ate_m": 0.0,  # no drift: no pose error to report
+    }
+    row = bm._episode_row(record, protocol)
+    assert row["steps_to_coverage_90"] == 3001
+    reached = bm._episode_row({**record, "seed": 6, "steps_to_coverage_90": 1200}, protocol)
+    summary = bm.summarize_results({"episodes": [row, reached]}, protocol)["SfW-Explore-v0"]
+    assert summary["steps_to_coverage_90"]["mean"] == pytest.approx(2100.5)
+    assert "ate_m" not in summary and summary["coverage"]["n"] == 2
+
+
+def test_another_agent_seed_runs_its_own_episodes(tmp_path):
+    argv = ["benchmark", "--agent", "random", "--split", "validation", "--episodes", "1"]
+    common = ["--workers", "1", "--no-progress"]
+    for seed in ("0", "1"):
+        out = ["--out", str(tmp_path / seed)]
+        assert main([*argv, "--seed", seed, *common, *out]) == 0
+    a = json.loads((tmp_path / "0" / "results.json").read_text())
+    b = json.loads((tmp_path / "1" / "results.json").read_text())
+    assert a["agent_seed"] == 0 and b["agent_seed"] == 1
+    assert [r["coverage"] for r in a["episodes"]] != [r["coverage"] for r in b["episodes"]]

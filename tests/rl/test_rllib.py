@@ -127,3 +127,27 @@ def test_the_module_never_picks_a_masked_candidate_goal():
     assert set(picks) <= {2, 5}
     values = module.compute_values({Columns.OBS: batch})
     assert values.shape == (4,)
+
+
+@needs_rllib
+def test_the_rl_zoo_block_maps_onto_rllibs_ppo_config():
+    from sfw_gym.rl.rllib import ppo_config
+    from sfw_gym.rl.rllib_module import DictObsModule
+
+    params = {
+        "policy": "MultiInputPolicy",  # an SB3 name: the Dict-observation module instead
+        "n_envs": 2,
+        "n_steps": 64,
+        "batch_size": 256,
+        "n_epochs": 3,
+        "gae_lambda": 0.9,
+        "learning_rate": 1e-3,
+        "policy_kwargs": {"net_arch": {"pi": [32], "vf": [32]}},
+    }
+    config = ppo_config(SMALL, params, num_env_runners=2, seed=5)
+    assert config.train_batch_size_per_learner == 128  # one SB3 rollout: n_steps x n_envs
+    assert config.minibatch_size == 128  # never above the batch
+    assert (config.num_epochs, config.lambda_, config.lr) == (3, 0.9, 1e-3)
+    assert config.num_envs_per_env_runner == 1 and config.seed == 5
+    spec = config.rl_module_spec
+    assert spec.module_class is DictObsModule and spec.model_config == {"hidden": 32}

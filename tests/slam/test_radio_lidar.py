@@ -132,3 +132,16 @@ def test_a_weakly_constrained_registration_far_from_the_odometry_is_not_used(
     poses = lidar_slam(odometry, scans, radio=RadioSlamConfig(keyframe_every=5)).poses
     expected = 1.0 if follows == "odometry" else 2.0  # two keyframe steps of 0.5 + 0.5
     assert poses[-1, 0] == pytest.approx(expected, abs=1e-6)
+
+
+def test_the_recorded_keyframe_scans_lie_on_the_walls_seen_from_their_true_poses(drive):
+    import shapely
+
+    walls = drive["env"].scene.floorplan.free_space.boundary
+    for k in list(drive["keyframe_scans"])[::40]:
+        x, y, theta = drive["truth"][k]
+        points = drive["keyframe_scans"][k]
+        c, s = np.cos(theta), np.sin(theta)
+        world = points @ np.array([[c, s], [-s, c]]) + [x, y]
+        off = shapely.distance(shapely.points(world), walls)
+        assert len(points) > 100 and np.quantile(off, 0.99) < 0.05, (k, off.max())
