@@ -15,6 +15,7 @@ from sfw_gym.agents.cross_pass import CrossPassAgent
 from sfw_gym.agents.frontier import FrontierAgent
 from sfw_gym.agents.greedy import GreedyInfoGainAgent
 from sfw_gym.agents.random_agent import RandomAgent
+from sfw_gym.agents.regions import RegionAgent
 from sfw_gym.core.errors import ConfigError
 
 #: Agents by their command-line name, as ``"module:Class"`` entry points imported on first use
@@ -25,8 +26,10 @@ AGENTS: dict[str, str] = {
     "cross-pass": "sfw_gym.agents.cross_pass:CrossPassAgent",
     "greedy": "sfw_gym.agents.greedy:GreedyInfoGainAgent",
     "random": "sfw_gym.agents.random_agent:RandomAgent",
+    "region-teacher": "sfw_gym.agents.regions:RegionAgent",
     "ppo": "sfw_gym.rl.agent:PPOAgent",
     "ppo-waypoint": "sfw_gym.rl.waypoint_agent:WaypointPPOAgent",
+    "ppo-regions": "sfw_gym.rl.agent:RegionsPPOAgent",
 }
 
 
@@ -83,6 +86,7 @@ __all__ = [
     "FrontierAgent",
     "GreedyInfoGainAgent",
     "RandomAgent",
+    "RegionAgent",
     "RobotView",
     "RobotViewHandle",
     "agent_class",

@@ -48,7 +48,14 @@ from scipy import ndimage
 from sfw_gym.agents.base import Agent, RobotView
 from sfw_gym.core.config import check
 from sfw_gym.core.constants import U8_FREE_MIN, U8_WALL_MAX
-from sfw_gym.navigation.candidates import SOURCES, CandidateGoals, CandidateSettings, GoalFinder
+from sfw_gym.navigation.candidates import (
+    GAIN_SCALE,
+    POTENTIAL_SCALE,
+    TURN_COST_M_PER_RAD,
+    CandidateSettings,
+    GoalFinder,
+    explore_lite_choice,  # noqa: F401  (re-exported: the teacher's choice, by its old home)
+)
 from sfw_gym.navigation.planning import (
     CostField,
     PurePursuit,
@@ -78,22 +85,6 @@ class Goal:
     best_remaining_m: float = np.inf
     steps_without_progress: int = 0
     bumps: int = 0
-
-
-#: explore_lite's utility of a frontier cluster: GAIN_SCALE × size (m) − POTENTIAL_SCALE × cost
-#: (m), the cost being the path plus TURN_COST_M_PER_RAD × the heading change (rad).
-GAIN_SCALE, POTENTIAL_SCALE, TURN_COST_M_PER_RAD = 1.0, 3.0, 0.3
-
-
-def explore_lite_choice(menu: CandidateGoals) -> int | None:
-    """The index of the menu's frontier candidate of best explore_lite utility (with the
-    frontier agent's default scales; None when no frontier candidate is reachable): the
-    frontier agent's choice on a K-candidate menu, the teacher of the learned explorer."""
-    f = menu.feature
-    cost = f("path_cost_m") + TURN_COST_M_PER_RAD * f("heading_change_rad")
-    utility = GAIN_SCALE * f("cluster_size_m") - POTENTIAL_SCALE * cost
-    ok = menu.valid & (menu.source == SOURCES.index("frontier"))
-    return int(np.argmax(np.where(ok, utility, -np.inf))) if ok.any() else None
 
 
 #: What :meth:`FrontierAgent._choose_goal` returns when a bounded search cannot prove its choice.

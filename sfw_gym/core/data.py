@@ -27,6 +27,8 @@ def data_path(*parts: str) -> Path:
 DEFAULT_WAYPOINT_MODEL_DIR = data_path("agents", "ppo", "SfW-Explore-v0_1")
 #: The shipped candidate-goal explorer (trained by ``sfw-gym train ppo_mask``).
 DEFAULT_MODEL_DIR = data_path("agents", "ppo_mask", "SfW-ExploreGoals-v0_1")
+#: The shipped region explorer (``sfw-gym train ppo_mask --env SfW-ExploreRegions-v0``).
+DEFAULT_REGIONS_MODEL_DIR = data_path("agents", "ppo_mask", "SfW-ExploreRegions-v0_1")
 #: PPO hyperparameters per env id (rl-zoo format).
 DEFAULT_HYPERPARAMS = data_path("agents", "hyperparams", "ppo.yml")
 

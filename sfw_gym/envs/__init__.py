@@ -26,6 +26,9 @@ ENV_IDS: dict[str, dict[str, Any]] = {
     },
     # Candidate-goal actions: pick one of K goals of the navigation menu, the robot drives there.
     "SfW-ExploreGoals-v0": {},
+    # Region actions: pick one of K candidates as a region every 20 steps; the classical local
+    # steering drives towards it (≤ 150 decisions an episode; sfw_gym.envs.regions).
+    "SfW-ExploreRegions-v0": {},
     # Drifting odometry (5 % of each step's travel, 0.02 rad of heading per step: about 1 m of
     # ATE over 1,500 frontier steps, scripts/slam_study.py) and 16 background access
     # points whose fingerprint Radio SLAM (sfw_gym.slam.radio_slam) can close loops with.
@@ -59,6 +62,7 @@ ENV_IDS: dict[str, dict[str, Any]] = {
 #: Ids whose env is not the explore env itself.
 ENTRY_POINTS: dict[str, str] = {
     "SfW-ExploreGoals-v0": "sfw_gym.envs.goals:SfWGoalsEnv",
+    "SfW-ExploreRegions-v0": "sfw_gym.envs.regions:SfWRegionsEnv",
     "SfW-Localize-v0": "sfw_gym.envs.localize:SfWLocalizeEnv",
 }
 
@@ -86,6 +90,10 @@ def __getattr__(name: str) -> Any:
         from sfw_gym.envs.goals import SfWGoalsEnv
 
         return SfWGoalsEnv
+    if name == "SfWRegionsEnv":
+        from sfw_gym.envs.regions import SfWRegionsEnv
+
+        return SfWRegionsEnv
     if name == "WaypointWrapper":
         from sfw_gym.envs.waypoint import WaypointWrapper
 

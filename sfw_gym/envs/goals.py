@@ -10,6 +10,7 @@ wastes, no separate fine), plus a bonus when the coverage target is reached; div
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -21,9 +22,15 @@ from sfw_gym.core.config import Config, setting
 from sfw_gym.core.constants import NOT_HEARD_DBM
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.explore import SfWExploreEnv
-from sfw_gym.navigation.candidates import FEATURES, CandidateGoals, GoalFinder
+from sfw_gym.navigation.candidates import (
+    FEATURES,
+    CandidateGoals,
+    GoalFinder,
+    explore_lite_choice,
+)
 from sfw_gym.navigation.goal_driver import GoalDriver
 from sfw_gym.navigation.planning import cost_field, to_discrete
+from sfw_gym.navigation.view import RobotView
 
 #: Scale of each feature column in the observation (value / scale, then clipped to [-1, 4]).
 FEATURE_SCALES: dict[str, float] = {
@@ -73,6 +80,7 @@ class SfWGoalsEnv(gym.Env):
     """
 
     metadata = SfWExploreEnv.metadata
+    config_class: ClassVar[type[GoalsConfig]] = GoalsConfig
 
     def __init__(
         self,
@@ -80,7 +88,7 @@ class SfWGoalsEnv(gym.Env):
         render_mode: str | None = None,
         **explore_kwargs: Any,
     ):
-        self.config = GoalsConfig.from_dict(goals, "goals")
+        self.config = self.config_class.from_dict(goals, self.config_class.prefix)
         self.explore = SfWExploreEnv(render_mode=render_mode, **explore_kwargs)
         self.render_mode = render_mode
         k = self.config.max_candidates
@@ -109,30 +117,16 @@ class SfWGoalsEnv(gym.Env):
         return self._observe(obs), info
 
     def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
-        if self.menu is None:
-            raise gym.error.ResetNeeded("call reset() before step()")
-        a = np.asarray(action)
-        k = self.config.max_candidates
-        if a.shape != () or a.dtype.kind not in "iu" or not 0 <= int(a) < k:
-            raise ConfigError(f"goal action must be an integer in [0, {k}), got {action!r}")
-        cfg = self.config
-        start_path, start_steps = self.explore.path_length_m, self.explore.steps
-        view = self.explore.robot_view()
-        invalid = not self.driver.start(view, self.menu, int(a))
-        gain = 0.0
-        while (command := self.driver.command(view)) is not None:
-            obs, _, terminated, truncated, info = self.explore.step(self._command(*command))
-            gain += info["info_gain_bits"]
-            view = self.explore.robot_view()
-            if terminated or truncated:
-                break
-        metres = self.explore.path_length_m - start_path
-        steps = self.explore.steps - start_steps
-        bits = gain - cfg.cost_per_m_bits * metres - cfg.cost_per_step_bits * steps
-        if terminated:
-            bits += cfg.goal_bonus_bits
-        info = dict(info, invalid_action=invalid, decision_steps=steps, decision_m=metres)
-        return self._observe(obs), bits / cfg.reward_scale_bits, terminated, truncated, info
+        i = self._action_index(action)
+        assert self.menu is not None
+        invalid = not self.driver.start(self.explore.robot_view(), self.menu, i)
+        return self._decide(self.driver.command, invalid)
+
+    def teacher_action(self) -> int:
+        """The frontier agent's choice on the current menu (explore_lite's utility; the first
+        allowed action when no frontier cluster is reachable): the imitation teacher."""
+        choice = explore_lite_choice(self.menu) if self.menu is not None else None
+        return int(np.argmax(self.action_masks())) if choice is None else choice
 
     def action_masks(self) -> np.ndarray:
         """Which actions pick a reachable candidate (for ``MaskablePPO``)."""
@@ -149,6 +143,39 @@ class SfWGoalsEnv(gym.Env):
         return self.explore.robot_view()
 
     # -- helpers ---------------------------------------------------------------------------------
+    def _action_index(self, action: Any) -> int:
+        """``action`` as a candidate index, or a one-line error."""
+        if self.menu is None:
+            raise gym.error.ResetNeeded("call reset() before step()")
+        a = np.asarray(action)
+        k = self.config.max_candidates
+        if a.shape != () or a.dtype.kind not in "iu" or not 0 <= int(a) < k:
+            raise ConfigError(f"goal action must be an integer in [0, {k}), got {action!r}")
+        return int(a)
+
+    def _decide(
+        self, command: Callable[[RobotView], tuple[float, float] | None], invalid: bool
+    ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        """Drive one decision, a ``command`` per env step until it returns None (or the
+        episode ends); its reward in bits (see the module doc) ÷ ``reward_scale_bits``."""
+        cfg = self.config
+        start_path, start_steps = self.explore.path_length_m, self.explore.steps
+        view = self.explore.robot_view()
+        gain = 0.0
+        while (next_command := command(view)) is not None:
+            obs, _, terminated, truncated, info = self.explore.step(self._command(*next_command))
+            gain += info["info_gain_bits"]
+            view = self.explore.robot_view()
+            if terminated or truncated:
+                break
+        metres = self.explore.path_length_m - start_path
+        steps = self.explore.steps - start_steps
+        bits = gain - cfg.cost_per_m_bits * metres - cfg.cost_per_step_bits * steps
+        if terminated:
+            bits += cfg.goal_bonus_bits
+        info = dict(info, invalid_action=invalid, decision_steps=steps, decision_m=metres)
+        return self._observe(obs), bits / cfg.reward_scale_bits, terminated, truncated, info
+
     def _observe(self, obs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         self.finder.set_step(self.explore.steps)
         self.menu, extra = menu_observation(

@@ -58,6 +58,15 @@ def state_size(n_routers: int) -> int:
     return 2 * n_routers + 6
 
 
+def map_pixels(grid: GridSpec, map_px: int, rc: np.ndarray) -> np.ndarray:
+    """``(N, 2)`` grid cells → their centres' (row, col) on the ``map`` image ÷ ``map_px``
+    (fractions in [0, 1]: where a policy samples image features for a cell)."""
+    cells_per_px = max(grid.shape) / map_px
+    pad = (map_px - np.array(grid.shape) / cells_per_px) / 2
+    centre = (np.asarray(rc, np.float64).reshape(-1, 2) + 0.5) / cells_per_px
+    return np.clip((centre + pad) / map_px, 0.0, 1.0).astype(np.float32)
+
+
 class ObservationBuilder:
     """Builds observations for one episode's grid; precomputes the sampling indices once.
 
@@ -100,6 +109,16 @@ class ObservationBuilder:
         c = math.floor((x - ox) / res / self.cells_per_px + self._pad_c)
         return min(max(r, 0), self.map_px - 1), min(max(c, 0), self.map_px - 1)
 
+    def image_of(self, grid_u8: np.ndarray) -> np.ndarray:
+        """A ``(rows, cols)`` uint8 grid sampled onto the map image (padding reads unknown)."""
+        image = grid_u8.ravel().take(self._flat_index)
+        image[self._pad] = U8_UNKNOWN
+        return image
+
+    def pixels_of_cells(self, rc: np.ndarray) -> np.ndarray:
+        """:func:`map_pixels` on this episode's grid and image."""
+        return map_pixels(self.grid, self.map_px, rc)
+
     def clear_visited(self) -> None:
         """Empty the trajectory channel (before drawing a corrected trajectory)."""
         self._trajectory.fill(0)
@@ -119,8 +138,7 @@ class ObservationBuilder:
     ) -> dict[str, np.ndarray]:
         """The observation dict for the current belief and readings."""
         x, y, theta = odometry_pose
-        belief = belief_u8.ravel().take(self._flat_index)
-        belief[self._pad] = U8_UNKNOWN
+        belief = self.image_of(belief_u8)
         robot = self._trajectory.copy()
         r, c = self.pixel_of(x, y)
         robot[max(r - 1, 0) : r + 2, max(c - 1, 0) : c + 2] = ROBOT_U8

@@ -128,6 +128,39 @@ class CandidateGoals:
         return self.paths.path(tuple(self.goal_rc[i]))
 
 
+#: explore_lite's utility of a frontier cluster: GAIN_SCALE × size (m) − POTENTIAL_SCALE × cost
+#: (m), the cost being the path plus TURN_COST_M_PER_RAD × the heading change (rad).
+GAIN_SCALE, POTENTIAL_SCALE, TURN_COST_M_PER_RAD = 1.0, 3.0, 0.3
+
+
+def explore_lite_choice(
+    menu: CandidateGoals,
+    anchor_rc: tuple[int, int] | None = None,
+    anchor_cost_per_m: float = 0.0,
+    resolution_m: float = 1.0,
+) -> int | None:
+    """The index of the menu's frontier candidate of best explore_lite utility (with the
+    frontier agent's default scales; None when no frontier candidate is reachable): the
+    frontier agent's choice on a K-candidate menu, the teacher of the learned explorer.
+
+    With ``anchor_rc`` (a region chosen higher up: :mod:`sfw_gym.navigation.regions`), each
+    candidate's utility also loses ``anchor_cost_per_m`` per metre between its target and the
+    anchor cell (cells of ``resolution_m``)."""
+    f = menu.feature
+    cost = f("path_cost_m") + TURN_COST_M_PER_RAD * f("heading_change_rad")
+    utility = GAIN_SCALE * f("cluster_size_m") - POTENTIAL_SCALE * cost
+    if np.isnan(utility[menu.valid]).any():
+        raise ValueError(
+            "explore_lite_choice needs the menu's path_cost_m, heading_change_rad and "
+            "cluster_size_m features (GoalFinder.find(features=...) left one out)"
+        )
+    if anchor_rc is not None and anchor_cost_per_m > 0 and len(menu):
+        offset_m = (menu.target_rc - np.asarray(anchor_rc)) * resolution_m
+        utility = utility - anchor_cost_per_m * np.hypot(offset_m[:, 0], offset_m[:, 1])
+    ok = menu.valid & (menu.source == SOURCES.index("frontier"))
+    return int(np.argmax(np.where(ok, utility, -np.inf))) if ok.any() else None
+
+
 def candidate_goals(view: RobotView, max_candidates: int = 32, **settings) -> CandidateGoals:
     """Up to ``max_candidates`` goals for ``view``'s belief (a fresh :class:`GoalFinder`).
 
@@ -408,10 +441,15 @@ class GoalFinder:
         max_candidates: int | None = None,
         sources: tuple[str, ...] = SOURCES,
         features: tuple[str, ...] = FEATURES,
+        anchor_rc: tuple[int, int] | None = None,
+        anchor_cost_per_m: float = 0.0,
     ) -> CandidateGoals:
         """The candidates of ``sources`` for ``view`` on ``paths``: all of them with
         ``max_candidates=None``, else the quotas of :func:`candidate_goals`. Only the columns
-        named in ``features`` are computed (the others are NaN): agents ask for what they use."""
+        named in ``features`` are computed (the others are NaN): agents ask for what they use.
+
+        With ``anchor_rc``, a frontier cluster's target is its cheapest cell counting also
+        ``anchor_cost_per_m`` (path metres) per metre between the cell and the anchor."""
         for given, known in ((sources, SOURCES), (features, FEATURES)):
             unknown_names = set(given) - set(known)
             if unknown_names:
@@ -436,6 +474,9 @@ class GoalFinder:
             float(heading),
             float(self.settings.turn_cost_m_per_rad),
             max(1, round(self.settings.min_frontier_size_m / res)),
+            -1 if anchor_rc is None else int(anchor_rc[0]),
+            -1 if anchor_rc is None else int(anchor_rc[1]),
+            float(anchor_cost_per_m),
         )
         reachable = np.isfinite(open_cost)
         walled_off_rc = open_cells[~reachable]
@@ -702,12 +743,16 @@ def _frontier_menu(
     heading,
     turn,
     min_cells,
+    anchor_r,
+    anchor_c,
+    anchor_cost,
 ):  # pragma: no cover (compiled)
     """The frontier part of a menu in one pass: the open frontier cells (not excluded),
     ``(N, 2)``, with their approach costs on ``cum``; their clusters of ``min_cells`` or more
     (cells flat, grouped as :func:`~sfw_gym.navigation.frontiers.cluster_cells` groups them,
     and the groups' bounds); and per cluster the index of its cheapest cell to resolve
-    (approach + ``turn`` × heading change)."""
+    (approach + ``turn`` × heading change + ``anchor_cost`` × the distance to the anchor cell
+    ``(anchor_r, anchor_c)`` when ``anchor_r >= 0``)."""
     h, w = belief.shape
     open_flat = frontier_flat[
         ~_excluded(belief, frontier_flat, near_bump, failed_until, unreachable_until, step, n_big)
@@ -727,6 +772,12 @@ def _frontier_menu(
             c = members[k] - r * w
             bearing = math.atan2(row_y[r] - y, col_x[c] - x) - heading
             cost[k] = cost[k] + turn * abs((bearing + math.pi) % (2 * math.pi) - math.pi)
+    if anchor_r >= 0 and anchor_cost > 0:
+        for k in range(len(members)):
+            r = members[k] // w
+            c = members[k] - r * w
+            dist = math.hypot(row_y[r] - row_y[anchor_r], col_x[c] - col_x[anchor_c])
+            cost[k] = cost[k] + anchor_cost * dist
     return cells, open_cost, members, bounds, _first_argmin_per_group(cost, bounds)
 
 

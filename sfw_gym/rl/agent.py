@@ -17,10 +17,11 @@ import numpy as np
 import yaml
 
 from sfw_gym.agents.base import Agent, RobotView
-from sfw_gym.core.data import DEFAULT_MODEL_DIR
+from sfw_gym.agents.regions import RegionAgent
+from sfw_gym.core.data import DEFAULT_MODEL_DIR, DEFAULT_REGIONS_MODEL_DIR
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.goals import GoalsConfig, action_masks, menu_observation
-from sfw_gym.navigation.candidates import GoalFinder
+from sfw_gym.navigation.candidates import CandidateGoals, GoalFinder
 from sfw_gym.navigation.goal_driver import GoalDriver
 
 
@@ -49,36 +50,14 @@ class PPOAgent(Agent):
         num_threads: int | None = 1,
         max_steps: int | None = None,
     ) -> None:
-        import torch
-        from sb3_contrib import MaskablePPO
-
-        if num_threads is not None:
-            torch.set_num_threads(num_threads)
-
         super().__init__(max_steps=max_steps)
-        given = Path(path)
-        folder = given.parent if given.suffix == ".zip" else given
         self.path, self.deterministic, self.device = str(path), bool(deterministic), device
         self.num_threads = num_threads
-        model_path = given if given.suffix == ".zip" else folder / "model.zip"
-        # a checkpoint (OUT/checkpoints/ppo_mask_<steps>_steps.zip): the run's config is above it
-        config_path = next(
-            (p for p in (folder / "config.yml", folder.parent / "config.yml") if p.is_file()),
-            None,
-        )
-        if not model_path.is_file():
-            raise ConfigError(
-                f"PPOAgent: {model_path} not found; train one with `sfw-gym train "
-                f"ppo_mask --env SfW-ExploreGoals-v0 --out {folder}`"
-            )
-        config: dict[str, Any] = {}
-        if config_path is not None:
-            config = yaml.safe_load(config_path.read_text(encoding="utf-8")) or {}
+        self.model, config = load_model(path, device, num_threads)
         goals = (config.get("env_kwargs") or {}).get("goals")
         self.config = GoalsConfig.from_dict(goals, "goals")
         # a policy trained without masks (an ablation) chooses among all candidates
         self.use_masking = bool((config.get("hyperparameters") or {}).get("use_masking", True))
-        self.model = MaskablePPO.load(str(model_path), device=device)
 
     def _on_reset(self, view: RobotView) -> None:
         self.finder = GoalFinder()
@@ -126,5 +105,87 @@ class PPOAgent(Agent):
         with torch.no_grad():
             tensor, _ = policy.obs_to_tensor(obs)
             dist = policy.get_distribution(tensor, action_masks=mask[None])
-            probs = dist.distribution.probs[0].cpu().numpy().astype(np.float64)  # type: ignore[union-attr]
+            probs = dist.distribution.probs[0].cpu().numpy().astype(np.float64)
         return int(self.rng.choice(len(probs), p=probs / probs.sum()))
+
+
+def load_model(
+    path: str | Path, device: str = "cpu", num_threads: int | None = 1
+) -> tuple[Any, dict[str, Any]]:
+    """A MaskablePPO model (fine-tuned ones load the same way) and its run's ``config.yml``
+    (empty if none) from a ``sfw-gym train ppo_mask`` output folder, or a ``.zip`` in it or in
+    its ``checkpoints``; ``num_threads``: PyTorch's CPU threads, set for the process."""
+    import torch
+    from sb3_contrib import MaskablePPO
+
+    if num_threads is not None:
+        torch.set_num_threads(num_threads)
+    given = Path(path)
+    folder = given.parent if given.suffix == ".zip" else given
+    model_path = given if given.suffix == ".zip" else folder / "model.zip"
+    # a checkpoint (OUT/checkpoints/ppo_mask_<steps>_steps.zip): the run's config is above it
+    config_path = next(
+        (p for p in (folder / "config.yml", folder.parent / "config.yml") if p.is_file()), None
+    )
+    if not model_path.is_file():
+        raise ConfigError(
+            f"{model_path} not found; train one with `sfw-gym train ppo_mask --env "
+            f"SfW-ExploreRegions-v0 --out {folder}` (or SfW-ExploreGoals-v0)"
+        )
+    config: dict[str, Any] = {}
+    if config_path is not None:
+        config = yaml.safe_load(config_path.read_text(encoding="utf-8")) or {}
+    return MaskablePPO.load(str(model_path), device=device), config
+
+
+class RegionsPPOAgent(RegionAgent):
+    """Acts with a model trained on ``SfW-ExploreRegions-v0`` (``sfw-gym train ppo_mask --env
+    SfW-ExploreRegions-v0``): every ``decision_steps`` steps the policy picks a region of the
+    candidate menu from the whole map (its actor reads no ground truth), and the classical
+    steering drives towards it, exactly as in the env.
+
+    Args:
+        path: A training output folder or a ``.zip`` in it or in its ``checkpoints``; by
+            default the shipped region model.
+        deterministic: Take the most likely region (the default); else sample it with the
+            agent's seeded generator.
+        device: Torch device of the policy.
+        num_threads: PyTorch's CPU threads, set for the process (None: leave them).
+        max_steps: Optional step limit of the agent.
+    """
+
+    name = "ppo-regions"
+
+    def __init__(
+        self,
+        path: str | Path = DEFAULT_REGIONS_MODEL_DIR,
+        deterministic: bool = True,
+        device: str = "cpu",
+        num_threads: int | None = 1,
+        max_steps: int | None = None,
+    ) -> None:
+        self.model, config = load_model(path, device, num_threads)
+        regions = (config.get("env_kwargs") or {}).get("regions")
+        super().__init__(regions=regions, max_steps=max_steps)
+        self.path, self.deterministic, self.device = str(path), bool(deterministic), device
+        self.num_threads = num_threads
+
+    def choose(
+        self, view: RobotView, obs: Any, menu: CandidateGoals, extra: dict[str, np.ndarray]
+    ) -> int:
+        import torch
+
+        if not isinstance(obs, dict):
+            raise ConfigError(f"{type(self).__name__}.act(obs) needs the env's (Dict) observation")
+        policy = self.model.policy
+        k = self.config.max_candidates
+        px = self.candidate_pixels(view, menu, k, obs["map"].shape[-1])
+        full = {**obs, **extra, "candidate_px": px}
+        with torch.no_grad():
+            x = {key: torch.as_tensor(full[key])[None] for key in policy.actor_keys}
+            logits = policy.actor_logits(x)[0].numpy().astype(np.float64)
+        logits = np.where(action_masks(menu, k), logits, -np.inf)
+        if self.deterministic:
+            return int(np.argmax(logits))
+        probs = np.exp(logits - logits.max())
+        return int(self.rng.choice(k, p=probs / probs.sum()))

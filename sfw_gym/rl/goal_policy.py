@@ -22,8 +22,6 @@ from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from torch import nn
 
-from sfw_gym.agents.frontier import explore_lite_choice
-
 
 class GoalsInputs(BaseFeaturesExtractor):
     """Features = ``[candidates flattened (K·F), state (S)]`` (no parameters)."""
@@ -98,6 +96,15 @@ class GoalsPolicy(MaskableMultiInputActorCriticPolicy):
             *inputs.shape, hidden=self.hidden, shared_trunk=self.shared_trunk
         )
 
+    #: The observation entries the actor reads.
+    actor_keys = GoalsInputs.keys
+
+    def actor_logits(self, obs: dict[str, torch.Tensor]) -> torch.Tensor:
+        """``(B, K)`` logits of the candidates (before masking)."""
+        features = self.extract_features({k: obs[k].float() for k in self.actor_keys})
+        assert isinstance(features, torch.Tensor)
+        return self.heads.forward_actor(features)
+
     @property
     def heads(self) -> CandidateHeads:
         """The actor's and the critic's heads (SB3's ``mlp_extractor``)."""
@@ -158,8 +165,8 @@ def teacher_decisions(
     learner: GoalsPolicy | None = None,
     learner_masked: bool = True,
 ) -> tuple[list[dict[str, np.ndarray]], np.ndarray, np.ndarray]:
-    """Observations, choices and masks of the frontier agent's choice on the menu
-    (:func:`~sfw_gym.agents.frontier.explore_lite_choice`; any valid goal when it has none)
+    """Observations, choices and masks of the env's teacher (``teacher_action()``: the frontier
+    agent's choice on the menu, :func:`~sfw_gym.navigation.candidates.explore_lite_choice`)
     over one episode per seed. The teacher drives, or the ``learner`` (its most likely choice,
     among the valid ones if ``learner_masked``) does: DAgger's states, labelled with the
     teacher's choices."""
@@ -170,8 +177,7 @@ def teacher_decisions(
         done = False
         while not done:
             mask = env.unwrapped.action_masks()  # type: ignore[attr-defined]
-            choice = explore_lite_choice(env.unwrapped.menu)  # type: ignore[attr-defined]
-            action = int(np.argmax(mask)) if choice is None else choice
+            action = env.unwrapped.teacher_action()  # type: ignore[attr-defined]
             observations.append(obs)
             actions.append(action)
             masks.append(mask)
@@ -186,7 +192,7 @@ def teacher_decisions(
 
 
 def behaviour_clone(
-    policy: GoalsPolicy,
+    policy: Any,
     observations: list[dict[str, np.ndarray]],
     actions: np.ndarray,
     masks: np.ndarray,
@@ -195,13 +201,13 @@ def behaviour_clone(
     lr: float = 1e-3,
     seed: int = 0,
 ) -> list[float]:
-    """Fit the actor to a teacher's ``actions`` (cross-entropy over the masked candidates);
-    returns the mean loss per epoch."""
+    """Fit the actor of ``policy`` (:class:`GoalsPolicy` or any policy with ``actor_keys``,
+    ``actor_logits`` and ``parameter_groups``) to a teacher's ``actions`` (cross-entropy over
+    the masked candidates); returns the mean loss per epoch."""
     gen = torch.Generator().manual_seed(seed)
-    obs = {k: torch.as_tensor(np.stack([o[k] for o in observations])) for k in GoalsInputs.keys}
+    obs = {k: torch.as_tensor(np.stack([o[k] for o in observations])) for k in policy.actor_keys}
     acts = torch.as_tensor(actions, dtype=torch.long)
     mask = torch.as_tensor(masks, dtype=torch.bool)
-    heads = policy.heads
     optimiser = torch.optim.Adam(policy.parameter_groups()["actor"], lr=lr)
     losses = []
     for _ in range(epochs):
@@ -209,9 +215,7 @@ def behaviour_clone(
         total = 0.0
         for start in range(0, len(acts), batch_size):
             idx = order[start : start + batch_size]
-            features = policy.extract_features({k: v[idx] for k, v in obs.items()})
-            assert isinstance(features, torch.Tensor)
-            logits = heads.forward_actor(features)
+            logits = policy.actor_logits({k: v[idx] for k, v in obs.items()})
             logits = logits.masked_fill(~mask[idx], -1e8)
             loss = nn.functional.cross_entropy(logits, acts[idx])
             optimiser.zero_grad()

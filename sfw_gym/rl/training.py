@@ -89,6 +89,7 @@ def load_hyperparams(env_id: str, path: str | Path = DEFAULT_HYPERPARAMS) -> dic
             "env_wrapper",
             "env_kwargs",
             "behaviour_cloning",
+            "fine_tuning",
             "use_masking",
         }
     )
@@ -264,15 +265,21 @@ def train_ppo(
         raise ConfigError(f"unknown algo {algo!r}; known: {list(ALGOS)}")
     Algo: Any
     EvalCallback: Any
+    params = load_hyperparams(env_id, hyperparams_path)
+    fine_tuning = dict(params.get("fine_tuning") or {})
     if algo == "ppo":
+        if fine_tuning:
+            raise ConfigError("fine_tuning needs algo ppo_mask (a cloned candidate policy)")
         from stable_baselines3 import PPO as Algo
         from stable_baselines3.common.callbacks import EvalCallback
     else:
         from sb3_contrib import MaskablePPO as Algo
         from sb3_contrib.common.maskable.callbacks import MaskableEvalCallback as EvalCallback
+
+        if fine_tuning:  # keep what cloning learned (rl.finetune)
+            from sfw_gym.rl.finetune import AnchoredMaskablePPO as Algo
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    params = load_hyperparams(env_id, hyperparams_path)
     n_envs = int(n_envs or params.get("n_envs", 1))
     policy = params.get("policy", "MultiInputPolicy")
     if "." in policy:  # a policy class of one's own, by dotted path
@@ -327,11 +334,14 @@ def train_ppo(
                     verbose=0,
                     tensorboard_log=str(out / "tb"),
                     **ppo_kwargs,
+                    **fine_tuning,
                 )
                 if params.get("behaviour_cloning"):
                     _clone_teacher(
                         model, env_id, env_kwargs, seed, params["behaviour_cloning"], **masking
                     )
+                if fine_tuning:
+                    model.set_anchor()  # the cloned policy: the KL term's reference
             grad_norms = []  # logged per head where the policy has separate heads
             if hasattr(model.policy, "parameter_groups"):
                 from sfw_gym.rl import goal_policy

@@ -23,6 +23,8 @@ WARNING_WHITELIST = (
     # SfW-ExploreGoals-v0's ``candidates`` is K rows of features, read row by row by a
     # per-candidate scorer (a custom policy), not flattened.
     "Your observation candidates has an unconventional shape",
+    # SfW-ExploreRegions-v0's ``candidate_px``: each candidate's (row, col) on the map image.
+    "Your observation candidate_px has an unconventional shape",
 )
 
 

@@ -1,0 +1,85 @@
+"""Region decisions on the explore env: the hierarchical explorer behind the agents' interface.
+
+:class:`RegionAgent` acts on ``SfW-Explore-v0`` (and every explore id) exactly as
+``SfW-ExploreRegions-v0`` does: every ``decision_steps`` steps it builds the same candidate menu,
+picks a region (:meth:`RegionAgent.choose`) and lets the same
+:class:`~sfw_gym.navigation.regions.RegionSteering` drive towards it. Its own choice is the
+teacher's (explore_lite's utility on the menu): ``region-teacher``, the level a learned region
+policy (:class:`sfw_gym.rl.PPOAgent` with a regions model) starts from.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from sfw_gym.agents.base import Agent, RobotView
+from sfw_gym.envs.goals import action_masks, menu_observation
+from sfw_gym.envs.observation import map_pixels
+from sfw_gym.envs.regions import RegionsConfig
+from sfw_gym.navigation.candidates import CandidateGoals, GoalFinder, explore_lite_choice
+from sfw_gym.navigation.goal_driver import GoalDriver
+from sfw_gym.navigation.regions import RegionSteering
+
+
+class RegionAgent(Agent):
+    """Region decisions every ``decision_steps`` steps, steered as ``SfW-ExploreRegions-v0``.
+
+    Args:
+        regions: :class:`~sfw_gym.envs.regions.RegionsConfig` fields (dict), as the env's.
+        max_steps: Optional step limit of the agent.
+    """
+
+    name = "region-teacher"
+
+    def __init__(self, regions: dict[str, Any] | None = None, max_steps: int | None = None) -> None:
+        super().__init__(max_steps=max_steps)
+        self.regions = dict(regions or {})
+        self.config = RegionsConfig.from_dict(self.regions, "regions")
+
+    def _on_reset(self, view: RobotView) -> None:
+        cfg = self.config
+        self.finder = GoalFinder()
+        self.finder.reset(view)
+        driver = GoalDriver(self.finder, cfg.max_steps_per_goal)
+        driver.reset()
+        self.steering = RegionSteering(self.finder, driver, cfg.anchor_cost_per_m)
+        self.steering.reset()
+        self.n_decisions = 0
+
+    def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
+        command = self.steering.command(view, self.steps)
+        if command is None:  # the decision's steps are spent (or the first step): choose
+            self.finder.set_step(self.steps)
+            k = self.config.max_candidates
+            menu, extra = menu_observation(self.finder, view, k)
+            choice = self.choose(view, obs, menu, extra)
+            valid = choice < len(menu) and bool(menu.valid[choice])
+            anchor = None
+            if valid:
+                self._log_decision(menu, choice)
+                anchor = (int(menu.target_rc[choice, 0]), int(menu.target_rc[choice, 1]))
+            self.steering.start(anchor, self.config.decision_steps)
+            self.n_decisions += 1
+            command = self.steering.command(view, self.steps)
+        assert command is not None
+        return command
+
+    def choose(
+        self, view: RobotView, obs: Any, menu: CandidateGoals, extra: dict[str, np.ndarray]
+    ) -> int:
+        """The region: a candidate index (the teacher: explore_lite's utility on the menu, the
+        first allowed candidate when no frontier cluster is reachable). ``extra``: the menu's
+        observation entries (``candidates``, ``candidate_mask``)."""
+        choice = explore_lite_choice(menu)
+        if choice is None:
+            return int(np.argmax(action_masks(menu, self.config.max_candidates)))
+        return choice
+
+    @staticmethod
+    def candidate_pixels(view: RobotView, menu: CandidateGoals, k: int, map_px: int) -> np.ndarray:
+        """The ``candidate_px`` observation entry (as ``SfW-ExploreRegions-v0``'s)."""
+        px = np.zeros((k, 2), np.float32)
+        px[: len(menu)] = map_pixels(view.grid, map_px, menu.target_rc)
+        return px
