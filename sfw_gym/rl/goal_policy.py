@@ -224,3 +224,23 @@ def behaviour_clone(
             total += float(loss.detach()) * len(idx)
         losses.append(total / len(acts))
     return losses
+
+
+def teacher_agreement(
+    policy: Any,
+    observations: list[dict[str, np.ndarray]],
+    actions: np.ndarray,
+    masks: np.ndarray,
+    batch_size: int = 512,
+) -> float:
+    """The share of decisions on which the actor's most likely allowed candidate is the
+    teacher's (behaviour cloning's accuracy)."""
+    hits = 0
+    with torch.no_grad():
+        for start in range(0, len(actions), batch_size):
+            chunk = observations[start : start + batch_size]
+            obs = {k: torch.as_tensor(np.stack([o[k] for o in chunk])) for k in policy.actor_keys}
+            mask = torch.as_tensor(masks[start : start + batch_size], dtype=torch.bool)
+            logits = policy.actor_logits(obs).masked_fill(~mask, -torch.inf)
+            hits += int((logits.argmax(1).numpy() == actions[start : start + batch_size]).sum())
+    return hits / max(len(actions), 1)

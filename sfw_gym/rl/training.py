@@ -10,6 +10,7 @@ Layout of an output folder::
     OUT/eval/evaluations.npz                held-out evaluation (EvalCallback)
     OUT/model.zip                           the final model (written atomically)
     OUT/config.yml                          hyperparameters, env, seeds, command, wall time
+    OUT/behaviour_cloning.yml               per cloning fit: decisions, loss, agreement with the teacher
     OUT/training_curve.png                  episode return and held-out return vs env steps
 """
 
@@ -337,9 +338,10 @@ def train_ppo(
                     **fine_tuning,
                 )
                 if params.get("behaviour_cloning"):
-                    _clone_teacher(
+                    cloning = _clone_teacher(
                         model, env_id, env_kwargs, seed, params["behaviour_cloning"], **masking
                     )
+                    write_text_atomic(out / "behaviour_cloning.yml", yaml.safe_dump(cloning))
                 if fine_tuning:
                     model.set_anchor()  # the cloned policy: the KL term's reference
             grad_norms = []  # logged per head where the policy has separate heads
@@ -413,12 +415,13 @@ def _clone_teacher(
     seed: int,
     spec: dict[str, Any],
     use_masking: bool = True,
-) -> None:
+) -> list[dict[str, Any]]:
     """Behaviour cloning of the frontier agent's menu choices before PPO (training seeds):
     ``episodes`` driven by the teacher, then ``dagger_rounds`` rounds of ``dagger_episodes``
     driven by the cloned policy and labelled by the teacher (DAgger), refitting on all.
-    Without ``use_masking`` every action counts as allowed (the learner's and the loss's)."""
-    from sfw_gym.rl.goal_policy import behaviour_clone, teacher_decisions
+    Without ``use_masking`` every action counts as allowed (the learner's and the loss's).
+    Returns per fit: decisions, final loss and the actor's agreement with the teacher."""
+    from sfw_gym.rl.goal_policy import behaviour_clone, teacher_agreement, teacher_decisions
 
     unknown = set(spec) - {"episodes", "epochs", "dagger_rounds", "dagger_episodes"}
     if unknown:
@@ -430,14 +433,28 @@ def _clone_teacher(
         obs, acts, masks = teacher_decisions(env_id, env_kwargs, seeds, learner, use_masking)
         return obs, acts, masks if use_masking else np.ones_like(masks)
 
+    fits: list[dict[str, Any]] = []
+
+    def fit() -> None:
+        losses = behaviour_clone(model.policy, observations, actions, masks, epochs=epochs)
+        agreement = teacher_agreement(model.policy, observations, actions, masks)
+        fits.append(
+            {
+                "decisions": len(actions),
+                "final_loss": float(losses[-1]) if losses else None,
+                "teacher_agreement": round(float(agreement), 4),
+            }
+        )
+
     observations, actions, masks = decisions(range(seed, seed + first))
-    behaviour_clone(model.policy, observations, actions, masks, epochs=epochs)
+    fit()
     for i in range(int(spec.get("dagger_rounds", 0))):
         start = seed + first + i * per_round
         more = decisions(range(start, start + per_round), model.policy)
         observations += more[0]
         actions, masks = np.concatenate([actions, more[1]]), np.concatenate([masks, more[2]])
-        behaviour_clone(model.policy, observations, actions, masks, epochs=epochs)
+        fit()
+    return fits
 
 
 def _continue_evaluations(callback: Any, path: Path, up_to_steps: int) -> None:

@@ -61,6 +61,7 @@ def test_dagger_rounds_follow_the_cloning_episodes_and_refit_on_everything(monke
         fits.append(([o["seed"] for o in observations], bool(masks.all())))
 
     monkeypatch.setattr(goal_policy, "behaviour_clone", clone)
+    monkeypatch.setattr(goal_policy, "teacher_agreement", lambda *args: 1.0)
     model = types.SimpleNamespace(policy="the policy")
     spec = {"episodes": 2, "epochs": 1, "dagger_rounds": 2, "dagger_episodes": 3}
     training._clone_teacher(model, "X", {}, 10, spec)

@@ -1,0 +1,127 @@
+"""The learned region explorer against frontier and the tuned heuristics (issue 30).
+
+Runs ``sfw-gym evaluate`` (resuming what is done) with every agent of the comparison on the same
+plans and seeds, then prints each agent's bits per metre and coverage as ratios to default
+frontier's (ratio of the means, 95 % interval by a paired bootstrap over episodes), the decisions
+per episode and the wall time per step relative to frontier's.
+
+    python scripts/regions_study.py --episodes 50 --seed 2000000 --out runs/study_test
+    python scripts/regions_study.py --episodes 11 --floorplans ../shared/floorplans/houseexpo \
+        --out runs/study_hx
+    python scripts/regions_study.py --agents frontier,region-teacher --episodes 20 \
+        --seed 3000000 --out runs/teacher20      # the teacher before any cloning
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+from sfw_gym.evaluation.runner import evaluate
+
+#: The tuned heuristics of DESIGN.md's sweep: name → (table label, entry point, parameters).
+TUNED = {
+    "greedy-tuned": (
+        "greedy (distance_offset_m=0.3)",
+        "sfw_gym.agents.greedy:GreedyInfoGainAgent",
+        {"distance_offset_m": 0.3},
+    ),
+    "frontier-tuned": (
+        "frontier (potential_scale=1)",
+        "sfw_gym.agents.frontier:FrontierAgent",
+        {"potential_scale": 1.0},
+    ),
+}
+DEFAULT_AGENTS = "frontier,ppo-regions,region-teacher,greedy-tuned,frontier-tuned,cross-pass,ppo"
+
+
+def paired_ratio(
+    ref: np.ndarray, other: np.ndarray, resamples: int = 10_000, seed: int = 0
+) -> tuple[float, float, float]:
+    """mean(other) / mean(ref) with a 95 % percentile interval from resampling the pairs."""
+    rng = np.random.default_rng(seed)
+    idx = rng.integers(0, len(ref), (resamples, len(ref)))
+    ratios = other[idx].mean(1) / ref[idx].mean(1)
+    low, high = np.percentile(ratios, [2.5, 97.5])
+    return float(other.mean() / ref.mean()), float(low), float(high)
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument(
+        "--agents", default=DEFAULT_AGENTS, help="comma-separated; the first is the reference"
+    )
+    p.add_argument("--episodes", type=int, default=50)
+    p.add_argument("--seed", type=int, default=2_000_000, help="benchmark-v1's test seeds")
+    p.add_argument("--floorplans", default=None)
+    p.add_argument("--model", default=None, help="ppo-regions model folder (default: shipped)")
+    p.add_argument("--agent-params", default="{}", help="more per-agent parameters (JSON)")
+    p.add_argument("--out", default="runs/regions_study")
+    p.add_argument("--workers", type=int, default=2)
+    args = p.parse_args()
+
+    agents, params, label = [], json.loads(args.agent_params), {}
+    for name in args.agents.split(","):
+        if name in TUNED:
+            label_text, entry, kwargs = TUNED[name]
+            agents.append(entry)
+            params[entry] = kwargs
+            label[entry] = label_text
+        else:
+            agents.append(name)
+            label[name] = name
+    if args.model and "ppo-regions" in agents:
+        params.setdefault("ppo-regions", {})["path"] = args.model
+    result = evaluate(
+        agents,
+        args.episodes,
+        args.seed,
+        out=args.out,
+        floorplans=args.floorplans,
+        agent_params=params,
+        workers=args.workers,
+        progress=False,
+    )
+    records: dict[str, dict[int, dict]] = {}
+    for r in result["records"]:
+        records.setdefault(r["agent"], {})[r["episode"]] = r
+    ref_name = agents[0]
+    episodes = sorted(set.intersection(*(set(v) for v in records.values())))
+
+    def column(agent: str, key: str) -> np.ndarray:
+        return np.array([float(records[agent][i][key]) for i in episodes])
+
+    def per_step_ms(agent: str) -> float:
+        rows = [records[agent][i] for i in episodes]
+        return 1e3 * sum(r["wall_s"] for r in rows) / sum(r["steps"] for r in rows)
+
+    ref_bits, ref_cov = column(ref_name, "info_gain_per_m"), column(ref_name, "coverage")
+    lines = [
+        f"{len(episodes)} paired episodes, ratios to {label[ref_name]} (95 % paired bootstrap)",
+        "",
+        "| agent | bits/m ratio | coverage ratio | bits/m | coverage | decisions / episode "
+        "(steps each) | ms / step (× ref) |",
+        "|---|---|---|---:|---:|---:|---:|",
+    ]
+    ref_ms = per_step_ms(ref_name)
+    for agent in agents:
+        bits, cov = column(agent, "info_gain_per_m"), column(agent, "coverage")
+        rb, rc = paired_ratio(ref_bits, bits), paired_ratio(ref_cov, cov)
+        decisions = np.mean([records[agent][i]["decisions"] for i in episodes])
+        steps = np.mean([records[agent][i]["steps"] for i in episodes])
+        ms = per_step_ms(agent)
+        lines.append(
+            f"| {label[agent]} | {rb[0]:.3f} [{rb[1]:.3f}, {rb[2]:.3f}] | "
+            f"{rc[0]:.3f} [{rc[1]:.3f}, {rc[2]:.3f}] | {bits.mean():.1f} | {cov.mean():.3f} | "
+            f"{decisions:.0f} ({steps / max(decisions, 1):.1f}) | {ms:.2f} ({ms / ref_ms:.2f}×) |"
+        )
+    text = "\n".join(lines)
+    Path(args.out, "ratios.md").write_text(text + "\n", encoding="utf-8")
+    print(text)
+
+
+if __name__ == "__main__":
+    main()
