@@ -10,7 +10,7 @@ Layout of an output folder::
     OUT/eval/evaluations.npz                held-out evaluation (EvalCallback)
     OUT/model.zip                           the final model (written atomically)
     OUT/config.yml                          hyperparameters, env, seeds, command, wall time
-    OUT/behaviour_cloning.yml               per cloning fit: decisions, loss, agreement with the teacher
+    OUT/behaviour_cloning.yml               per cloning fit: decisions, loss, teacher agreement
     OUT/training_curve.png                  episode return and held-out return vs env steps
 """
 
