@@ -131,3 +131,22 @@ def test_the_true_map_is_only_in_privileged_observations():
 def test_bad_settings_name_the_setting(kwargs, match):
     with pytest.raises(ConfigError, match=match):
         make(**kwargs)
+
+
+def _decision_with_anchor(anchor, seed: int = 8):
+    """One decision of the regions env steered towards ``anchor`` (a cell or None)."""
+    env = make()
+    env.reset(seed=seed)
+    u = env.unwrapped
+    cell = u.robot_view().cell
+    u.steering.start(anchor(cell) if anchor else None, u.config.decision_steps)
+    _, _, _, _, info = u._decide(lambda view: u.steering.command(view, u.explore.steps), False)
+    return info["true_pose"], u.steering.anchor_rc
+
+
+def test_a_region_already_explored_is_released_at_once():
+    """An anchor on a resolved cell (the robot's own, free) steers as no anchor does."""
+    released, left = _decision_with_anchor(lambda cell: cell)
+    unanchored, _ = _decision_with_anchor(None)
+    np.testing.assert_array_equal(released, unanchored)
+    assert left is None
