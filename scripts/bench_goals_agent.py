@@ -1,11 +1,12 @@
-"""What a decision of the learned candidate-goal explorer costs on CPU, beside frontier's steps.
+"""What a decision of a learned menu explorer costs on CPU, beside frontier's steps.
 
-    python scripts/bench_goals_agent.py [--model PATH] [--seeds 3]
+    python scripts/bench_goals_agent.py [--agent ppo|ppo-regions] [--model PATH] [--seeds 3]
 
-Runs ``PPOAgent`` (the shipped model by default) on ``SfW-Explore-v0`` held-out seeds and times
-each decision's two parts, the candidate menu (``menu_observation``) and the policy's choice
-(``PPOAgent._choose``), then the whole episode per step beside ``FrontierAgent``'s on the same
-seeds (one process, side by side).
+Runs the learned agent (``ppo``: ``PPOAgent``, candidate goals; ``ppo-regions``:
+``RegionsPPOAgent``, a region every 20 steps; the shipped model by default) on ``SfW-Explore-v0``
+held-out seeds and times each decision's two parts, the candidate menu (``menu_observation``) and
+the policy's choice, then the whole episode per step beside ``FrontierAgent``'s on the same seeds
+(one process, side by side).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import numpy as np
 
 import sfw_gym  # noqa: F401  (registration)
 from sfw_gym.agents import make_agent
-from sfw_gym.core.data import DEFAULT_MODEL_DIR
+from sfw_gym.agents import regions as region_agent
 from sfw_gym.envs import goals
 from sfw_gym.rl import agent as goal_agent
 
@@ -46,13 +47,16 @@ def episode_seconds(agent, seed: int) -> tuple[float, int]:
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--model", default=str(DEFAULT_MODEL_DIR))
+    p.add_argument("--agent", choices=("ppo", "ppo-regions"), default="ppo")
+    p.add_argument("--model", default=None, help="a trained folder (default: the shipped one)")
     p.add_argument("--seeds", type=int, default=3)
     args = p.parse_args()
     parts: dict[str, list[float]] = {"menu": [], "policy": []}
-    goal_agent.menu_observation = timed(parts, "menu", goals.menu_observation)  # type: ignore[assignment]
-    learned = make_agent("ppo", path=args.model)
-    learned._choose = timed(parts, "policy", learned._choose)  # type: ignore[method-assign]
+    menu = timed(parts, "menu", goals.menu_observation)
+    goal_agent.menu_observation = region_agent.menu_observation = menu  # type: ignore[assignment]
+    learned = make_agent(args.agent, **({"path": args.model} if args.model else {}))
+    choose = "_choose" if args.agent == "ppo" else "choose"
+    setattr(learned, choose, timed(parts, "policy", getattr(learned, choose)))
     frontier = make_agent("frontier")
     episode_seconds(learned, 0)  # warm-up: compiled kernels, torch
     episode_seconds(frontier, 0)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 import pytest
+import yaml
 
 import sfw_gym  # noqa: F401  (registration)
 from tests.envs.test_regions import SMALL
@@ -70,6 +71,8 @@ def test_cloning_then_anchored_fine_tuning_keeps_the_teacher_and_resumes(tmp_pat
     train_ppo("SfW-ExploreRegions-v0", 32, out, checkpoint_every=16, **kwargs)
     model = AnchoredMaskablePPO.load(latest_checkpoint(out, "ppo_mask")[0])
     assert model.anchor is not None and model.n_train_calls == 2
+    (fit,) = yaml.safe_load((out / "behaviour_cloning.yml").read_text())
+    assert fit["decisions"] == 3 * 15 and fit["teacher_agreement"] > 0.5
 
     env = gym.make("SfW-ExploreRegions-v0", privileged=True, **SMALL)
     obs, _ = env.reset(seed=10_000)
