@@ -9,14 +9,11 @@ import numpy as np
 from sfw_gym.agents.base import RobotView
 from sfw_gym.agents.frontier import FrontierAgent, Goal
 from sfw_gym.core.config import check
-from sfw_gym.navigation.candidates import CandidateGoals, CandidateSettings
+from sfw_gym.navigation.candidates import (
+    CandidateSettings,
+    bits_per_metre,
+)
 from sfw_gym.navigation.planning import CostField
-
-
-def bits_per_metre(menu: CandidateGoals, distance_offset_m: float = 1.0) -> np.ndarray:
-    """The greedy agent's score of each candidate: expected gain (bits) ÷ (path cost +
-    ``distance_offset_m``)."""
-    return menu.feature("expected_gain_bits") / (menu.feature("path_cost_m") + distance_offset_m)
 
 
 class GreedyInfoGainAgent(FrontierAgent):

@@ -15,10 +15,11 @@ from typing import Any
 import numpy as np
 
 from sfw_gym.agents.base import Agent, RobotView
+from sfw_gym.core.config import check
 from sfw_gym.envs.goals import action_masks, menu_observation
 from sfw_gym.envs.observation import map_pixels
 from sfw_gym.envs.regions import RegionsConfig
-from sfw_gym.navigation.candidates import CandidateGoals, GoalFinder, explore_lite_choice
+from sfw_gym.navigation.candidates import TEACHERS, CandidateGoals, GoalFinder
 from sfw_gym.navigation.goal_driver import GoalDriver
 from sfw_gym.navigation.regions import RegionSteering
 
@@ -28,15 +29,24 @@ class RegionAgent(Agent):
 
     Args:
         regions: :class:`~sfw_gym.envs.regions.RegionsConfig` fields (dict), as the env's.
+        teacher: Whose choice on the menu (:data:`~sfw_gym.navigation.candidates.TEACHERS`):
+            ``explore_lite`` (the frontier agent's utility) or ``greedy`` (expected bits per
+            metre, the tuned greedy agent's offset).
         max_steps: Optional step limit of the agent.
     """
 
     name = "region-teacher"
 
-    def __init__(self, regions: dict[str, Any] | None = None, max_steps: int | None = None) -> None:
+    def __init__(
+        self,
+        regions: dict[str, Any] | None = None,
+        teacher: str = "explore_lite",
+        max_steps: int | None = None,
+    ) -> None:
         super().__init__(max_steps=max_steps)
         self.regions = dict(regions or {})
         self.config = RegionsConfig.from_dict(self.regions, "regions")
+        self.teacher = check("teacher", teacher, choices=sorted(TEACHERS))
 
     def _on_reset(self, view: RobotView) -> None:
         cfg = self.config
@@ -69,10 +79,10 @@ class RegionAgent(Agent):
     def choose(
         self, view: RobotView, obs: Any, menu: CandidateGoals, extra: dict[str, np.ndarray]
     ) -> int:
-        """The region: a candidate index (the teacher: explore_lite's utility on the menu, the
-        first allowed candidate when no frontier cluster is reachable). ``extra``: the menu's
-        observation entries (``candidates``, ``candidate_mask``)."""
-        choice = explore_lite_choice(menu)
+        """The region: a candidate index (the ``teacher``'s choice on the menu, the first
+        allowed candidate when it has none). ``extra``: the menu's observation entries
+        (``candidates``, ``candidate_mask``)."""
+        choice = TEACHERS[self.teacher](menu)
         if choice is None:
             return int(np.argmax(action_masks(menu, self.config.max_candidates)))
         return choice

@@ -24,9 +24,9 @@ from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.explore import SfWExploreEnv
 from sfw_gym.navigation.candidates import (
     FEATURES,
+    TEACHERS,
     CandidateGoals,
     GoalFinder,
-    explore_lite_choice,
 )
 from sfw_gym.navigation.goal_driver import GoalDriver
 from sfw_gym.navigation.planning import cost_field, to_discrete
@@ -122,10 +122,13 @@ class SfWGoalsEnv(gym.Env):
         invalid = not self.driver.start(self.explore.robot_view(), self.menu, i)
         return self._decide(self.driver.command, invalid)
 
-    def teacher_action(self) -> int:
-        """The frontier agent's choice on the current menu (explore_lite's utility; the first
-        allowed action when no frontier cluster is reachable): the imitation teacher."""
-        choice = explore_lite_choice(self.menu) if self.menu is not None else None
+    def teacher_action(self, teacher: str = "explore_lite") -> int:
+        """A teacher's choice on the current menu (:data:`~sfw_gym.navigation.candidates.
+        TEACHERS`: ``explore_lite``, the frontier agent's utility, or ``greedy``, expected bits
+        per metre; the first allowed action when it has none): the imitation teacher."""
+        if teacher not in TEACHERS:
+            raise ConfigError(f"unknown teacher {teacher!r}; known: {sorted(TEACHERS)}")
+        choice = TEACHERS[teacher](self.menu) if self.menu is not None else None
         return int(np.argmax(self.action_masks())) if choice is None else choice
 
     def action_masks(self) -> np.ndarray:

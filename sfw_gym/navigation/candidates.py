@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -159,6 +160,26 @@ def explore_lite_choice(
         utility = utility - anchor_cost_per_m * np.hypot(offset_m[:, 0], offset_m[:, 1])
     ok = menu.valid & (menu.source == SOURCES.index("frontier"))
     return int(np.argmax(np.where(ok, utility, -np.inf))) if ok.any() else None
+
+
+def bits_per_metre(menu: CandidateGoals, distance_offset_m: float = 1.0) -> np.ndarray:
+    """The greedy agent's score of each candidate: expected gain (bits) ÷ (path cost +
+    ``distance_offset_m``)."""
+    return menu.feature("expected_gain_bits") / (menu.feature("path_cost_m") + distance_offset_m)
+
+
+def greedy_choice(menu: CandidateGoals, distance_offset_m: float = 0.3) -> int | None:
+    """The index of the valid candidate with the most expected bits per metre
+    (:func:`bits_per_metre`; the tuned greedy agent's offset), None when none is valid."""
+    score = np.where(menu.valid, bits_per_metre(menu, distance_offset_m), -np.inf)
+    return int(np.argmax(score)) if menu.valid.any() else None
+
+
+#: Teachers on a full menu (every feature computed), by name: each returns a candidate or None.
+TEACHERS: dict[str, Callable[[CandidateGoals], int | None]] = {
+    "explore_lite": explore_lite_choice,
+    "greedy": greedy_choice,
+}
 
 
 def candidate_goals(view: RobotView, max_candidates: int = 32, **settings) -> CandidateGoals:

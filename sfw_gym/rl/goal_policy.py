@@ -162,14 +162,15 @@ def teacher_decisions(
     env_id: str,
     env_kwargs: dict[str, Any],
     seeds: Iterable[int],
-    learner: GoalsPolicy | None = None,
+    learner: Any = None,
     learner_masked: bool = True,
+    teacher: str = "explore_lite",
 ) -> tuple[list[dict[str, np.ndarray]], np.ndarray, np.ndarray]:
-    """Observations, choices and masks of the env's teacher (``teacher_action()``: the frontier
-    agent's choice on the menu, :func:`~sfw_gym.navigation.candidates.explore_lite_choice`)
-    over one episode per seed. The teacher drives, or the ``learner`` (its most likely choice,
-    among the valid ones if ``learner_masked``) does: DAgger's states, labelled with the
-    teacher's choices."""
+    """Observations, choices and masks of the env's ``teacher`` (``teacher_action(teacher)``; by
+    default the frontier agent's choice on the menu,
+    :func:`~sfw_gym.navigation.candidates.explore_lite_choice`) over one episode per seed. The
+    teacher drives, or the ``learner`` (its most likely choice, among the valid ones if
+    ``learner_masked``) does: DAgger's states, labelled with the teacher's choices."""
     observations, actions, masks = [], [], []
     for seed in seeds:
         env = gym.make(env_id, **env_kwargs)
@@ -177,7 +178,7 @@ def teacher_decisions(
         done = False
         while not done:
             mask = env.unwrapped.action_masks()  # type: ignore[attr-defined]
-            action = env.unwrapped.teacher_action()  # type: ignore[attr-defined]
+            action = env.unwrapped.teacher_action(teacher)  # type: ignore[attr-defined]
             observations.append(obs)
             actions.append(action)
             masks.append(mask)

@@ -416,21 +416,24 @@ def _clone_teacher(
     spec: dict[str, Any],
     use_masking: bool = True,
 ) -> list[dict[str, Any]]:
-    """Behaviour cloning of the frontier agent's menu choices before PPO (training seeds):
-    ``episodes`` driven by the teacher, then ``dagger_rounds`` rounds of ``dagger_episodes``
-    driven by the cloned policy and labelled by the teacher (DAgger), refitting on all.
+    """Behaviour cloning of a teacher's menu choices before PPO (training seeds; ``teacher``:
+    explore_lite, the frontier agent's choice, by default): ``episodes`` driven by the teacher,
+    then ``dagger_rounds`` rounds of ``dagger_episodes`` driven by the cloned policy and
+    labelled by the teacher (DAgger), refitting on all.
     Without ``use_masking`` every action counts as allowed (the learner's and the loss's).
     Returns per fit: decisions, final loss and the actor's agreement with the teacher."""
     from sfw_gym.rl.goal_policy import behaviour_clone, teacher_agreement, teacher_decisions
 
-    unknown = set(spec) - {"episodes", "epochs", "dagger_rounds", "dagger_episodes"}
+    unknown = set(spec) - {"episodes", "epochs", "dagger_rounds", "dagger_episodes", "teacher"}
     if unknown:
         raise ConfigError(f"behaviour_cloning: unknown keys {sorted(unknown)}")
     epochs, first = int(spec.get("epochs", 30)), int(spec.get("episodes", 8))
     per_round = int(spec.get("dagger_episodes", 4))
 
     def decisions(seeds: range, learner: Any = None) -> tuple[list, np.ndarray, np.ndarray]:
-        obs, acts, masks = teacher_decisions(env_id, env_kwargs, seeds, learner, use_masking)
+        obs, acts, masks = teacher_decisions(
+            env_id, env_kwargs, seeds, learner, use_masking, spec.get("teacher", "explore_lite")
+        )
         return obs, acts, masks if use_masking else np.ones_like(masks)
 
     fits: list[dict[str, Any]] = []

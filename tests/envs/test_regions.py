@@ -20,12 +20,12 @@ def make(env_id: str = "SfW-ExploreRegions-v0", **kwargs):
     return gym.make(env_id, **{**SMALL, **kwargs})
 
 
-def teacher_episode(seed: int, **kwargs) -> tuple[list, list[dict]]:
+def teacher_episode(seed: int, teacher: str = "explore_lite", **kwargs) -> tuple[list, list[dict]]:
     env = make(**kwargs)
     env.reset(seed=seed)
     poses, infos, done = [], [], False
     while not done:
-        _, _, terminated, truncated, info = env.step(env.unwrapped.teacher_action())
+        _, _, terminated, truncated, info = env.step(env.unwrapped.teacher_action(teacher))
         poses.append(info["true_pose"])
         infos.append(info)
         done = terminated or truncated
@@ -40,11 +40,12 @@ def test_every_decision_lasts_decision_steps_until_the_episode_ends():
     assert len(infos) <= -(-300 // 20)  # ≤ 150 on the default 3,000-step episodes
 
 
-def test_the_region_agent_acts_on_the_explore_env_exactly_as_the_env_does():
-    poses, infos = teacher_episode(1)
+@pytest.mark.parametrize("teacher", ["explore_lite", "greedy"])
+def test_the_region_agent_acts_on_the_explore_env_exactly_as_the_env_does(teacher):
+    poses, infos = teacher_episode(1, teacher)
     env = make("SfW-Explore-v0")
     obs, _ = env.reset(seed=1)
-    agent = RegionAgent()
+    agent = RegionAgent(teacher=teacher)
     agent.reset(env, seed=1)
     boundaries = np.cumsum([i["decision_steps"] for i in infos])
     for step in range(1, boundaries[-1] + 1):
@@ -150,3 +151,19 @@ def test_a_region_already_explored_is_released_at_once():
     unanchored, _ = _decision_with_anchor(None)
     np.testing.assert_array_equal(released, unanchored)
     assert left is None
+
+
+def test_the_teachers_choose_by_their_own_scores():
+    env = make()
+    env.reset(seed=9)
+    u = env.unwrapped
+    menu, mask = u.menu, u.menu.valid
+    cost = menu.feature("path_cost_m") + 0.3 * menu.feature("heading_change_rad")
+    utility = np.where(
+        mask & (menu.source == 0), menu.feature("cluster_size_m") - 3 * cost, -np.inf
+    )
+    assert u.teacher_action() == int(np.argmax(utility))
+    bits = menu.feature("expected_gain_bits") / (menu.feature("path_cost_m") + 0.3)
+    assert u.teacher_action("greedy") == int(np.argmax(np.where(mask, bits, -np.inf)))
+    with pytest.raises(ConfigError, match="unknown teacher 'oracle'; known: \\['explore_lite'"):
+        u.teacher_action("oracle")

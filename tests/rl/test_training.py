@@ -48,8 +48,9 @@ def test_dagger_rounds_follow_the_cloning_episodes_and_refit_on_everything(monke
 
     calls, fits = [], []
 
-    def decisions(env_id, env_kwargs, seeds, learner=None, learner_masked=True):
+    def decisions(env_id, env_kwargs, seeds, learner=None, learner_masked=True, teacher="?"):
         seeds = list(seeds)
+        assert teacher == "explore_lite"  # the default teacher
         calls.append((seeds, learner, learner_masked))
         obs = [{"seed": s} for s in seeds]
         return obs, np.array(seeds), np.array([[True, False]] * len(seeds))
