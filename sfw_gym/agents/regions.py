@@ -4,8 +4,8 @@
 ``SfW-ExploreRegions-v0`` does: every ``decision_steps`` steps it builds the same candidate menu,
 picks a region (:meth:`RegionAgent.choose`) and lets the same
 :class:`~sfw_gym.navigation.regions.RegionSteering` drive towards it. Its own choice is the
-teacher's (explore_lite's utility on the menu): ``region-teacher``, the level a learned region
-policy (:class:`sfw_gym.rl.PPOAgent` with a regions model) starts from.
+teacher's (by default the expected bits per metre on the menu): ``region-teacher``, the level a
+learned region policy (:class:`sfw_gym.rl.agent.RegionsPPOAgent`) starts from.
 """
 
 from __future__ import annotations
@@ -30,8 +30,9 @@ class RegionAgent(Agent):
     Args:
         regions: :class:`~sfw_gym.envs.regions.RegionsConfig` fields (dict), as the env's.
         teacher: Whose choice on the menu (:data:`~sfw_gym.navigation.candidates.TEACHERS`):
-            ``explore_lite`` (the frontier agent's utility) or ``greedy`` (expected bits per
-            metre, the tuned greedy agent's offset).
+            ``greedy`` (expected bits per metre, the tuned greedy agent's offset: the region
+            teacher, level with frontier) or ``explore_lite`` (the frontier agent's utility,
+            which lost coverage on region actions).
         max_steps: Optional step limit of the agent.
     """
 
@@ -40,7 +41,7 @@ class RegionAgent(Agent):
     def __init__(
         self,
         regions: dict[str, Any] | None = None,
-        teacher: str = "explore_lite",
+        teacher: str = "greedy",
         max_steps: int | None = None,
     ) -> None:
         super().__init__(max_steps=max_steps)
