@@ -421,12 +421,20 @@ def _clone_teacher(
     then ``dagger_rounds`` rounds of ``dagger_episodes`` driven by the cloned policy and
     labelled by the teacher (DAgger), refitting on all.
     Without ``use_masking`` every action counts as allowed (the learner's and the loss's).
-    Returns per fit: decisions, final loss and the actor's agreement with the teacher."""
+    Returns per fit: decisions, final loss and the actor's agreement with the teacher.
+
+    ``from_model``: instead, copy the actor of an earlier run's clone (the anchor of a
+    fine-tuned model in ``from_model``, a folder or ``.zip``), so that fine-tuning variants
+    start from the same clone."""
     from sfw_gym.rl.goal_policy import behaviour_clone, teacher_agreement, teacher_decisions
 
-    unknown = set(spec) - {"episodes", "epochs", "dagger_rounds", "dagger_episodes", "teacher"}
+    keys = {"episodes", "epochs", "dagger_rounds", "dagger_episodes", "teacher", "from_model"}
+    unknown = set(spec) - keys
     if unknown:
         raise ConfigError(f"behaviour_cloning: unknown keys {sorted(unknown)}")
+    if "from_model" in spec:
+        _copy_clone(model, Path(spec["from_model"]))
+        return [{"from_model": str(spec["from_model"])}]
     epochs, first = int(spec.get("epochs", 30)), int(spec.get("episodes", 8))
     per_round = int(spec.get("dagger_episodes", 4))
 
@@ -458,6 +466,23 @@ def _clone_teacher(
         actions, masks = np.concatenate([actions, more[1]]), np.concatenate([masks, more[2]])
         fit()
     return fits
+
+
+def _copy_clone(model: Any, path: Path) -> None:
+    """Copy the actor of the cloned policy saved at ``path`` (a fine-tuned model's anchor; else
+    its policy) into ``model``'s actor."""
+    import torch
+
+    from sfw_gym.rl.finetune import AnchoredMaskablePPO
+
+    source = AnchoredMaskablePPO.load(path / "model.zip" if path.is_dir() else path)
+    clone = source.anchor if source.anchor is not None else source.policy
+    mine, theirs = model.policy.parameter_groups()["actor"], clone.parameter_groups()["actor"]
+    if [p.shape for p in mine] != [p.shape for p in theirs]:
+        raise ConfigError(f"behaviour_cloning.from_model: {path}'s actor differs from this one")
+    with torch.no_grad():
+        for dst, src in zip(mine, theirs, strict=True):
+            dst.copy_(src)
 
 
 def _continue_evaluations(callback: Any, path: Path, up_to_steps: int) -> None:

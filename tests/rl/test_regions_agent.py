@@ -13,10 +13,11 @@ from tests.envs.test_regions import SMALL
 
 sb3_contrib = pytest.importorskip("sb3_contrib")
 torch = pytest.importorskip("torch")
+from sfw_gym.core.errors import ConfigError  # noqa: E402
 from sfw_gym.rl.agent import RegionsPPOAgent  # noqa: E402
 from sfw_gym.rl.finetune import AnchoredMaskablePPO  # noqa: E402
 from sfw_gym.rl.region_policy import RegionsPolicy  # noqa: E402
-from sfw_gym.rl.training import latest_checkpoint, train_ppo  # noqa: E402
+from sfw_gym.rl.training import _copy_clone, latest_checkpoint, train_ppo  # noqa: E402
 
 YAML = """
 SfW-ExploreRegions-v0:
@@ -87,6 +88,21 @@ def test_cloning_then_anchored_fine_tuning_keeps_the_teacher_and_resumes(tmp_pat
         obs, _, terminated, truncated, _ = env.step(teacher)
         done = terminated or truncated
     assert np.mean(agree) > 0.5  # uniform choice among ~10 valid candidates: ~0.1
+
+    # a fine-tuning variant starts from the same clone (behaviour_cloning.from_model)
+    fresh = sb3_contrib.MaskablePPO(RegionsPolicy, env, n_steps=16, batch_size=16, seed=1)
+    _copy_clone(fresh, out)
+    for a, b in zip(
+        fresh.policy.parameter_groups()["actor"],
+        model.anchor.parameter_groups()["actor"],
+        strict=True,
+    ):
+        torch.testing.assert_close(a, b)
+    other = sb3_contrib.MaskablePPO(
+        RegionsPolicy, env, n_steps=16, policy_kwargs={"map_context": False}
+    )
+    with pytest.raises(ConfigError, match=r"from_model: .*'s actor differs from this one"):
+        _copy_clone(other, out)
 
     summary = train_ppo("SfW-ExploreRegions-v0", 48, out, resume=True, **kwargs)
     assert summary["steps"] == 48
