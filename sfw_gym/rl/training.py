@@ -476,7 +476,7 @@ def _copy_clone(model: Any, path: Path) -> None:
     from sfw_gym.rl.finetune import AnchoredMaskablePPO
 
     source = AnchoredMaskablePPO.load(path / "model.zip" if path.is_dir() else path)
-    clone = source.anchor if source.anchor is not None else source.policy
+    clone: Any = source.anchor if source.anchor is not None else source.policy
     mine, theirs = model.policy.parameter_groups()["actor"], clone.parameter_groups()["actor"]
     if [p.shape for p in mine] != [p.shape for p in theirs]:
         raise ConfigError(f"behaviour_cloning.from_model: {path}'s actor differs from this one")
