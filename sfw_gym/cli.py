@@ -547,7 +547,7 @@ def build_parser() -> argparse.ArgumentParser:
     train.add_argument(
         "algo",
         choices=["ppo", "ppo_mask"],
-        help="ppo, or ppo_mask (MaskablePPO, for SfW-ExploreGoals-v0)",
+        help="ppo, or ppo_mask (MaskablePPO, for SfW-ExploreGoals-v0 and SfW-ExploreRegions-v0)",
     )
     train.add_argument("--env", default="SfW-Explore-v0", help="env id (default SfW-Explore-v0)")
     train.add_argument("--timesteps", type=positive_int, default=1_000_000, help="total env steps")
