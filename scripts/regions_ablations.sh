@@ -7,8 +7,10 @@
 #   noprivileged: env_kwargs privileged false (the critic sees no true plan)
 #   nomap: policy_kwargs map_context=False (the actor scores candidates by their features
 #          alone; cloned afresh: its actor differs)
-# Usage: scripts/regions_ablations.sh [OUT=runs/regions_ablations] [STEPS=9000] [FULL=runs/regions]
-#        [NAMES...]
+# Usage: [BASE=recipe.yml] scripts/regions_ablations.sh [OUT=runs/regions_ablations] [STEPS=9000]
+#        [FULL=runs/regions] [NAMES...]   (BASE: the recipe to ablate, default the shipped
+#        ppo_mask.yml; the figures in BENCHMARKS.md ablate the greedy-teacher variant written
+#        there, from its run's clone)
 set -euo pipefail
 out=${1:-runs/regions_ablations}
 steps=${2:-9000}
@@ -17,12 +19,12 @@ shift 3 || true
 names=${*:-nofinetune noprivileged nomap}
 mkdir -p "$out"
 for name in $names; do
-  python - "$name" "$out/$name.yml" "$full" <<'PY'
+  python - "$name" "$out/$name.yml" "$full" "${BASE:-}" <<'PY'
 import sys, yaml
 from sfw_gym.core.data import data_path
-name, path, full = sys.argv[1:4]
+name, path, full, base = sys.argv[1:5]
 env_id = "SfW-ExploreRegions-v0"
-block = yaml.safe_load(open(data_path("agents", "hyperparams", "ppo_mask.yml")))[env_id]
+block = yaml.safe_load(open(base or data_path("agents", "hyperparams", "ppo_mask.yml")))[env_id]
 if name == "nomap":
     block["policy_kwargs"] = "dict(map_context=False)"
 else:
