@@ -1,9 +1,9 @@
 """What a decision of a learned menu explorer costs on CPU, beside frontier's steps.
 
-    python scripts/bench_goals_agent.py [--agent ppo|ppo-regions] [--model PATH] [--seeds 3]
+    python scripts/bench_goals_agent.py [--agent ppo|ppo-goals] [--model PATH] [--seeds 3]
 
-Runs the learned agent (``ppo``: ``PPOAgent``, candidate goals; ``ppo-regions``:
-``RegionsPPOAgent``, a region every 20 steps; the shipped model by default) on ``SfW-Explore-v0``
+Runs the learned agent (``ppo``: ``RegionsPPOAgent``, a region every 20 steps; ``ppo-goals``:
+``PPOAgent``, candidate goals; the shipped model by default) on ``SfW-Explore-v0``
 held-out seeds and times each decision's two parts, the candidate menu (``menu_observation``) and
 the policy's choice, then the whole episode per step beside ``FrontierAgent``'s on the same seeds
 (one process, side by side).
@@ -47,7 +47,7 @@ def episode_seconds(agent, seed: int) -> tuple[float, int]:
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--agent", choices=("ppo", "ppo-regions"), default="ppo")
+    p.add_argument("--agent", choices=("ppo", "ppo-goals"), default="ppo")
     p.add_argument("--model", default=None, help="a trained folder (default: the shipped one)")
     p.add_argument("--seeds", type=int, default=3)
     args = p.parse_args()
@@ -55,7 +55,7 @@ def main() -> None:
     menu = timed(parts, "menu", goals.menu_observation)
     goal_agent.menu_observation = region_agent.menu_observation = menu  # type: ignore[assignment]
     learned = make_agent(args.agent, **({"path": args.model} if args.model else {}))
-    choose = "_choose" if args.agent == "ppo" else "choose"
+    choose = "_choose" if args.agent == "ppo-goals" else "choose"
     setattr(learned, choose, timed(parts, "policy", getattr(learned, choose)))
     frontier = make_agent("frontier")
     episode_seconds(learned, 0)  # warm-up: compiled kernels, torch

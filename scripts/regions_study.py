@@ -35,7 +35,7 @@ TUNED = {
         {"potential_scale": 1.0},
     ),
 }
-DEFAULT_AGENTS = "frontier,ppo-regions,region-teacher,greedy-tuned,frontier-tuned,cross-pass,ppo"
+DEFAULT_AGENTS = "frontier,ppo,region-teacher,greedy-tuned,frontier-tuned,cross-pass,ppo-goals"
 
 
 def paired_ratio(
@@ -57,7 +57,7 @@ def main() -> None:
     p.add_argument("--episodes", type=int, default=50)
     p.add_argument("--seed", type=int, default=2_000_000, help="benchmark-v1's test seeds")
     p.add_argument("--floorplans", default=None)
-    p.add_argument("--model", default=None, help="ppo-regions model folder (default: shipped)")
+    p.add_argument("--model", default=None, help="the ppo agent's model (default: shipped)")
     p.add_argument("--agent-params", default="{}", help="more per-agent parameters (JSON)")
     p.add_argument("--out", default="runs/regions_study")
     p.add_argument("--workers", type=int, default=2)
@@ -73,8 +73,8 @@ def main() -> None:
         else:
             agents.append(name)
             label[name] = name
-    if args.model and "ppo-regions" in agents:
-        params.setdefault("ppo-regions", {})["path"] = args.model
+    if args.model and "ppo" in agents:
+        params.setdefault("ppo", {})["path"] = args.model
     result = evaluate(
         agents,
         args.episodes,

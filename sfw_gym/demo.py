@@ -53,7 +53,7 @@ def run_demo(
     )
     index = out / "index.md"
     wall_s = time.perf_counter() - start
-    policy = str(model) if model is not None else "agents/ppo_mask/SfW-ExploreGoals-v0_1"
+    policy = str(model) if model is not None else "agents/ppo_mask/SfW-ExploreRegions-v0_1"
     write_text_atomic(index, _index_markdown(out, result, seed, wall_s, policy))
     return index
 

@@ -27,9 +27,9 @@ AGENTS: dict[str, str] = {
     "greedy": "sfw_gym.agents.greedy:GreedyInfoGainAgent",
     "random": "sfw_gym.agents.random_agent:RandomAgent",
     "region-teacher": "sfw_gym.agents.regions:RegionAgent",
-    "ppo": "sfw_gym.rl.agent:PPOAgent",
+    "ppo": "sfw_gym.rl.agent:RegionsPPOAgent",
+    "ppo-goals": "sfw_gym.rl.agent:PPOAgent",
     "ppo-waypoint": "sfw_gym.rl.waypoint_agent:WaypointPPOAgent",
-    "ppo-regions": "sfw_gym.rl.agent:RegionsPPOAgent",
 }
 
 

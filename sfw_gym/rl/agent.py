@@ -1,11 +1,12 @@
-"""The candidate-goal explorer (``sfw-gym train ppo_mask`` on ``SfW-ExploreGoals-v0``) behind the
-agents' interface, on the explore env itself.
+"""The learned menu explorers behind the agents' interface, on the explore env itself.
 
-Each decision builds the same menu as the goals env (:func:`~sfw_gym.envs.goals.menu_observation`),
-lets the policy pick a candidate, and drives there step by step with the same
-:class:`~sfw_gym.navigation.goal_driver.GoalDriver`, so it acts exactly as in training and runs
-through ``sfw-gym evaluate`` beside the classical agents (``--agents frontier,ppo``; a model of
-one's own with ``--agent-params '{"ppo": {"path": "runs/goals"}}'``).
+``ppo`` (:class:`RegionsPPOAgent`, the shipped learned explorer): a model trained on
+``SfW-ExploreRegions-v0`` picks a region every 20 steps and the classical steering drives, as
+:class:`~sfw_gym.agents.regions.RegionAgent` does. ``ppo-goals`` (:class:`PPOAgent`): a model
+trained on ``SfW-ExploreGoals-v0`` picks a candidate goal at a time, driven by the same
+:class:`~sfw_gym.navigation.goal_driver.GoalDriver` as in that env. Both act exactly as in
+training and run through ``sfw-gym evaluate`` beside the classical agents (``--agents
+frontier,ppo``; a model of one's own with ``--agent-params '{"ppo": {"path": "runs/regions"}}'``).
 """
 
 from __future__ import annotations
@@ -26,7 +27,8 @@ from sfw_gym.navigation.goal_driver import GoalDriver
 
 
 class PPOAgent(Agent):
-    """Acts with a MaskablePPO model over candidate goals.
+    """Acts with a MaskablePPO model over candidate goals (``ppo-goals``: the learned explorer
+    before the region one, which is now ``ppo``).
 
     Args:
         path: A ``sfw-gym train ppo_mask`` output folder (``model.zip``, ``config.yml``) or a
@@ -40,7 +42,7 @@ class PPOAgent(Agent):
         max_steps: Optional step limit of the agent.
     """
 
-    name = "ppo"
+    name = "ppo-goals"
 
     def __init__(
         self,
@@ -154,7 +156,7 @@ class RegionsPPOAgent(RegionAgent):
         max_steps: Optional step limit of the agent.
     """
 
-    name = "ppo-regions"
+    name = "ppo"
 
     def __init__(
         self,

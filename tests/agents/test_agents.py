@@ -257,7 +257,8 @@ def _reachable(obj: Any, stop: tuple[type, ...]) -> list[Any]:
 
 def env_for(name: str, **kwargs: Any) -> gym.Env:
     """SMALL, except for the shipped learned agents, which need the default 64 x 64 observations."""
-    return gym.make("SfW-Explore-v0" if name in ("ppo", "ppo-waypoint") else SMALL, **kwargs)
+    learned = ("ppo", "ppo-goals", "ppo-waypoint")
+    return gym.make("SfW-Explore-v0" if name in learned else SMALL, **kwargs)
 
 
 @pytest.mark.parametrize("name", sorted(AGENTS))

@@ -98,10 +98,12 @@ def run_episode(
         if terminated or truncated:
             break
     goals = getattr(agent, "goals", None)  # the waypoint agent's; the others log decisions
+    # the learned menu agents count their policy's choices (a region agent logs valid ones only)
+    decisions = getattr(agent, "n_decisions", len(goals) if goals is not None else None)
     return {
         "actions": actions,
         "poses": poses,
-        "decisions": len(goals) if goals is not None else len(agent.decisions),
+        "decisions": len(agent.decisions) if decisions is None else decisions,
         "global_rng_untouched": global_states() == before,
     }
 
