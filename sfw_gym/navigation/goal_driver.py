@@ -118,5 +118,10 @@ class GoalDriver:
         return self.command(view)
 
     def _resolved(self, view: RobotView) -> bool:
-        value = int(view.belief_u8[self.target])
-        return value <= U8_WALL_MAX or value >= U8_FREE_MIN
+        return resolved(view, self.target)
+
+
+def resolved(view: RobotView, cell: tuple[int, int]) -> bool:
+    """Whether the belief at ``cell`` is no longer unknown (a wall or free)."""
+    value = int(view.belief_u8[cell])
+    return value <= U8_WALL_MAX or value >= U8_FREE_MIN

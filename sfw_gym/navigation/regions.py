@@ -15,9 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from sfw_gym.core.constants import U8_FREE_MIN, U8_WALL_MAX
 from sfw_gym.navigation.candidates import POTENTIAL_SCALE, GoalFinder, explore_lite_choice
-from sfw_gym.navigation.goal_driver import TURN, GoalDriver
+from sfw_gym.navigation.goal_driver import TURN, GoalDriver, resolved
 from sfw_gym.navigation.planning import cost_field
 from sfw_gym.navigation.view import RobotView
 
@@ -45,6 +44,7 @@ class RegionSteering:
         self.anchor_rc: tuple[int, int] | None = None
         self.remaining = 0
         self.micro_decisions = 0
+        self._driving = False  # a goal of this decision is being driven
 
     def reset(self) -> None:
         """A new episode (after the finder's and the driver's resets)."""
@@ -61,7 +61,7 @@ class RegionSteering:
         decision's steps are spent."""
         if self.remaining <= 0:
             return None
-        if self.anchor_rc is not None and self._resolved(view, self.anchor_rc):
+        if self.anchor_rc is not None and resolved(view, self.anchor_rc):
             self.anchor_rc = None  # the region is explored: the classical rule alone from here
         command = self.driver.command(view) if self._driving else None
         if command is None:
@@ -70,11 +70,6 @@ class RegionSteering:
             command = self.driver.command(view)
         self.remaining -= 1
         return TURN if command is None else command
-
-    @staticmethod
-    def _resolved(view: RobotView, cell: tuple[int, int]) -> bool:
-        value = int(view.belief_u8[cell])
-        return value <= U8_WALL_MAX or value >= U8_FREE_MIN
 
     def _choose(self, view: RobotView) -> None:
         """Start the driver on the micro menu's best goal near the anchor (when no frontier
