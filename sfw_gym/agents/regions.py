@@ -17,8 +17,7 @@ import numpy as np
 from sfw_gym.agents.base import Agent, RobotView
 from sfw_gym.core.config import check
 from sfw_gym.envs.goals import action_masks, menu_observation
-from sfw_gym.envs.observation import map_pixels
-from sfw_gym.envs.regions import RegionsConfig
+from sfw_gym.envs.regions import RegionsConfig, region_anchor
 from sfw_gym.navigation.candidates import TEACHERS, CandidateGoals, GoalFinder
 from sfw_gym.navigation.goal_driver import GoalDriver
 from sfw_gym.navigation.regions import RegionSteering
@@ -66,11 +65,9 @@ class RegionAgent(Agent):
             k = self.config.max_candidates
             menu, extra = menu_observation(self.finder, view, k)
             choice = self.choose(view, obs, menu, extra)
-            valid = choice < len(menu) and bool(menu.valid[choice])
-            anchor = None
-            if valid:
+            anchor = region_anchor(menu, choice)
+            if anchor is not None:
                 self._log_decision(menu, choice)
-                anchor = (int(menu.target_rc[choice, 0]), int(menu.target_rc[choice, 1]))
             self.steering.start(anchor, self.config.decision_steps)
             self.n_decisions += 1
             command = self.steering.command(view, self.steps)
@@ -87,10 +84,3 @@ class RegionAgent(Agent):
         if choice is None:
             return int(np.argmax(action_masks(menu, self.config.max_candidates)))
         return choice
-
-    @staticmethod
-    def candidate_pixels(view: RobotView, menu: CandidateGoals, k: int, map_px: int) -> np.ndarray:
-        """The ``candidate_px`` observation entry (as ``SfW-ExploreRegions-v0``'s)."""
-        px = np.zeros((k, 2), np.float32)
-        px[: len(menu)] = map_pixels(view.grid, map_px, menu.target_rc)
-        return px

@@ -115,10 +115,6 @@ class ObservationBuilder:
         image[self._pad] = U8_UNKNOWN
         return image
 
-    def pixels_of_cells(self, rc: np.ndarray) -> np.ndarray:
-        """:func:`map_pixels` on this episode's grid and image."""
-        return map_pixels(self.grid, self.map_px, rc)
-
     def clear_visited(self) -> None:
         """Empty the trajectory channel (before drawing a corrected trajectory)."""
         self._trajectory.fill(0)

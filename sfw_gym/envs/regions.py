@@ -24,6 +24,9 @@ from gymnasium import spaces
 
 from sfw_gym.core.config import check, setting
 from sfw_gym.envs.goals import GoalsConfig, SfWGoalsEnv
+from sfw_gym.envs.observation import map_pixels
+from sfw_gym.mapping import GridSpec
+from sfw_gym.navigation.candidates import CandidateGoals
 from sfw_gym.navigation.regions import RegionSteering
 
 
@@ -77,15 +80,12 @@ class SfWRegionsEnv(SfWGoalsEnv):
         return super().reset(seed=seed, options=options)
 
     def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
-        i = self._action_index(action)
-        menu = self.menu
-        assert menu is not None
-        valid = i < len(menu) and bool(menu.valid[i])
-        anchor = (int(menu.target_rc[i, 0]), int(menu.target_rc[i, 1])) if valid else None
+        assert self.menu is not None
+        anchor = region_anchor(self.menu, self._action_index(action))
         self.steering.start(anchor, self.config.decision_steps)
         micro_before = self.steering.micro_decisions
         obs, reward, terminated, truncated, info = self._decide(
-            lambda view: self.steering.command(view, self.explore.steps), not valid
+            lambda view: self.steering.command(view, self.explore.steps), anchor is None
         )
         info["micro_decisions"] = self.steering.micro_decisions - micro_before
         return obs, reward, terminated, truncated, info
@@ -93,10 +93,25 @@ class SfWRegionsEnv(SfWGoalsEnv):
     def _observe(self, obs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         out = super()._observe(obs)
         assert self.menu is not None
-        px = np.zeros((self.config.max_candidates, 2), np.float32)
-        px[: len(self.menu)] = self.explore.obs_builder.pixels_of_cells(self.menu.target_rc)
-        out["candidate_px"] = px
+        out["candidate_px"] = candidate_pixels(
+            self.menu, self.explore.grid, self.config.max_candidates, self.explore.map_px
+        )
         if self.privileged:
             truth = self.explore.ground_truth().truth_u8
             out["true_map"] = self.explore.obs_builder.image_of(truth)[None]
         return out
+
+
+def region_anchor(menu: CandidateGoals, i: int) -> tuple[int, int] | None:
+    """The cell a choice of candidate ``i`` steers towards (None: no valid candidate)."""
+    if i >= len(menu) or not menu.valid[i]:
+        return None
+    return int(menu.target_rc[i, 0]), int(menu.target_rc[i, 1])
+
+
+def candidate_pixels(menu: CandidateGoals, grid: GridSpec, k: int, map_px: int) -> np.ndarray:
+    """The ``candidate_px`` observation entry: each of the ``k`` slots' target on the ``map``
+    image (:func:`~sfw_gym.envs.observation.map_pixels`; 0 for empty slots)."""
+    px = np.zeros((k, 2), np.float32)
+    px[: len(menu)] = map_pixels(grid, map_px, menu.target_rc)
+    return px

@@ -22,6 +22,7 @@ from sfw_gym.agents.regions import RegionAgent
 from sfw_gym.core.data import DEFAULT_MODEL_DIR, DEFAULT_REGIONS_MODEL_DIR
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.goals import GoalsConfig, action_masks, menu_observation
+from sfw_gym.envs.regions import candidate_pixels
 from sfw_gym.navigation.candidates import CandidateGoals, GoalFinder
 from sfw_gym.navigation.goal_driver import GoalDriver
 
@@ -181,7 +182,7 @@ class RegionsPPOAgent(RegionAgent):
             raise ConfigError(f"{type(self).__name__}.act(obs) needs the env's (Dict) observation")
         policy = self.model.policy
         k = self.config.max_candidates
-        px = self.candidate_pixels(view, menu, k, obs["map"].shape[-1])
+        px = candidate_pixels(menu, view.grid, k, obs["map"].shape[-1])
         full = {**obs, **extra, "candidate_px": px}
         with torch.no_grad():
             x = {key: torch.as_tensor(full[key])[None] for key in policy.actor_keys}

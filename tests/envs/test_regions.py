@@ -167,3 +167,19 @@ def test_the_teachers_choose_by_their_own_scores():
     assert u.teacher_action("greedy") == int(np.argmax(np.where(mask, bits, -np.inf)))
     with pytest.raises(ConfigError, match="unknown teacher 'oracle'; known: \\['explore_lite'"):
         u.teacher_action("oracle")
+
+
+def test_explore_lite_refuses_a_menu_without_its_features():
+    """A menu computed without cluster sizes would make every utility NaN (and the first
+    candidate the choice every time): an error instead."""
+    from sfw_gym.navigation.candidates import explore_lite_choice
+    from sfw_gym.navigation.planning import cost_field
+
+    env = make()
+    env.reset(seed=0)
+    u = env.unwrapped
+    view = u.robot_view()
+    paths = cost_field(u.finder.costs(view), view.cell, view.grid.resolution_m)
+    partial = u.finder.find(view, paths, features=("path_cost_m", "heading_change_rad"))
+    with pytest.raises(ValueError, match="needs the menu's path_cost_m, heading_change_rad"):
+        explore_lite_choice(partial)
