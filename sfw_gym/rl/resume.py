@@ -119,10 +119,13 @@ def restore_state(model: Any, venv: Any, eval_venv: Any, checkpoint: Path) -> bo
 
 
 def _venv_state(venv: Any) -> dict[str, Any]:
-    """The envs of an SB3 ``VecMonitor(VecEnv)`` and the monitor's running episodes."""
+    """The envs of an SB3 ``VecMonitor(VecEnv)``, the monitor's running episodes, and the seeds
+    and options still waiting for the next reset (an evaluation env is first reset at its first
+    evaluation, which may come after a checkpoint)."""
     return {
         "envs": venv.env_method("snapshot"),
         "monitor": (venv.episode_returns, venv.episode_lengths, venv.episode_count),
+        "next_reset": (list(venv.venv._seeds), list(venv.venv._options)),
     }
 
 
@@ -130,4 +133,6 @@ def _set_venv_state(venv: Any, state: dict[str, Any]) -> None:
     for i, blob in enumerate(state["envs"]):
         venv.env_method("restore", blob, indices=[i])
     venv.episode_returns, venv.episode_lengths, venv.episode_count = state["monitor"]
-    venv.venv._reset_seeds()  # the envs continue: a seed waiting for the next reset would not
+    # a state saved before the pending seeds were kept: the envs continue without them
+    seeds, options = state.get("next_reset", ([None] * venv.num_envs, [{}] * venv.num_envs))
+    venv.venv._seeds, venv.venv._options = list(seeds), list(options)

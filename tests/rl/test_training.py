@@ -304,6 +304,18 @@ def test_a_resumed_run_keeps_its_evaluations_and_survives_a_cut_monitor_line(tmp
         train_ppo("SfW-ExploreSmall-v0", 8, tmp_path / "x", **{**run, "checkpoint_every": 0})
 
 
+def test_a_resume_from_before_the_first_evaluation_evaluates_on_the_same_episodes(tmp_path):
+    """The evaluation env has not been reset yet at the first checkpoint: its seed still waits
+    for that reset, and a resume must keep it (not draw fresh entropy)."""
+    run = {"n_envs": 1, "env_kwargs": TINY, "checkpoint_every": 64, "eval_every": 128}
+    train_ppo("SfW-ExploreSmall-v0", 64, tmp_path / "cut", progress_bar=False, **run)
+    train_ppo("SfW-ExploreSmall-v0", 256, tmp_path / "cut", resume=True, progress_bar=False, **run)
+    train_ppo("SfW-ExploreSmall-v0", 256, tmp_path / "whole", progress_bar=False, **run)
+    cut, whole = (np.load(tmp_path / d / "eval" / "evaluations.npz") for d in ("cut", "whole"))
+    assert cut["timesteps"].tolist() == whole["timesteps"].tolist() == [128, 256]
+    np.testing.assert_array_equal(cut["results"], whole["results"])
+
+
 @pytest.mark.slow
 def test_a_killed_training_leaves_no_env_worker_behind(tmp_path):
     out = tmp_path / "run"
