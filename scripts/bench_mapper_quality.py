@@ -31,18 +31,12 @@ Usage:
 from __future__ import annotations
 
 import argparse
-import itertools
-import math
 import statistics
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
-import shapely
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import breadth_first_order
-from shapely.geometry import LineString
 
 from sfw_gym.mapping import (
     GridSpec,
@@ -59,12 +53,10 @@ from sfw_gym.world import (
     load_floorplan,
     place_routers,
 )
+from sfw_gym.world.walks import CLEARANCE_M, survey
 
 HOUSEEXPO = Path(__file__).resolve().parents[2] / "shared" / "floorplans" / "houseexpo"
 ROBOT_RADIUS_M = 0.17
-CLEARANCE_M = ROBOT_RADIUS_M + 0.02
-STEP_M = 0.05
-PLAN_RES_M = 0.05  # grid of the transit planner
 METRICS = (
     "paper_iou",
     "free_iou",
@@ -76,136 +68,6 @@ METRICS = (
 )
 ORACLE_METRICS = ("oracle_free_iou", "oracle_wall_recall")
 TARGETS = {"paper_iou": 0.95, "free_iou": 0.85, "wall_precision": 0.8, "interior_wall_recall": 0.7}
-
-
-# -- the survey -----------------------------------------------------------------------------------
-class TransitPlanner:
-    """Collision-free transits inside a region: straight if possible, else a path found by
-    breadth-first search on a grid (8-neighbours) and shortened by string pulling."""
-
-    def __init__(self, region) -> None:
-        self.region = region
-        xmin, ymin, xmax, ymax = region.bounds
-        self.origin = np.array([xmin - PLAN_RES_M, ymin - PLAN_RES_M])
-        nx = math.ceil((xmax - xmin) / PLAN_RES_M) + 3
-        ny = math.ceil((ymax - ymin) / PLAN_RES_M) + 3
-        gx, gy = np.meshgrid(
-            self.origin[0] + (np.arange(nx) + 0.5) * PLAN_RES_M,
-            self.origin[1] + (np.arange(ny) + 0.5) * PLAN_RES_M,
-        )
-        self.centres = np.stack([gx.ravel(), gy.ravel()], axis=1)
-        ok = shapely.contains_xy(region, gx, gy)
-        self.ok = ok
-        node = np.full(ok.size, -1, np.int64)
-        node[ok.ravel()] = np.arange(ok.sum())
-        self.node = node.reshape(ok.shape)
-        self.cell_of = np.flatnonzero(ok.ravel())
-        src, dst, w = [], [], []
-        for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
-            a = ok[: ny - dr, max(0, -dc) : nx - max(0, dc)]
-            b = ok[dr:, max(0, dc) : nx - max(0, -dc)]
-            both = a & b
-            src.append(self.node[: ny - dr, max(0, -dc) : nx - max(0, dc)][both])
-            dst.append(self.node[dr:, max(0, dc) : nx - max(0, -dc)][both])
-            w.append(np.full(int(both.sum()), math.hypot(dr, dc)))
-        s, d, ww = np.concatenate(src), np.concatenate(dst), np.concatenate(w)
-        n = int(ok.sum())
-        self.graph = coo_matrix((np.r_[ww, ww], (np.r_[s, d], np.r_[d, s])), shape=(n, n)).tocsr()
-
-    def _nearest_node(self, p) -> int:
-        i = int((p[1] - self.origin[1]) / PLAN_RES_M)
-        j = int((p[0] - self.origin[0]) / PLAN_RES_M)
-        best, best_d = -1, math.inf
-        for a in range(max(i - 3, 0), min(i + 4, self.ok.shape[0])):
-            for b in range(max(j - 3, 0), min(j + 4, self.ok.shape[1])):
-                if self.ok[a, b]:
-                    d = math.dist(self.centres[a * self.ok.shape[1] + b], p)
-                    if d < best_d:
-                        best, best_d = int(self.node[a, b]), d
-        return best
-
-    def path(self, a, b) -> list:
-        """Waypoints strictly between ``a`` and ``b``."""
-        if self.region.contains(LineString([a, b])):
-            return []
-        s, t = self._nearest_node(a), self._nearest_node(b)
-        _, pred = breadth_first_order(self.graph, s, directed=False)
-        chain = [t]
-        while chain[-1] != s and chain[-1] >= 0:
-            chain.append(int(pred[chain[-1]]))
-        pts = [np.asarray(a)] + [self.centres[self.cell_of[v]] for v in chain[::-1]]
-        pts.append(np.asarray(b))
-        out, i = [], 0  # string pulling: keep only the corners the region forces
-        while i < len(pts) - 1:
-            j = len(pts) - 1
-            while j > i + 1 and not self.region.contains(LineString([pts[i], pts[j]])):
-                j -= 1
-            out.append(tuple(pts[j]))
-            i = j
-        return out[:-1]
-
-
-def resample(waypoints: list, step_m: float) -> np.ndarray:
-    """Points every ``step_m`` along a polyline (its vertices kept)."""
-    out = []
-    for a, b in itertools.pairwise(waypoints):
-        a, b = np.asarray(a, float), np.asarray(b, float)
-        n = max(1, math.ceil(math.dist(a, b) / step_m))
-        out.append(a + (np.arange(n)[:, None] / n) * (b - a))
-    out.append(np.asarray(waypoints[-1], float)[None])
-    return np.concatenate(out)
-
-
-def survey(plan: Floorplan, spacing_m: float, wall_follow: bool = True) -> np.ndarray:
-    """The continuous survey path (N, 2) described in the module docstring."""
-    region = plan.free_space.buffer(-CLEARANCE_M)
-    planner = TransitPlanner(region)
-    route: list = []
-
-    def go(seq: list) -> None:
-        if route:
-            route.extend(planner.path(route[-1], seq[0]))
-        route.extend(seq)
-
-    if wall_follow:
-        for poly in getattr(region, "geoms", [region]):
-            for ring in (poly.exterior, *poly.interiors):
-                loop = list(ring.coords)[:-1]
-                if route:  # enter the loop at its point nearest the robot
-                    i = int(np.argmin(np.linalg.norm(np.asarray(loop) - route[-1], axis=1)))
-                    loop = loop[i:] + loop[:i]
-                go([*loop, loop[0]])
-    xmin, ymin, xmax, ymax = region.bounds
-    segs, rows = [], []
-    for row, y in enumerate(np.arange(ymin + spacing_m / 2, ymax, spacing_m)):
-        cut = region.intersection(LineString([(xmin - 1, y), (xmax + 1, y)]))
-        for g in getattr(cut, "geoms", [cut]):
-            if g.geom_type == "LineString" and g.length > 0:
-                (x0, _), (x1, _) = g.coords[0], g.coords[-1]
-                segs.append(((min(x0, x1), y), (max(x0, x1), y)))
-                rows.append(row)
-    left = set(range(len(segs)))
-    last = None
-    while left:
-        here = route[-1] if route else segs[0][0]
-        gap = {i: min(math.dist(here, segs[i][0]), math.dist(here, segs[i][1])) for i in left}
-        nxt = None
-        if last is not None:  # boustrophedon: an overlapping segment of the next or previous row
-            lo, hi = segs[last][0][0], segs[last][1][0]
-            cands = [
-                i
-                for i in left
-                if abs(rows[i] - rows[last]) == 1
-                and min(hi, segs[i][1][0]) > max(lo, segs[i][0][0])
-            ]
-            nxt = min(cands, key=gap.__getitem__) if cands else None
-        if nxt is None:
-            nxt = min(left, key=gap.__getitem__)
-        left.remove(nxt)
-        a, b = segs[nxt]
-        go([a, b] if math.dist(here, a) <= math.dist(here, b) else [b, a])
-        last = nxt
-    return resample(route, STEP_M)
 
 
 # -- one plan -------------------------------------------------------------------------------------

@@ -90,8 +90,9 @@ def _cmd_world(args: argparse.Namespace) -> int:
 
 
 def _cmd_map(args: argparse.Namespace) -> int:
-    from sfw_gym.mapping import MapperConfig
-    from sfw_gym.mapping.offline import map_log, write_map
+    from dataclasses import replace
+
+    from sfw_gym.mapping.offline import OFFLINE_CONFIG, map_log, write_map
 
     routers = parse_routers(args.routers)
     if isinstance(routers, int):
@@ -106,7 +107,9 @@ def _cmd_map(args: argparse.Namespace) -> int:
         resolution_m=args.resolution,
         margin_m=args.margin,
         rssi_column=args.rssi_column,
-        config=MapperConfig(router_policy=args.policy),
+        config=replace(OFFLINE_CONFIG, router_policy=args.policy or OFFLINE_CONFIG.router_policy),
+        method=args.method,
+        passes=args.passes,
     )
     paths = write_map(result, args.out, y_down=args.y_down)
     log = result.log
@@ -120,6 +123,38 @@ def _cmd_map(args: argparse.Namespace) -> int:
         f"{result.us_per_sample:.1f}), {cols} x {rows} cells of {result.grid.resolution_m:g} m"
     )
     print(f"wrote {paths['png']}, {paths['npy']}, {paths['json']}")
+    if args.score:
+        from sfw_gym.evaluation.logs import read_log_meta, score_map
+
+        meta = read_log_meta(args.log)
+        scores = score_map(result.occupancy_u8, result.grid, meta["truth_u8"], meta["truth_grid"])
+        print("against the recorded truth: " + ", ".join(f"{k} {v:.3f}" for k, v in scores.items()))
+    return 0
+
+
+def _cmd_record(args: argparse.Namespace) -> int:
+    from sfw_gym.evaluation.logs import record_log
+    from sfw_gym.world import generate_floorplan, load_floorplan
+
+    plan = load_floorplan(args.floorplan) if args.floorplan else generate_floorplan(args.seed)
+    routers = parse_routers(args.routers)
+    paths = record_log(
+        plan, args.out, routers=routers, seed=args.seed, trajectory=args.trajectory,
+        step_m=args.step,
+    )  # fmt: skip
+    from sfw_gym.evaluation.logs import read_log_meta
+
+    meta = read_log_meta(paths["csv"])
+    where = ";".join(f"{x:g},{y:g}" for x, y in meta["routers_px"])
+    print(
+        f"{plan.name}: {meta['samples']} samples ({args.trajectory}), "
+        f"{len(meta['routers_px'])} router(s) at pixels {where}"
+    )
+    print(f"wrote {paths['csv']}, {paths['truth']}, {paths['json']}")
+    print(
+        f"map and score it: sfw-gym map {paths['csv']} --routers '{where}' "
+        f"--px-per-m {1 / meta['pixel_m']:g} --y-down --score"
+    )
     return 0
 
 
@@ -451,14 +486,47 @@ def build_parser() -> argparse.ArgumentParser:
     mp.add_argument(
         "--policy",
         choices=["strongest", "all"],
-        default="strongest",
-        help="update along the strongest router's ray (the paper) or all heard routers",
+        default=None,
+        help="update along every heard router's ray (all: the default, measured best on "
+        "two-router logs) or the strongest's only (the paper)",
+    )
+    mp.add_argument(
+        "--method",
+        choices=["inverse-k", "sfw-reference"],
+        default="inverse-k",
+        help="sparse inverse k-visibility (ours, default) or the SfW authors' method",
+    )
+    mp.add_argument(
+        "--passes",
+        type=int,
+        choices=[1, 2],
+        default=2,
+        help="2 (default): run the log forward, then reversed; 1: forward only",
+    )
+    mp.add_argument(
+        "--score",
+        action="store_true",
+        help="score the map against the truth recorded beside the log (sfw-gym record)",
     )
     mp.add_argument(
         "--y-down", action="store_true", help="the CSV's y grows downward (image pixels)"
     )
     mp.add_argument("--out", default="map.png", help="output PNG; .npy and .json beside it")
     mp.set_defaults(func=_cmd_map)
+
+    rec = sub.add_parser(
+        "record",
+        help="record an RSSI log (CSV, the SfW layout) from the simulator, the truth beside it",
+    )
+    rec.add_argument("out", help="the CSV to write; .truth.npy and .truth.json go beside it")
+    rec.add_argument("--floorplan", help="a floorplan file (default: a generated one)")
+    rec.add_argument("--seed", type=seed_int, default=0, help="plan, routers, walk and radio")
+    rec.add_argument("--routers", default="2", help="a count, or positions 'x1,y1;x2,y2' (m)")
+    rec.add_argument("--trajectory", choices=["walk", "survey"], default="walk")
+    rec.add_argument(
+        "--step", type=positive_float, default=0.05, help="metres between samples (default 0.05)"
+    )
+    rec.set_defaults(func=_cmd_record)
     slam = sub.add_parser(
         "slam", help="Radio SLAM on a recorded log (CSV): corrected trajectory, fingerprint map"
     )

@@ -49,8 +49,17 @@ from sfw_gym.core.atomic import atomic_path, write_text_atomic
 from sfw_gym.core.constants import NOT_HEARD_DBM
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.mapping import GridSpec, MapperConfig, SparseInverseKVisibility
+from sfw_gym.mapping.reference import sfw_reference_map
 
 BANDS = ("2.4", "5")
+#: ``inverse-k``: sparse inverse k-visibility (ours); ``sfw-reference``: the authors' method.
+METHODS = ("inverse-k", "sfw-reference")
+#: The offline default: every heard router's ray (``router_policy="all"``) and two passes. On
+#: recorded two-router walks it beats ``"strongest"`` and one pass on free-space IoU and
+#: interior-wall recall (scripts/mapper_logs_study.py, BENCHMARKS.md, issue 31); with one router
+#: the policies coincide and two passes still win.
+OFFLINE_CONFIG = MapperConfig(router_policy="all")
+OFFLINE_PASSES = 2
 PROGRESS_MIN_ROWS = 5000
 MAX_GRID_CELLS = 16_000_000
 _CHUNK_ROWS = 65_536
@@ -103,17 +112,22 @@ class OfflineMap:
 
     Attributes:
         log: The parsed log.
-        mapper: The mapper after the whole log (``mapper.occupancy_u8`` is the map).
-        grid: Its grid (world metres).
+        occupancy_u8: The map: 0 wall … 127 unknown … 255 free, ``[row, col]`` on ``grid``.
+        method: ``"inverse-k"`` (ours) or ``"sfw-reference"`` (the authors' method).
+        mapper: Ours: the mapper after the whole log; None for the reference method.
+        grid: The map's grid (world metres).
         positions_m: ``(N, 2)`` trajectory in metres.
         routers_m: ``(R, 2)`` router positions in metres.
         columns: RSSI column used for each router.
         scale_m_per_unit: Metres per CSV unit.
-        update_us: ``(N,)`` wall time of each ``update()`` call, microseconds.
+        update_us: Wall time of each ``update()`` call (both passes), microseconds; for the
+            reference method the whole map's time spread over the samples.
     """
 
     log: RssiLog
-    mapper: SparseInverseKVisibility
+    occupancy_u8: np.ndarray
+    method: str
+    mapper: SparseInverseKVisibility | None
     grid: GridSpec
     positions_m: np.ndarray
     routers_m: np.ndarray
@@ -394,6 +408,8 @@ def map_log(
     margin_m: float = 1.0,
     rssi_column: str | None = None,
     config: MapperConfig | None = None,
+    method: str = "inverse-k",
+    passes: int = OFFLINE_PASSES,
     progress: bool | None = None,
     max_cells: int = MAX_GRID_CELLS,
 ) -> OfflineMap:
@@ -407,7 +423,12 @@ def map_log(
         margin_m: Border around the bounding box of the trajectory and routers, metres.
         rssi_column: Which RSSI feeds each router (:func:`router_column_groups`; default
             ``"max"``: its strongest band, as the SfW authors mapped).
-        config: Mapper configuration (default :class:`MapperConfig`).
+        config: Mapper configuration (default :data:`OFFLINE_CONFIG`: every router's ray).
+        method: ``"inverse-k"`` (ours) or ``"sfw-reference"`` (the authors' method,
+            :mod:`sfw_gym.mapping.reference`; it ignores ``config`` and ``passes``).
+        passes: 2 (the default): the log forward and then reversed through the same mapper (the
+            second pass sees the whole trajectory and the final thresholds, as the authors
+            do); 1: forward only.
         progress: Show a tqdm bar on stderr; None = only for logs over 5,000 rows.
         max_cells: Refuse grids larger than this (a forgotten ``--scale`` on a pixel log).
 
@@ -418,6 +439,10 @@ def map_log(
         ConfigError: On bad input (see :func:`read_rssi_log`, :func:`select_router_columns`), a
             non-positive scale, resolution or margin, or a grid over ``max_cells``.
     """
+    if method not in METHODS:
+        raise ConfigError(f"method must be one of {METHODS}, got {method!r}")
+    if passes not in (1, 2):
+        raise ConfigError(f"passes must be 1 or 2, got {passes!r}")
     if not isinstance(log, RssiLog):
         log = read_rssi_log(log)
     for name, v in (("scale_m_per_unit", scale_m_per_unit), ("resolution_m", resolution_m)):
@@ -447,31 +472,18 @@ def map_log(
             f"({size[0]} x {size[1]} m at {resolution_m} m), over {max_cells:,}; is --scale "
             f"(metres per CSV unit, now {scale_m_per_unit}) right? Else use a coarser --resolution"
         )
-    mapper = SparseInverseKVisibility(grid, routers_m, config)
-    _warm_up(mapper.config)
-
-    n = len(positions_m)
-    times = np.empty(n, np.float64)
-    show = n > PROGRESS_MIN_ROWS if progress is None else progress
-    bar = _progress(n, f"mapping {log.path.name}") if show else None
-    clock = time.perf_counter
-    update = mapper.update
-    try:
-        for i in range(n):
-            t0 = clock()
-            try:
-                update(positions_m[i], rssi[i])
-            except ConfigError as exc:
-                raise ConfigError(f"{log.path}:{log.line_numbers[i]}: {exc}") from exc
-            times[i] = clock() - t0
-            if bar is not None and (i & 255) == 255:
-                bar.update(256)
-    finally:
-        if bar is not None:
-            bar.update(n - bar.n)
-            bar.close()
+    if method == "sfw-reference":
+        start = time.perf_counter()
+        occupancy = sfw_reference_map(grid, routers_m, positions_m, rssi)
+        mapper, times = None, np.full(len(rssi), (time.perf_counter() - start) / max(len(rssi), 1))
+    else:
+        mapper = SparseInverseKVisibility(grid, routers_m, config or OFFLINE_CONFIG)
+        times = _run_mapper(mapper, log, positions_m, rssi, passes, progress)
+        occupancy = mapper.occupancy_u8
     return OfflineMap(
         log=log,
+        occupancy_u8=occupancy,
+        method=method,
         mapper=mapper,
         grid=grid,
         positions_m=positions_m,
@@ -480,6 +492,40 @@ def map_log(
         scale_m_per_unit=float(scale_m_per_unit),
         update_us=times * 1e6,
     )
+
+
+def _run_mapper(
+    mapper: SparseInverseKVisibility,
+    log: RssiLog,
+    positions_m: np.ndarray,
+    rssi: np.ndarray,
+    passes: int,
+    progress: bool | None,
+) -> np.ndarray:
+    """Feed the log (forward, then reversed if ``passes == 2``); each update's seconds."""
+    _warm_up(mapper.config)
+    n = len(positions_m)
+    order = np.arange(n) if passes == 1 else np.concatenate([np.arange(n), np.arange(n)[::-1]])
+    times = np.empty(len(order), np.float64)
+    show = n > PROGRESS_MIN_ROWS if progress is None else progress
+    bar = _progress(len(order), f"mapping {log.path.name}") if show else None
+    clock = time.perf_counter
+    update = mapper.update
+    try:
+        for step, i in enumerate(order):
+            t0 = clock()
+            try:
+                update(positions_m[i], rssi[i])
+            except ConfigError as exc:
+                raise ConfigError(f"{log.path}:{log.line_numbers[i]}: {exc}") from exc
+            times[step] = clock() - t0
+            if bar is not None and (step & 255) == 255:
+                bar.update(256)
+    finally:
+        if bar is not None:
+            bar.update(len(order) - bar.n)
+            bar.close()
+    return times
 
 
 def _column_label(log: RssiLog, group: list[int]) -> str:
@@ -533,7 +579,7 @@ def write_map(result: OfflineMap, out: str | os.PathLike[str], *, y_down: bool =
     if out.suffix.lower() != ".png":
         raise ConfigError(f"--out must be a .png file, got {str(out)!r}")
     npy, meta = out.with_suffix(".npy"), out.with_suffix(".json")
-    occ = np.array(result.mapper.occupancy_u8)
+    occ = np.array(result.occupancy_u8)
     with atomic_path(npy) as tmp:
         np.save(tmp, occ, allow_pickle=False)
     info = {
@@ -548,7 +594,8 @@ def write_map(result: OfflineMap, out: str | os.PathLike[str], *, y_down: bool =
         "rssi_columns": list(result.columns),
         "n_samples": result.log.n_samples,
         "n_skipped": result.log.n_skipped,
-        "mapper_config": result.mapper.config.to_dict(),
+        "method": result.method,
+        "mapper_config": result.mapper.config.to_dict() if result.mapper else None,
     }
     text = json.dumps(info, indent=2) + "\n"
     write_text_atomic(meta, text)

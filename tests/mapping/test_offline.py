@@ -106,9 +106,11 @@ def test_log_parsed_with_bom_trailing_comma_and_gaps(two_room_log, mapped):
 
 
 def test_map_equals_the_mapper_run_directly(mapped, two_room_log):
-    direct = SparseInverseKVisibility(mapped.grid, mapped.routers_m)
+    """The default: the log forward, then reversed, through one mapper."""
+    direct = SparseInverseKVisibility(mapped.grid, mapped.routers_m, mapped.mapper.config)
     strongest = np.maximum(two_room_log["r24"], two_room_log["r5"])
-    for p, r in zip(mapped.log.positions * PX, strongest, strict=True):
+    samples = list(zip(mapped.log.positions * PX, strongest, strict=True))
+    for p, r in [*samples, *samples[::-1]]:
         direct.update(p, np.array([r]))
     np.testing.assert_array_equal(mapped.mapper.occupancy_u8, direct.occupancy_u8)
     np.testing.assert_allclose(mapped.routers_m, [ROUTER_M])
@@ -135,7 +137,7 @@ def test_one_band_or_named_columns_on_request(two_room_log):
     path = two_room_log["path"]
     res = map_log(path, router, scale_m_per_unit=PX, rssi_column="5", progress=True)
     assert res.columns == ("router1_5",)
-    assert res.mapper.n_updates == len(two_room_log["traj"])
+    assert res.mapper.n_updates == 2 * len(two_room_log["traj"])  # two passes
     assert map_log(path, router, scale_m_per_unit=PX, rssi_column="router1_2.4").columns == (
         "router1_2.4",
     )
