@@ -9,9 +9,9 @@ thresholds ``t_1 > t_2 > ...`` (so ``k = 0`` above ``t_1``, ``k = K`` at or belo
 step in k (the robot crossing a shadow line) is not smeared into features between two levels,
 which would be misread and, once fitted, become a spurious level of their own.
 
-Thresholds come from 1-D k-means (scikit-learn, single-threaded; two deterministic starts,
-sample quantiles and evenly spaced over the range, the lower-inertia fit kept) with ``K + 1``
-clusters on the router's samples. With sorted centroids
+Thresholds come from 1-D k-means (a compiled, exact 1-D Lloyd that matches scikit-learn's
+KMeans; two deterministic starts, sample quantiles and evenly spaced over the range, the
+lower-inertia fit kept) with ``K + 1`` clusters on the router's samples. With sorted centroids
 ``C_0 > C_1 > ...``:
 
 1. adjacent centroids closer than ``min_cluster_gap_db`` are merged (size-weighted), so data
@@ -46,7 +46,7 @@ import warnings
 from typing import Any
 
 import numpy as np
-from numba import njit
+from numba import njit, objmode
 
 from sfw_gym.core.constants import NOT_HEARD_DBM
 from sfw_gym.core.errors import ConfigError
@@ -175,6 +175,52 @@ def add_samples(
     return due
 
 
+@njit(cache=True)
+def _merge_sorted(c, w, min_gap, min_fraction):
+    """:func:`merge_levels` on centroids already sorted descending (``w`` > 0), compiled."""
+    c = c.copy()
+    w = w.copy()
+    m = c.shape[0]
+
+    def merge(i, m):
+        wt = w[i] + w[i + 1]
+        c[i] = (c[i] * w[i] + c[i + 1] * w[i + 1]) / wt
+        w[i] = wt
+        for j in range(i + 1, m - 1):
+            c[j] = c[j + 1]
+            w[j] = w[j + 1]
+        return m - 1
+
+    while m > 1:
+        i = 0
+        gap = c[0] - c[1]
+        for j in range(1, m - 1):
+            g = c[j] - c[j + 1]
+            if g < gap:
+                gap = g
+                i = j
+        if gap >= min_gap:
+            break
+        m = merge(i, m)
+    total = 0.0
+    for j in range(m):
+        total += w[j]
+    while m > 1:
+        i = 0
+        for j in range(1, m):
+            if w[j] < w[i]:
+                i = j
+        if w[i] >= min_fraction * total:
+            break
+        if i == 0:
+            m = merge(0, m)
+        elif i == m - 1 or c[i - 1] - c[i] <= c[i] - c[i + 1]:
+            m = merge(i - 1, m)
+        else:
+            m = merge(i, m)
+    return c[:m].copy()
+
+
 def merge_levels(
     centroids: np.ndarray, counts: np.ndarray, min_gap: float, min_fraction: float = 0.0
 ) -> np.ndarray:
@@ -184,34 +230,33 @@ def merge_levels(
     size-weighted mean. Then, while the smallest cluster holds less than ``min_fraction`` of the
     samples, it is merged into its nearer neighbour. 0 disables either step.
     """
-    order = np.argsort(-np.asarray(centroids, dtype=np.float64))
-    c = list(np.asarray(centroids, dtype=np.float64)[order])
-    w = list(np.maximum(np.asarray(counts, dtype=np.float64)[order], 1e-12))
+    c = np.asarray(centroids, dtype=np.float64)
+    order = np.argsort(-c)
+    w = np.maximum(np.asarray(counts, dtype=np.float64)[order], 1e-12)
+    return _merge_sorted(c[order], w, float(min_gap), float(min_fraction))
 
-    def merge(i: int) -> None:
-        wt = w[i] + w[i + 1]
-        c[i] = (c[i] * w[i] + c[i + 1] * w[i + 1]) / wt
-        w[i] = wt
-        del c[i + 1], w[i + 1]
 
-    while len(c) > 1:
-        gaps = [c[i] - c[i + 1] for i in range(len(c) - 1)]
-        i = int(np.argmin(gaps))
-        if gaps[i] >= min_gap:
-            break
-        merge(i)
-    total = sum(w)
-    while len(c) > 1:
-        i = int(np.argmin(w))
-        if w[i] >= min_fraction * total:
-            break
-        if i == 0:
-            merge(0)
-        elif i == len(c) - 1 or c[i - 1] - c[i] <= c[i] - c[i + 1]:
-            merge(i - 1)
-        else:
-            merge(i)
-    return np.asarray(c)
+@njit(cache=True)
+def _thresholds(g, max_k, wall_loss_db, k_top):
+    """:func:`thresholds_from_levels`, compiled (the same arithmetic)."""
+    m = g.shape[0]
+    n_below = max(0, max_k - k_top - (m - 1))
+    n = min(max_k, k_top + (m - 1) + n_below)
+    out = np.empty(n)
+    t = 0
+    for j in range(1, k_top + 1):
+        if t < n:
+            out[t] = g[0] + (float(k_top - j) + 0.5) * wall_loss_db
+            t += 1
+    for j in range(m - 1):
+        if t < n:
+            out[t] = (g[j] + g[j + 1]) / 2.0
+            t += 1
+    for j in range(n_below):
+        if t < n:
+            out[t] = g[m - 1] - (float(j) + 0.5) * wall_loss_db
+            t += 1
+    return out
 
 
 def thresholds_from_levels(
@@ -221,33 +266,254 @@ def thresholds_from_levels(
 
     See the module docstring (step 3). Returns at most ``max_k`` thresholds.
     """
-    g = np.asarray(levels, dtype=np.float64)
-    above = g[0] + (k_top - np.arange(1, k_top + 1) + 0.5) * wall_loss_db
-    between = (g[:-1] + g[1:]) / 2.0
-    n_below = max(0, max_k - k_top - (g.size - 1))
-    below = g[-1] - (np.arange(n_below) + 0.5) * wall_loss_db
-    return np.concatenate([above, between, below])[:max_k]
+    g = np.asarray(levels, dtype=np.float64).ravel()
+    return _thresholds(g, int(max_k), float(wall_loss_db), int(k_top))
 
 
-def fit_levels(data: np.ndarray, max_k: int, min_gap_db: float, min_fraction: float = 0.0):
-    """1-D k-means with ``max_k + 1`` clusters on ``data``.
+# -- 1-D k-means ------------------------------------------------------------------------------
+#: Which k-means :func:`fit_levels` (and so :meth:`KEstimator.refit`) uses by default:
+#: ``"numba"`` (compiled, exact 1-D Lloyd) or ``"sklearn"`` (the reference; benchmarks only).
+FIT_BACKEND = "numba"
+#: scikit-learn's KMeans defaults that the fits use: iteration cap and relative tolerance.
+KMEANS_MAX_ITER, KMEANS_TOL = 100, 1e-4
+
+
+@njit(cache=True)
+def _farthest(dist, n_empty):
+    """scikit-learn's pick for empty clusters, ``argpartition(dist, -n)[:-n-1:-1]`` (numpy's own,
+    so ties between equally far points go the same way)."""
+    with objmode(far="int64[:]"):
+        far = np.argpartition(dist, -n_empty)[: -n_empty - 1 : -1].astype(np.int64)
+    return far
+
+
+@njit(cache=True)
+def _small_sum(a):
+    """``a.sum()`` as numpy computes it for up to 128 values (pairwise: 8 accumulators)."""
+    n = a.shape[0]
+    if n < 8:
+        res = 0.0
+        for i in range(n):
+            res += a[i]
+        return res
+    r = a[:8].copy()
+    m = n - n % 8
+    for i in range(8, m, 8):
+        for j in range(8):
+            r[j] += a[i + j]
+    res = (r[0] + r[1] + (r[2] + r[3])) + (r[4] + r[5] + (r[6] + r[7]))
+    for i in range(m, n):
+        res += a[i]
+    return res
+
+
+@njit(cache=True)
+def _lloyd_1d(xc, init, max_iter, tol):
+    """scikit-learn's ``_kmeans_single_lloyd`` (one thread, unit weights) on centred 1-D data.
+
+    The same arithmetic in the same order, so the same result to the last bit: the E-step's
+    distances ``|c|^2 - 2 x c`` (nearest centre, the lowest index on a tie), the M-step's sums in
+    data order, empty clusters taking the points farthest from their centres, the stop on
+    unchanged labels ("strict") or on a squared centre shift ``<= tol``, then (not strict) a
+    last E-step. O(n k) an iteration, no allocation but the labels.
 
     Returns:
-        ``(levels, (lowest, highest))``: the merged descending levels and the extreme raw
-        centroids, or None when the data has fewer than 2 distinct values.
+        ``(centres, labels, inertia, n_iter)``.
     """
-    from sklearn.cluster import KMeans  # imported here: ~0.5 s that only fitting needs
+    k = init.shape[0]
+    n = xc.shape[0]
+    centers = init.copy()
+    new = np.zeros(k)
+    c2 = np.empty(k)
+    weight = np.zeros(k)
+    shift = np.empty(k)
+    labels = np.full(n, -1, np.int32)
+    labels_old = labels.copy()
+    strict = False
+    n_iter = 0
+    for _ in range(max_iter):
+        n_iter += 1
+        for j in range(k):
+            c2[j] = centers[j] * centers[j]
+            new[j] = 0.0
+            weight[j] = 0.0
+        for i in range(n):
+            x = xc[i]
+            best = c2[0] - 2.0 * (x * centers[0])
+            lab = 0
+            for j in range(1, k):
+                d = c2[j] - 2.0 * (x * centers[j])
+                if d < best:
+                    best = d
+                    lab = j
+            labels[i] = lab
+            weight[lab] += 1.0
+            new[lab] += x
+        n_empty = 0
+        for j in range(k):
+            if weight[j] == 0.0:
+                n_empty += 1
+        if n_empty > 0:
+            dist = np.empty(n)
+            dmax = 0.0
+            for i in range(n):
+                dist[i] = (xc[i] - centers[labels[i]]) ** 2
+                dmax = max(dmax, dist[i])
+            if dmax > 0.0:  # else more clusters than distinct values: nothing to relocate
+                far = _farthest(dist, n_empty)
+                e = 0
+                for j in range(k):
+                    if weight[j] == 0.0:
+                        i = far[e]
+                        e += 1
+                        old = labels[i]
+                        new[old] -= xc[i]
+                        new[j] = xc[i]
+                        weight[j] = 1.0
+                        weight[old] -= 1.0
+        # Average; a cluster still empty goes where the heaviest is (scikit-learn's quirk: its
+        # sum, not yet its mean, when that cluster comes later).
+        heaviest = np.argmax(weight)
+        for j in range(k):
+            if weight[j] > 0.0:
+                new[j] *= 1.0 / weight[j]
+            else:
+                new[j] = new[heaviest]
+        for j in range(k):
+            d = new[j] - centers[j]
+            s = math.sqrt(d * d)
+            shift[j] = s * s
+        centers, new = new, centers
+        same = True
+        for i in range(n):
+            if labels[i] != labels_old[i]:
+                same = False
+                break
+        if same:
+            strict = True
+            break
+        if _small_sum(shift) <= tol:
+            break
+        labels_old[:] = labels
+    if not strict:
+        for j in range(k):
+            c2[j] = centers[j] * centers[j]
+        for i in range(n):
+            x = xc[i]
+            best = c2[0] - 2.0 * (x * centers[0])
+            lab = 0
+            for j in range(1, k):
+                d = c2[j] - 2.0 * (x * centers[j])
+                if d < best:
+                    best = d
+                    lab = j
+            labels[i] = lab
+    inertia = 0.0
+    for i in range(n):
+        d = xc[i] - centers[labels[i]]
+        inertia += d * d
+    return centers, labels, inertia, n_iter
+
+
+@njit(cache=True)
+def _quantiles_sorted(xs, k):
+    """``np.quantile(xs, (arange(k) + 0.5) / k)`` of sorted ``xs``, numpy's rounding included."""
+    n = xs.shape[0]
+    out = np.empty(k)
+    for j in range(k):
+        v = (n - 1) * ((j + 0.5) / k)
+        if v >= n - 1:
+            out[j] = xs[n - 1]
+            continue
+        lo = int(v)  # v >= 0: floor
+        g = v - lo
+        a = xs[lo]
+        d = xs[lo + 1] - a
+        out[j] = xs[lo + 1] - d * (1.0 - g) if g >= 0.5 else a + d * g
+    return out
+
+
+@njit(cache=True)
+def _cluster_1d(x, mean, tol, n_clusters_max, max_iter):
+    """The two-start k-means of :func:`fit_levels` on ``x`` (``mean``, ``tol``: its mean and
+    ``var * tol_rel``, from numpy): ``(centres, counts)``, empty when ``x`` holds fewer than 2
+    distinct values."""
+    xs = np.sort(x)
+    n = xs.shape[0]
+    uniq = np.empty(n)
+    n_uniq = 0
+    for i in range(n):
+        if i == 0 or xs[i] != xs[i - 1]:
+            uniq[n_uniq] = xs[i]
+            n_uniq += 1
+    if n_uniq < 2:
+        return np.empty(0), np.empty(0, np.int64)
+    uniq = uniq[:n_uniq]
+    k = min(n_clusters_max, n_uniq)
+    q = _quantiles_sorted(xs, k)
+    for j in range(1, k):
+        if q[j] == q[j - 1]:
+            q = _quantiles_sorted(uniq, k)
+            break
+    # np.linspace(uniq[0], uniq[-1], k)
+    step = (uniq[n_uniq - 1] - uniq[0]) / (k - 1)
+    spread = np.empty(k)
+    for j in range(k):
+        spread[j] = j * step + uniq[0]
+    spread[k - 1] = uniq[n_uniq - 1]
+    xc = x - mean
+    best_c, best_l, best_i, _ = _lloyd_1d(xc, q - mean, max_iter, tol)
+    c, lab, inertia, _ = _lloyd_1d(xc, spread - mean, max_iter, tol)
+    if inertia < best_i:
+        best_c, best_l = c, lab
+    counts = np.zeros(k, np.int64)
+    for i in range(n):
+        counts[best_l[i]] += 1
+    return best_c + mean, counts
+
+
+def kmeans_1d(
+    data, init, max_iter: int = KMEANS_MAX_ITER, tol: float = KMEANS_TOL
+) -> tuple[np.ndarray, np.ndarray, float, int]:
+    """Compiled 1-D k-means from the given initial centres: scikit-learn's, to the last bit.
+
+    The same as ``KMeans(len(init), init=init[:, None], n_init=1, max_iter=max_iter,
+    tol=tol).fit(data[:, None])`` run single-threaded (see :func:`_lloyd_1d`), at a few
+    microseconds per thousand points and iteration where scikit-learn spends ~1 ms a call.
+
+    Returns:
+        ``(centres, labels, inertia, n_iter)``, centres in the order of ``init``.
+    """
+    x = np.ascontiguousarray(data, dtype=np.float64).ravel()
+    c0 = np.array(init, dtype=np.float64).ravel()
+    if not 1 <= c0.size <= x.size:
+        raise ValueError(f"kmeans_1d needs 1 <= len(init) <= len(data), got {c0.size}, {x.size}")
+    mean = x.mean()
+    c, labels, inertia, n_iter = _lloyd_1d(x - mean, c0 - mean, int(max_iter), x.var() * tol)
+    return c + mean, labels, float(inertia), int(n_iter)
+
+
+_warm = False
+
+
+def _warm_up_kmeans() -> None:
+    """Run every path of the compiled k-means once (the first relocation of an empty cluster
+    costs ~70 ms: numba compiles its object-mode block at first use, it is not cached), so the
+    first fit that needs it (or ``offline._warm_up``, through the first fit) pays it up front."""
+    global _warm
+    kmeans_1d([0.0, 1.0, 10.0], [0.0, 5.0, 100.0])  # 100 gets nothing: relocated to 10
+    _warm = True
+
+
+def _cluster_sklearn(x: np.ndarray, n_clusters_max: int) -> tuple[np.ndarray, np.ndarray]:
+    """The reference for :func:`_cluster_1d`: the same two starts through scikit-learn."""
+    from sklearn.cluster import KMeans  # imported here: ~0.5 s that only this path needs
     from sklearn.exceptions import ConvergenceWarning
 
-    x = np.asarray(data, dtype=np.float64)
     uniq = np.unique(x)
     if uniq.size < 2:
-        return None
-    n_clusters = min(max_k + 1, uniq.size)
-    # Two deterministic starts, the better (lower inertia) kept: sample quantiles, which suit
-    # balanced levels, and evenly spaced over the range, which keeps a dominant level (most
-    # samples seen from one room) from taking several clusters and leaving two sparse levels
-    # to share one.
+        return np.empty(0), np.empty(0, np.int64)
+    n_clusters = min(n_clusters_max, uniq.size)
     q = np.quantile(x, (np.arange(n_clusters) + 0.5) / n_clusters)
     if np.unique(q).size < n_clusters:
         q = np.quantile(uniq, (np.arange(n_clusters) + 0.5) / n_clusters)
@@ -258,15 +524,58 @@ def fit_levels(data: np.ndarray, max_k: int, min_gap_db: float, min_fraction: fl
         # Fewer distinct clusters than asked (repeated values) is fine: empty ones are dropped.
         warnings.simplefilter("ignore", ConvergenceWarning)
         for init in (q, spread):
-            km = KMeans(n_clusters=n_clusters, init=init[:, None], n_init=1, max_iter=100)
+            km = KMeans(
+                n_clusters=n_clusters,
+                init=init[:, None],
+                n_init=1,
+                max_iter=KMEANS_MAX_ITER,
+                tol=KMEANS_TOL,
+            )
             labels = km.fit_predict(x[:, None])
             if best is None or km.inertia_ < best[0].inertia_:
                 best = (km, labels)
     assert best is not None
     km, labels = best
-    counts = np.bincount(labels, minlength=n_clusters)
+    return km.cluster_centers_[:, 0], np.bincount(labels, minlength=n_clusters)
+
+
+def fit_levels(
+    data: np.ndarray,
+    max_k: int,
+    min_gap_db: float,
+    min_fraction: float = 0.0,
+    *,
+    backend: str | None = None,
+):
+    """1-D k-means with ``max_k + 1`` clusters on ``data``.
+
+    Two deterministic starts, the better (lower inertia) kept: sample quantiles, which suit
+    balanced levels, and evenly spaced over the range, which keeps a dominant level (most
+    samples seen from one room) from taking several clusters and leaving two sparse levels to
+    share one. The fit is a compiled, exact 1-D Lloyd (:func:`kmeans_1d`; tens of µs where
+    scikit-learn's KMeans costs ~1 ms a call); ``backend="sklearn"`` (or the module's
+    :data:`FIT_BACKEND`) runs the same starts through scikit-learn, the reference.
+
+    Returns:
+        ``(levels, (lowest, highest))``: the merged descending levels and the extreme raw
+        centroids, or None when the data has fewer than 2 distinct values.
+    """
+    backend = FIT_BACKEND if backend is None else backend
+    x = np.ascontiguousarray(data, dtype=np.float64).ravel()
+    if backend == "numba":
+        if not _warm:
+            _warm_up_kmeans()
+        tol = x.var() * KMEANS_TOL if x.size else 0.0
+        mean = x.mean() if x.size else 0.0
+        cents, counts = _cluster_1d(x, mean, tol, int(max_k) + 1, KMEANS_MAX_ITER)
+    elif backend == "sklearn":
+        cents, counts = _cluster_sklearn(x, int(max_k) + 1)
+    else:
+        raise ConfigError(f"backend must be 'numba' or 'sklearn', got {backend!r}")
+    if cents.size == 0:
+        return None
     keep = counts > 0
-    cents = km.cluster_centers_[keep, 0]
+    cents = cents[keep]
     levels = merge_levels(cents, counts[keep], min_gap_db, min_fraction)
     return levels, (float(cents.min()), float(cents.max()))
 

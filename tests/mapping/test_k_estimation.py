@@ -338,3 +338,132 @@ def test_refit_merges_levels_below_the_minimum_fraction():
     est.refit(force=True)
     top = (-800.0 - 140.0) / 22
     assert est.thresholds(0) == pytest.approx([top - 5.0, top - 15.0, top - 25.0])
+
+
+# -- issue 31: the compiled 1-D k-means against scikit-learn, and the refit schedule -------------
+def sklearn_kmeans(x, init, max_iter=100):
+    """scikit-learn's KMeans from ``init``, one thread (as fit_levels ran it)."""
+    import warnings
+
+    from sklearn.cluster import KMeans
+
+    from sfw_gym.core.threads import single_threaded_openmp
+
+    with single_threaded_openmp(), warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # fewer distinct clusters than asked
+        km = KMeans(
+            len(init), init=np.asarray(init)[:, None], n_init=1, max_iter=max_iter, tol=1e-4
+        )
+        km.fit(np.asarray(x)[:, None])
+    return km
+
+
+def random_levels(rng, rounded):
+    n, k = int(rng.integers(20, 1500)), int(rng.integers(2, 6))
+    x = rng.choice(rng.uniform(-90, -20, k), n) + rng.normal(0, rng.uniform(0.5, 4), n)
+    return (np.round(x) if rounded else x), k
+
+
+@pytest.mark.parametrize("rounded", [False, True], ids=["continuous", "integer_dbm"])
+def test_kmeans_1d_matches_sklearn(rounded):
+    # Same starts as fit_levels (quantiles, evenly spaced); integer dBm has ties at midpoints
+    # and empty clusters (relocated). Tolerance: centroids 1e-9 dB, inertia 1e-9 relative (the
+    # arithmetic is scikit-learn's, in its order, so they agree to the bit here); labels and
+    # iteration counts exactly.
+    from sfw_gym.mapping.k_estimation import kmeans_1d
+
+    rng = np.random.default_rng(31)
+    for _ in range(60):
+        x, k = random_levels(rng, rounded)
+        for init in (np.quantile(x, (np.arange(k) + 0.5) / k), np.linspace(x.min(), x.max(), k)):
+            if np.unique(init).size < k:
+                continue
+            km = sklearn_kmeans(x, init)
+            c, labels, inertia, n_iter = kmeans_1d(x, init)
+            np.testing.assert_allclose(c, km.cluster_centers_[:, 0], rtol=0, atol=1e-9)
+            np.testing.assert_array_equal(labels, km.labels_)
+            assert inertia == pytest.approx(km.inertia_, rel=1e-9)
+            assert n_iter == km.n_iter_
+
+
+def test_kmeans_1d_relocates_empty_clusters_as_sklearn():
+    # Evenly spaced starts -95, -75.5, -56, -36.5, -17: -36.5 gets nothing and takes the
+    # farthest point (-66, 9.5 dB from -75.5), which empties -75.5; scikit-learn then parks
+    # -75.5 on the heaviest cluster's not-yet-averaged sum (its quirk), outside the data.
+    from sfw_gym.mapping.k_estimation import kmeans_1d
+
+    x = np.array([-95.0] * 3 + [-86.0] * 2 + [-66.0] + [-56.0, -50.0, -47.0] * 6 + [-25, -17] * 3)
+    init = np.linspace(-95.0, -17.0, 5)
+    for max_iter in (1, 100):
+        km = sklearn_kmeans(x, init, max_iter)
+        c, labels, _, n_iter = kmeans_1d(x, init, max_iter=max_iter)
+        np.testing.assert_allclose(c, km.cluster_centers_[:, 0], rtol=0, atol=1e-9)
+        np.testing.assert_array_equal(labels, km.labels_)
+        assert n_iter == km.n_iter_
+        if max_iter == 1:  # -75.5 parked on the heaviest cluster's sum of centred values
+            heavy = x[(x >= -56.0) & (x <= -47.0)]
+            assert c[1] == pytest.approx(x.mean() + np.sum(heavy - x.mean()), abs=1e-9)
+            assert not heavy.min() <= c[1] <= heavy.max()  # not the heaviest's mean
+
+
+@pytest.mark.parametrize("rounded", [False, True], ids=["continuous", "integer_dbm"])
+def test_fit_levels_matches_the_sklearn_backend(rounded):
+    rng = np.random.default_rng(5)
+    for _ in range(40):
+        x, _ = random_levels(rng, rounded)
+        for gap, frac in ((0.0, 0.0), (7.0, 0.02)):
+            new = fit_levels(x, 3, gap, frac)
+            old = fit_levels(x, 3, gap, frac, backend="sklearn")
+            np.testing.assert_allclose(new[0], old[0], rtol=0, atol=1e-9)
+            assert new[1] == pytest.approx(old[1], abs=1e-9)
+    with pytest.raises(ConfigError, match="backend"):
+        fit_levels(x, 3, 7.0, backend="magic")
+
+
+def survey_readings(n, seed=0):
+    """A robot walking past two walls of one router: distance-aware RSSI in integer dBm."""
+    rng = np.random.default_rng(seed)
+    d = 2.0 + 6.0 * np.abs(np.sin(np.arange(n) / 40.0))
+    k = (np.arange(n) // 50) % 3  # rooms behind 0, 1, 2 walls, in turn
+    return np.round(K0 - 20.0 * np.log10(d) - 10.0 * k + rng.normal(0.0, 2.0, n)), d
+
+
+def test_scheduled_refits_equal_a_full_refit():
+    cfg = MapperConfig(refit_min_samples=32, refit_growth=1.5)
+    rssi, d = survey_readings(1200)
+    # Stop at the first scheduled refit after 200 samples: it saw every sample so far, so its
+    # thresholds are a full refit's (to the bit; tolerance 1e-9 dB).
+    est = KEstimator(1, cfg)
+    for i in range(1200):
+        before = est.n_refits
+        est.update([rssi[i]], [d[i]])
+        if est.n_refits > before and i + 1 >= 200:
+            break
+    assert 200 <= i + 1 < 400 and est.n_refits >= 5
+    scheduled = est.thresholds(0)
+    est.refit(force=True)
+    np.testing.assert_allclose(est.thresholds(0), scheduled, rtol=0, atol=1e-9)
+    # Between refits (1200 samples, the last refit some hundreds earlier): the data's mix of
+    # levels barely moves, so the thresholds stay within 0.25 dB of a full refit's.
+    est = KEstimator(1, cfg)
+    for i in range(1200):
+        est.update([rssi[i]], [d[i]])
+    scheduled = est.thresholds(0)
+    assert np.isfinite(scheduled).all() and est._fitted[0]
+    est.refit(force=True)
+    np.testing.assert_allclose(est.thresholds(0), scheduled, rtol=0, atol=0.25)
+
+
+def test_estimator_with_either_backend_gives_the_same_k_values(monkeypatch):
+    from sfw_gym.mapping import k_estimation
+
+    rssi, d = survey_readings(600, seed=2)
+    out = {}
+    for backend in ("sklearn", "numba"):
+        monkeypatch.setattr(k_estimation, "FIT_BACKEND", backend)
+        est = KEstimator(1, MapperConfig(refit_min_samples=16))
+        ks = [est.update([rssi[i]], [d[i]])[0] for i in range(600)]
+        out[backend] = (ks, est.thresholds(0), est.n_refits)
+    assert out["numba"][0] == out["sklearn"][0]
+    np.testing.assert_allclose(out["numba"][1], out["sklearn"][1], rtol=0, atol=1e-9)
+    assert out["numba"][2] == out["sklearn"][2] > 5
