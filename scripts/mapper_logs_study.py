@@ -29,11 +29,12 @@ from sfw_gym.world import generate_floorplan, load_floorplan
 HOUSEEXPO = Path(__file__).resolve().parents[2] / "shared" / "floorplans" / "houseexpo"
 METRICS = ("free_iou", "wall_precision", "interior_wall_recall")
 REFERENCE = "sfw-reference"
-#: label -> map_log keyword arguments (ours: the offline default mapper, no calibration)
+#: label -> map_log keyword arguments (ours: no calibration, as for a log from elsewhere;
+#: "all+2pass" is map_log's default)
 METHODS = {
     REFERENCE: {"method": "sfw-reference"},
-    "strongest": {"config": MapperConfig(router_policy="strongest")},
-    "all": {"config": MapperConfig(router_policy="all")},
+    "strongest": {"config": MapperConfig(router_policy="strongest"), "passes": 1},
+    "all": {"config": MapperConfig(router_policy="all"), "passes": 1},
     "strongest+2pass": {"config": MapperConfig(router_policy="strongest"), "passes": 2},
     "all+2pass": {"config": MapperConfig(router_policy="all"), "passes": 2},
     "all+2.4GHz": {"config": MapperConfig(router_policy="all"), "rssi_column": "2.4"},
