@@ -11,7 +11,8 @@ which would be misread and, once fitted, become a spurious level of their own.
 
 Thresholds come from 1-D k-means (a compiled, exact 1-D Lloyd that matches scikit-learn's
 KMeans; two deterministic starts, sample quantiles and evenly spaced over the range, the
-lower-inertia fit kept) with ``K + 1`` clusters on the router's samples. With sorted centroids
+lower-inertia fit kept; a refit of all routers, merge and thresholds included, is one compiled
+call) with ``K + 1`` clusters on the router's samples. With sorted centroids
 ``C_0 > C_1 > ...``:
 
 1. adjacent centroids closer than ``min_cluster_gap_db`` are merged (size-weighted), so data
@@ -360,17 +361,23 @@ def _lloyd_1d(xc, init, max_iter, tol):
                 dist[i] = (xc[i] - centers[labels[i]]) ** 2
                 dmax = max(dmax, dist[i])
             if dmax > 0.0:  # else more clusters than distinct values: nothing to relocate
-                far = _farthest(dist, n_empty)
+                # The clusters empty now (not those a relocation empties: scikit-learn lists
+                # them first; re-checking weights ran past ``far``, out of bounds).
+                empty = np.empty(n_empty, np.int64)
                 e = 0
                 for j in range(k):
                     if weight[j] == 0.0:
-                        i = far[e]
+                        empty[e] = j
                         e += 1
-                        old = labels[i]
-                        new[old] -= xc[i]
-                        new[j] = xc[i]
-                        weight[j] = 1.0
-                        weight[old] -= 1.0
+                far = _farthest(dist, n_empty)
+                for e in range(n_empty):
+                    j = empty[e]
+                    i = far[e]
+                    old = labels[i]
+                    new[old] -= xc[i]
+                    new[j] = xc[i]
+                    weight[j] = 1.0
+                    weight[old] -= 1.0
         # Average; a cluster still empty goes where the heaviest is (scikit-learn's quirk: its
         # sum, not yet its mean, when that cluster comes later).
         heaviest = np.argmax(weight)
@@ -472,6 +479,182 @@ def _cluster_1d(x, mean, tol, n_clusters_max, max_iter):
     return best_c + mean, counts
 
 
+@njit(cache=True)
+def _block_sum(a, lo, n):
+    """``a[lo:lo + n].sum()`` for ``n <= 128`` as numpy computes it (8 accumulators)."""
+    if n < 8:
+        res = 0.0
+        for i in range(lo, lo + n):
+            res += a[i]
+        return res
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    m = n - n % 8
+    for i in range(lo + 8, lo + m, 8):
+        r0 += a[i]
+        r1 += a[i + 1]
+        r2 += a[i + 2]
+        r3 += a[i + 3]
+        r4 += a[i + 4]
+        r5 += a[i + 5]
+        r6 += a[i + 6]
+        r7 += a[i + 7]
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    for i in range(lo + m, lo + n):
+        res += a[i]
+    return res
+
+
+@njit(cache=True)
+def _pairwise_sum(a):
+    """``a.sum()`` as numpy computes it, to the bit: its pairwise summation (blocks of at most
+    128 values, see :func:`_block_sum`; longer runs split in halves rounded down to a multiple
+    of 8, the left half's sum plus the right's), evaluated with an explicit stack (a recursive
+    compiled function does not survive numba's cache)."""
+    n = a.shape[0]
+    if n <= 128:
+        return _block_sum(a, 0, n)
+    node_lo = np.empty(128, np.int64)
+    node_n = np.empty(128, np.int64)
+    node_stage = np.empty(128, np.int64)
+    vals = np.empty(128)
+    sp = 1
+    vp = 0
+    node_lo[0], node_n[0], node_stage[0] = 0, n, 0
+    while sp > 0:
+        t = sp - 1
+        lo, m = node_lo[t], node_n[t]
+        if m <= 128:
+            vals[vp] = _block_sum(a, lo, m)
+            vp += 1
+            sp -= 1
+            continue
+        m2 = m // 2
+        m2 -= m2 % 8
+        if node_stage[t] == 0:  # left half first
+            node_stage[t] = 1
+            node_lo[sp], node_n[sp], node_stage[sp] = lo, m2, 0
+            sp += 1
+        elif node_stage[t] == 1:  # then the right half
+            node_stage[t] = 2
+            node_lo[sp], node_n[sp], node_stage[sp] = lo + m2, m - m2, 0
+            sp += 1
+        else:  # both done: left + right
+            vals[vp - 2] = vals[vp - 2] + vals[vp - 1]
+            vp -= 1
+            sp -= 1
+    return vals[0]
+
+
+@njit(cache=True)
+def _mean_var(x):
+    """``(x.mean(), x.var())`` as numpy computes them (``x`` 1-D contiguous, not empty)."""
+    n = x.shape[0]
+    mean = _pairwise_sum(x) / n
+    sq = np.empty(n)
+    for i in range(n):
+        d = x[i] - mean
+        sq[i] = d * d
+    return mean, _pairwise_sum(sq) / n
+
+
+@njit(cache=True)
+def _fit_levels_1d(x, n_clusters_max, min_gap, min_fraction, max_iter, tol_rel):
+    """:func:`fit_levels`' numba backend in one compiled call: ``(status, levels, lowest,
+    highest)``, status 1 fitted, 0 fewer than 2 distinct values, 2 two kept centroids exactly
+    equal (their order in numpy's ``argsort`` is not reproduced here: the caller falls back to
+    :func:`merge_levels`)."""
+    empty = np.empty(0)
+    if x.shape[0] == 0:
+        return 0, empty, 0.0, 0.0
+    mean, var = _mean_var(x)
+    cents, counts = _cluster_1d(x, mean, var * tol_rel, n_clusters_max, max_iter)
+    k = cents.shape[0]
+    if k == 0:
+        return 0, empty, 0.0, 0.0
+    # the kept (non-empty) clusters, sorted descending by insertion (unique without ties)
+    c = np.empty(k)
+    w = np.empty(k)
+    m = 0
+    for j in range(k):
+        if counts[j] > 0:
+            v = cents[j]
+            cw = float(counts[j])
+            i = m
+            while i > 0 and c[i - 1] < v:
+                c[i] = c[i - 1]
+                w[i] = w[i - 1]
+                i -= 1
+            if i > 0 and c[i - 1] == v:
+                return 2, empty, 0.0, 0.0
+            c[i] = v
+            w[i] = cw
+            m += 1
+    levels = _merge_sorted(c[:m], w[:m], min_gap, min_fraction)
+    return 1, levels, c[m - 1], c[0]
+
+
+@njit(cache=True)
+def _refit_routers(
+    force,
+    growth_factor,
+    max_interval,
+    max_k,
+    min_gap,
+    min_fraction,
+    wall_loss_db,
+    calibrated,
+    k0_level_dbm,
+    max_iter,
+    tol_rel,
+    fit_buf,
+    fit_n,
+    n_fit_seen,
+    next_refit,
+    novel,
+    thresholds,
+    n_thr,
+    fit_range,
+    fitted,
+    fallback,
+):
+    """:meth:`KEstimator.refit`'s loop over the routers, compiled (numba backend): the schedule,
+    the fit, the thresholds. Routers whose fit needs :func:`merge_levels` (tied centroids) are
+    scheduled but flagged in ``fallback``, not fitted. Returns ``(n_fitted, n_fallback)``."""
+    n_fitted = 0
+    n_fallback = 0
+    for r in range(fit_n.shape[0]):
+        fallback[r] = False
+        n_seen = n_fit_seen[r]
+        if n_seen == 0 or (not force and n_seen < next_refit[r]):
+            continue
+        growth = math.ceil(n_seen * (growth_factor - 1.0))
+        next_refit[r] = n_seen + max(1, min(growth, max_interval))
+        novel[r] = 0
+        status, levels, lowest, highest = _fit_levels_1d(
+            fit_buf[r, : fit_n[r]], max_k + 1, min_gap, min_fraction, max_iter, tol_rel
+        )
+        if status == 0:
+            continue
+        if status == 2:
+            fallback[r] = True
+            n_fallback += 1
+            continue
+        k_top = 0
+        if calibrated:
+            k_top = int(np.rint((k0_level_dbm - levels[0]) / wall_loss_db))
+            k_top = min(max(k_top, 0), max_k)
+        thr = _thresholds(levels, max_k, wall_loss_db, k_top)
+        for j in range(thresholds.shape[1]):
+            thresholds[r, j] = thr[j] if j < thr.shape[0] else -np.inf
+        n_thr[r] = thr.shape[0]
+        fit_range[r, 0] = highest
+        fit_range[r, 1] = lowest
+        fitted[r] = True
+        n_fitted += 1
+    return n_fitted, n_fallback
+
+
 def kmeans_1d(
     data, init, max_iter: int = KMEANS_MAX_ITER, tol: float = KMEANS_TOL
 ) -> tuple[np.ndarray, np.ndarray, float, int]:
@@ -565,9 +748,15 @@ def fit_levels(
     if backend == "numba":
         if not _warm:
             _warm_up_kmeans()
-        tol = x.var() * KMEANS_TOL if x.size else 0.0
-        mean = x.mean() if x.size else 0.0
-        cents, counts = _cluster_1d(x, mean, tol, int(max_k) + 1, KMEANS_MAX_ITER)
+        status, levels, lowest, highest = _fit_levels_1d(
+            x, int(max_k) + 1, float(min_gap_db), float(min_fraction), KMEANS_MAX_ITER, KMEANS_TOL
+        )
+        if status == 1:
+            return levels, (float(lowest), float(highest))
+        if status == 0:
+            return None
+        mean, var = _mean_var(x)  # tied centroids: numpy's argsort orders them
+        cents, counts = _cluster_1d(x, mean, var * KMEANS_TOL, int(max_k) + 1, KMEANS_MAX_ITER)
     elif backend == "sklearn":
         cents, counts = _cluster_sklearn(x, int(max_k) + 1)
     else:
@@ -622,6 +811,7 @@ class KEstimator:
         self._novel = np.zeros(n, np.int64)
         self._feature = np.full(n, np.nan)
         self._k = np.full(n, -1, np.int64)
+        self._fallback = np.zeros(n, np.bool_)
         self.reset()
 
     def reset(self) -> None:
@@ -738,6 +928,42 @@ class KEstimator:
 
     def refit(self, force: bool = False) -> None:
         """Refit every router whose schedule is due (every router with samples if forced)."""
+        if FIT_BACKEND != "numba":
+            self._refit_python(force)
+            return
+        if not _warm:
+            _warm_up_kmeans()
+        cfg = self.config
+        n_fitted, n_fallback = _refit_routers(
+            bool(force),
+            float(cfg.refit_growth),
+            int(cfg.refit_max_interval),
+            int(cfg.max_k),
+            float(cfg.min_cluster_gap_db),
+            float(cfg.min_level_fraction),
+            float(cfg.prior_wall_loss_db),
+            cfg.k0_level_dbm is not None,
+            0.0 if cfg.k0_level_dbm is None else float(cfg.k0_level_dbm),
+            KMEANS_MAX_ITER,
+            KMEANS_TOL,
+            self._fit_buf,
+            self._fit_n,
+            self._n_fit_seen,
+            self._next_refit,
+            self._novel,
+            self._thresholds,
+            self._n_thr,
+            self._fit_range,
+            self._fitted,
+            self._fallback,
+        )
+        self.n_refits += n_fitted
+        if n_fallback:  # tied centroids (rare): the Python fit, schedule already advanced
+            for r in np.flatnonzero(self._fallback):
+                self._fit_router(int(r))
+
+    def _refit_python(self, force: bool = False) -> None:
+        """:meth:`refit` router by router in Python (the reference; any :data:`FIT_BACKEND`)."""
         cfg = self.config
         for r in range(self.n_routers):
             n_seen = int(self._n_fit_seen[r])
@@ -746,19 +972,24 @@ class KEstimator:
             growth = math.ceil(n_seen * (cfg.refit_growth - 1.0))
             self._next_refit[r] = n_seen + max(1, min(growth, cfg.refit_max_interval))
             self._novel[r] = 0
-            data = self._fit_buf[r, : self._fit_n[r]]
-            fit = fit_levels(data, cfg.max_k, cfg.min_cluster_gap_db, cfg.min_level_fraction)
-            if fit is None:
-                continue
-            levels, (lowest, highest) = fit
-            k_top = 0
-            if cfg.k0_level_dbm is not None:
-                k_top = round((cfg.k0_level_dbm - levels[0]) / cfg.prior_wall_loss_db)
-                k_top = min(max(k_top, 0), cfg.max_k)
-            thr = thresholds_from_levels(levels, cfg.max_k, cfg.prior_wall_loss_db, k_top)
-            self._thresholds[r, :] = -np.inf
-            self._thresholds[r, : thr.size] = thr
-            self._n_thr[r] = thr.size
-            self._fit_range[r] = (highest, lowest)
-            self._fitted[r] = True
-            self.n_refits += 1
+            self._fit_router(r)
+
+    def _fit_router(self, r: int) -> None:
+        """Fit router ``r``'s levels and thresholds through :func:`fit_levels`."""
+        cfg = self.config
+        data = self._fit_buf[r, : self._fit_n[r]]
+        fit = fit_levels(data, cfg.max_k, cfg.min_cluster_gap_db, cfg.min_level_fraction)
+        if fit is None:
+            return
+        levels, (lowest, highest) = fit
+        k_top = 0
+        if cfg.k0_level_dbm is not None:
+            k_top = round((cfg.k0_level_dbm - levels[0]) / cfg.prior_wall_loss_db)
+            k_top = min(max(k_top, 0), cfg.max_k)
+        thr = thresholds_from_levels(levels, cfg.max_k, cfg.prior_wall_loss_db, k_top)
+        self._thresholds[r, :] = -np.inf
+        self._thresholds[r, : thr.size] = thr
+        self._n_thr[r] = thr.size
+        self._fit_range[r] = (highest, lowest)
+        self._fitted[r] = True
+        self.n_refits += 1

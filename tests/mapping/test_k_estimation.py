@@ -406,6 +406,25 @@ def test_kmeans_1d_relocates_empty_clusters_as_sklearn():
             assert not heavy.min() <= c[1] <= heavy.max()  # not the heaviest's mean
 
 
+def test_kmeans_1d_relocation_that_empties_a_later_cluster_is_sklearns():
+    # Quantile starts, 6 clusters on 9 points: one cluster is empty and takes the farthest
+    # point, the only point of a later cluster, which empties it; scikit-learn relocates only
+    # the clusters empty before the relocation (the later one is parked on the heaviest's sum).
+    # Re-checking the weights while relocating read past the farthest points (a segfault).
+    from sfw_gym.mapping.k_estimation import kmeans_1d
+
+    x = np.array([-69.19, -24.11, -69.09, -68.68, -68.95, -69.7, -23.22, -24.34, -24.56])
+    init = np.quantile(x, (np.arange(6) + 0.5) / 6)
+    for max_iter in (1, 2, 100):
+        km = sklearn_kmeans(x, init, max_iter)
+        c, labels, inertia, n_iter = kmeans_1d(x, init, max_iter=max_iter)
+        np.testing.assert_allclose(c, km.cluster_centers_[:, 0], rtol=0, atol=1e-9)
+        np.testing.assert_array_equal(labels, km.labels_)
+        assert n_iter == km.n_iter_ and inertia == pytest.approx(km.inertia_, rel=1e-9)
+    new, old = fit_levels(x, 5, 3.0, 0.1), fit_levels(x, 5, 3.0, 0.1, backend="sklearn")
+    np.testing.assert_allclose(new[0], old[0], rtol=0, atol=1e-9)
+
+
 @pytest.mark.parametrize("rounded", [False, True], ids=["continuous", "integer_dbm"])
 def test_fit_levels_matches_the_sklearn_backend(rounded):
     rng = np.random.default_rng(5)
@@ -467,3 +486,135 @@ def test_estimator_with_either_backend_gives_the_same_k_values(monkeypatch):
     assert out["numba"][0] == out["sklearn"][0]
     np.testing.assert_allclose(out["numba"][1], out["sklearn"][1], rtol=0, atol=1e-9)
     assert out["numba"][2] == out["sklearn"][2] > 5
+
+
+# -- the compiled refit (one call per refit) against the Python path it replaced ----------------
+def test_mean_var_are_numpys_to_the_bit():
+    # numpy's pairwise sums: 8 accumulators up to 128 values, halves (multiples of 8) above
+    from sfw_gym.mapping.k_estimation import _mean_var
+
+    rng = np.random.default_rng(7)
+    sizes = [*range(1, 300), 511, 512, 513, 1000, 4095, 4096, 4097, 9999, 70001]
+    for n in sizes:
+        x = rng.normal(-60.0, 12.0, n)
+        for data in (x, np.round(x)):
+            mean, var = _mean_var(data)
+            assert mean == data.mean() and var == data.var(), n
+
+
+def old_fit_levels(x, max_k, gap, frac):
+    """fit_levels' numba backend before the fit went compiled end to end (numpy's mean, var,
+    the cluster filter and merge_levels in Python around the compiled k-means)."""
+    from sfw_gym.mapping.k_estimation import KMEANS_MAX_ITER, KMEANS_TOL, _cluster_1d
+
+    x = np.asarray(x, dtype=np.float64)
+    cents, counts = _cluster_1d(x, x.mean(), x.var() * KMEANS_TOL, max_k + 1, KMEANS_MAX_ITER)
+    if cents.size == 0:
+        return None
+    keep = counts > 0
+    cents = cents[keep]
+    return merge_levels(cents, counts[keep], gap, frac), (cents.min(), cents.max())
+
+
+@pytest.mark.parametrize("rounded", [False, True], ids=["continuous", "integer_dbm"])
+def test_compiled_fit_levels_equals_the_python_path_to_the_bit(rounded):
+    rng = np.random.default_rng(11)
+    for _ in range(300):
+        x, _ = random_levels(rng, rounded)
+        x = x[: int(rng.integers(1, x.size + 1))]
+        for max_k, gap, frac in ((3, 0.0, 0.0), (3, 7.0, 0.02), (5, 3.0, 0.1), (1, 7.0, 0.0)):
+            new, old = fit_levels(x, max_k, gap, frac), old_fit_levels(x, max_k, gap, frac)
+            if old is None:
+                assert new is None
+                continue
+            np.testing.assert_array_equal(new[0], old[0])
+            assert new[1] == old[1]
+    assert fit_levels([], 3, 7.0) is None and fit_levels([-50.0], 3, 7.0) is None
+
+
+def test_fit_levels_falls_back_to_merge_levels_on_tied_centroids(monkeypatch):
+    # Tied kept centroids (their order left to numpy's argsort) take the Python merge; forced
+    # here, it gives the compiled path's result.
+    from sfw_gym.mapping import k_estimation
+
+    x = np.round(np.random.default_rng(3).choice([-40.0, -55.0, -70.0], 400) + 2.0)
+    expected = fit_levels(x, 3, 7.0, 0.02)
+    real = k_estimation._fit_levels_1d
+    monkeypatch.setattr(k_estimation, "_fit_levels_1d", lambda *a: (2, *real(*a)[1:]))
+    got = fit_levels(x, 3, 7.0, 0.02)
+    np.testing.assert_array_equal(got[0], expected[0])
+    assert got[1] == expected[1]
+
+
+def estimator_state(est):
+    return [
+        a.copy()
+        for a in (est._thresholds, est._n_thr, est._fit_range, est._fitted, est._next_refit)
+    ] + [est._novel.copy(), est.n_refits, est.last_k]
+
+
+@pytest.mark.parametrize(
+    "config",
+    [
+        MapperConfig(refit_min_samples=16),
+        MapperConfig(refit_min_samples=16, k_estimator="kmeans", min_level_fraction=0.1),
+        MapperConfig(k_estimator="distance_aware", k0_level_dbm=K0, refit_max_interval=50),
+        MapperConfig(min_cluster_gap_db=0.0, max_k=5, fit_buffer_size=64, refit_growth=1.1),
+    ],
+    ids=["default", "kmeans", "calibrated", "small_buffer"],
+)
+def test_compiled_refit_equals_the_python_refit_to_the_bit(config):
+    # Three routers (one never heard, one at a single level most of the time), through every
+    # scheduled and forced refit: the compiled loop and the Python one leave the same state.
+    rssi, d = survey_readings(1500, seed=4)
+    rng = np.random.default_rng(4)
+    est_new, est_old = KEstimator(3, config), KEstimator(3, config)
+    est_old.refit = est_old._refit_python  # the per-router Python loop through fit_levels
+    for i in range(1500):
+        r = np.array([-100.0, -50.0 - 10.0 * (i % 97 == 0), rssi[i]])
+        dist = np.array([1.0, 2.0 + rng.uniform(0, 3), d[i]])
+        est_new.update(r, dist)
+        est_old.update(r, dist)
+        if i % 500 == 499:
+            est_new.refit(force=True)
+            est_old.refit(force=True)
+        for a, b in zip(estimator_state(est_new), estimator_state(est_old), strict=True):
+            np.testing.assert_array_equal(a, b)
+    assert est_new.n_refits > 10
+
+
+def test_compiled_refit_hands_tied_routers_to_the_python_fit(monkeypatch):
+    # A router flagged by the compiled loop (tied centroids) keeps the schedule the loop gave it
+    # and is fitted by _fit_router instead. Forced here on every router the loop fitted (its
+    # writes undone): the same state as the plain compiled run.
+    from sfw_gym.mapping import k_estimation
+
+    rssi, d = survey_readings(400, seed=6)
+    real = k_estimation._refit_routers
+
+    def flag_all(*args):
+        outputs = args[16:20]  # thresholds, n_thr, fit_range, fitted
+        saved = [a.copy() for a in outputs]
+        next_refit = args[14].copy()
+        real(*args)
+        for a, b in zip(outputs, saved, strict=True):
+            a[...] = b
+        fallback = args[20]
+        fallback[:] = args[14] != next_refit
+        return 0, int(fallback.sum())
+
+    out = []
+    for patched in (False, True):
+        if patched:
+            monkeypatch.setattr(k_estimation, "_refit_routers", flag_all)
+        est = KEstimator(2, MapperConfig(refit_min_samples=16))
+        calls = []
+        real_fit = est._fit_router
+        est._fit_router = lambda r, calls=calls, real_fit=real_fit: (calls.append(r), real_fit(r))
+        for i in range(400):
+            est.update([rssi[i], rssi[i] + 3.0 if i % 3 else -100.0], [d[i], d[i]])
+        out.append(estimator_state(est))
+        assert bool(calls) == patched and set(calls) <= {0, 1}
+    for a, b in zip(*out, strict=True):
+        np.testing.assert_array_equal(a, b)
+    assert out[1][6] > 10
