@@ -685,6 +685,19 @@ def _warm_up_kmeans() -> None:
     first fit that needs it (or ``offline._warm_up``, through the first fit) pays it up front."""
     global _warm
     kmeans_1d([0.0, 1.0, 10.0], [0.0, 5.0, 100.0])  # 100 gets nothing: relocated to 10
+    # Each compiled entry point compiles that block anew: the refit's, fit_levels' (and its
+    # fallback's) too, with the argument types of their real calls. 6 clusters on these 9 points
+    # relocate from the quantile start.
+    x = np.array([-69.19, -24.11, -69.09, -68.68, -68.95, -69.7, -23.22, -24.34, -24.56])
+    _fit_levels_1d(x, 6, 3.0, 0.1, KMEANS_MAX_ITER, KMEANS_TOL)
+    _cluster_1d(x, *_mean_var(x), 6, KMEANS_MAX_ITER)
+    i64, one = np.int64, np.ones(1, np.int64)
+    _refit_routers(
+        True, 1.5, 2000, 5, 3.0, 0.1, 10.0, False, 0.0, KMEANS_MAX_ITER, KMEANS_TOL,
+        x[None, :].copy(), one * x.size, one * x.size, np.zeros(1, i64), np.zeros(1, i64),
+        np.zeros((1, 5)), np.zeros(1, i64), np.zeros((1, 2)), np.zeros(1, np.bool_),
+        np.zeros(1, np.bool_),
+    )  # fmt: skip
     _warm = True
 
 
