@@ -41,14 +41,14 @@ METHODS = {
 }
 
 
-def run(job: tuple[str, int, Path, tuple[str, ...]]) -> list[dict]:
-    source, n_routers, out, methods = job
+def run(job: tuple[str, int, Path, tuple[str, ...], str]) -> list[dict]:
+    source, n_routers, out, methods, trajectory = job
     plan = (
         generate_floorplan(int(source[4:])) if source.startswith("gen:") else load_floorplan(source)
     )
     name = source if source.startswith("gen:") else Path(source).stem[:10]
     csv_path = out / f"{name.replace(':', '')}_{n_routers}r.csv"
-    record_log(plan, csv_path, routers=n_routers, seed=7)
+    record_log(plan, csv_path, routers=n_routers, seed=7, trajectory=trajectory)
     meta = read_log_meta(csv_path)
     rows = []
     for label in methods:
@@ -77,6 +77,7 @@ def main() -> None:
     parser.add_argument("--generated", type=int, default=10)
     parser.add_argument("--houseexpo", type=Path, default=HOUSEEXPO)
     parser.add_argument("--methods", default=",".join(METHODS))
+    parser.add_argument("--trajectory", choices=["walk", "survey"], default="walk")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--out", type=Path, default=Path("runs/logs_study"))
     args = parser.parse_args()
@@ -87,7 +88,7 @@ def main() -> None:
     args.out.mkdir(parents=True, exist_ok=True)
     sources = [f"gen:{s}" for s in range(args.generated)]
     sources += [str(p) for p in sorted(args.houseexpo.glob("*.json"))]
-    jobs = [(s, r, args.out, methods) for r in (1, 2) for s in sources]
+    jobs = [(s, r, args.out, methods, args.trajectory) for r in (1, 2) for s in sources]
     with ProcessPoolExecutor(args.workers) as pool:
         rows = [row for part in pool.map(run, jobs) for row in part]
     with open(args.out / "rows.csv", "w", newline="") as fh:

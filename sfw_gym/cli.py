@@ -133,7 +133,7 @@ def _cmd_map(args: argparse.Namespace) -> int:
 
 
 def _cmd_record(args: argparse.Namespace) -> int:
-    from sfw_gym.evaluation.logs import record_log
+    from sfw_gym.evaluation.logs import read_log_meta, record_log
     from sfw_gym.world import generate_floorplan, load_floorplan
 
     plan = load_floorplan(args.floorplan) if args.floorplan else generate_floorplan(args.seed)
@@ -142,8 +142,6 @@ def _cmd_record(args: argparse.Namespace) -> int:
         plan, args.out, routers=routers, seed=args.seed, trajectory=args.trajectory,
         step_m=args.step,
     )  # fmt: skip
-    from sfw_gym.evaluation.logs import read_log_meta
-
     meta = read_log_meta(paths["csv"])
     where = ";".join(f"{x:g},{y:g}" for x, y in meta["routers_px"])
     print(
