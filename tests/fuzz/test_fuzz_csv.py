@@ -47,6 +47,6 @@ def test_rssi_logs(tmp_path_factory, bom, log_text, newline):
         assert np.isfinite(log.positions).all() and np.isfinite(log.rssi_dbm).all()
         assert len(log.positions) == len(log.rssi_dbm) == len(log.line_numbers)
         res = map_log(log, [[0.0, 0.0]] * max(1, len(log.rssi_names) // 2), resolution_m=0.5)
-        assert res.mapper.n_updates == log.n_samples
+        assert res.mapper.n_updates == 2 * log.n_samples  # forward, then reversed
 
     outcome("RSSI CSV", read_and_map, names="log.csv")

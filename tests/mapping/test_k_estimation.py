@@ -370,7 +370,7 @@ def test_kmeans_1d_matches_sklearn(rounded):
     # and empty clusters (relocated). Tolerance: centroids 1e-9 dB, inertia 1e-9 relative (the
     # arithmetic is scikit-learn's, in its order, so they agree to the bit here); labels and
     # iteration counts exactly.
-    from sfw_gym.mapping.k_estimation import kmeans_1d
+    from sfw_gym.mapping.kmeans1d import kmeans_1d
 
     rng = np.random.default_rng(31)
     for _ in range(60):
@@ -390,7 +390,7 @@ def test_kmeans_1d_relocates_empty_clusters_as_sklearn():
     # Evenly spaced starts -95, -75.5, -56, -36.5, -17: -36.5 gets nothing and takes the
     # farthest point (-66, 9.5 dB from -75.5), which empties -75.5; scikit-learn then parks
     # -75.5 on the heaviest cluster's not-yet-averaged sum (its quirk), outside the data.
-    from sfw_gym.mapping.k_estimation import kmeans_1d
+    from sfw_gym.mapping.kmeans1d import kmeans_1d
 
     x = np.array([-95.0] * 3 + [-86.0] * 2 + [-66.0] + [-56.0, -50.0, -47.0] * 6 + [-25, -17] * 3)
     init = np.linspace(-95.0, -17.0, 5)
@@ -411,7 +411,7 @@ def test_kmeans_1d_relocation_that_empties_a_later_cluster_is_sklearns():
     # point, the only point of a later cluster, which empties it; scikit-learn relocates only
     # the clusters empty before the relocation (the later one is parked on the heaviest's sum).
     # Re-checking the weights while relocating read past the farthest points (a segfault).
-    from sfw_gym.mapping.k_estimation import kmeans_1d
+    from sfw_gym.mapping.kmeans1d import kmeans_1d
 
     x = np.array([-69.19, -24.11, -69.09, -68.68, -68.95, -69.7, -23.22, -24.34, -24.56])
     init = np.quantile(x, (np.arange(6) + 0.5) / 6)
@@ -491,24 +491,24 @@ def test_estimator_with_either_backend_gives_the_same_k_values(monkeypatch):
 # -- the compiled refit (one call per refit) against the Python path it replaced ----------------
 def test_mean_var_are_numpys_to_the_bit():
     # numpy's pairwise sums: 8 accumulators up to 128 values, halves (multiples of 8) above
-    from sfw_gym.mapping.k_estimation import _mean_var
+    from sfw_gym.mapping.kmeans1d import mean_var
 
     rng = np.random.default_rng(7)
     sizes = [*range(1, 300), 511, 512, 513, 1000, 4095, 4096, 4097, 9999, 70001]
     for n in sizes:
         x = rng.normal(-60.0, 12.0, n)
         for data in (x, np.round(x)):
-            mean, var = _mean_var(data)
+            mean, var = mean_var(data)
             assert mean == data.mean() and var == data.var(), n
 
 
 def old_fit_levels(x, max_k, gap, frac):
     """fit_levels' numba backend before the fit went compiled end to end (numpy's mean, var,
     the cluster filter and merge_levels in Python around the compiled k-means)."""
-    from sfw_gym.mapping.k_estimation import KMEANS_MAX_ITER, KMEANS_TOL, _cluster_1d
+    from sfw_gym.mapping.kmeans1d import KMEANS_MAX_ITER, KMEANS_TOL, cluster_1d
 
     x = np.asarray(x, dtype=np.float64)
-    cents, counts = _cluster_1d(x, x.mean(), x.var() * KMEANS_TOL, max_k + 1, KMEANS_MAX_ITER)
+    cents, counts = cluster_1d(x, x.mean(), x.var() * KMEANS_TOL, max_k + 1, KMEANS_MAX_ITER)
     if cents.size == 0:
         return None
     keep = counts > 0
