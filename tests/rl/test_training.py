@@ -89,8 +89,9 @@ def test_a_save_killed_midway_leaves_no_checkpoint_under_its_name(tmp_path):
             Path(path).write_bytes(b"PK half a zip")
             raise KeyboardInterrupt  # killed during the save
 
-    class Venv:  # and of its VecMonitor
+    class Venv:  # and of its VecMonitor (and the seeds its VecEnv holds for the next reset)
         episode_returns = episode_lengths = episode_count = 0
+        venv = types.SimpleNamespace(_seeds=[None], _options=[{}])
 
         def env_method(self, name):
             return [b"env"]
