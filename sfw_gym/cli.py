@@ -392,6 +392,37 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return 0
 
 
+#: One example per subcommand, shown at the end of its ``--help``.
+EXAMPLES = {
+    "demo": "sfw-gym demo --out sfw-report",
+    "world": "sfw-gym world --seed 3 --out world.png",
+    "map": 'sfw-gym map LOG.csv --routers "60,60;220,220" --scale 0.05 --out map.png',
+    "record": "sfw-gym record walk.csv --seed 3 --routers 2",
+    "slam": "sfw-gym slam drift.csv --record 7",
+    "localize": "sfw-gym localize --plans 10 --json localize",
+    "bench": "sfw-gym bench --steps 5000 --resets 50",
+    "train": "sfw-gym train ppo_mask --env SfW-ExploreRegions-v0 --out runs/regions --resume",
+    "evaluate": "sfw-gym evaluate --agents frontier,ppo,greedy --episodes 10 --seed 2000000",
+    "benchmark": "sfw-gym benchmark --agent frontier --split test",
+}
+
+
+class HelpWithDefaults(argparse.RawDescriptionHelpFormatter):
+    """Help that shows each option's default (unless its text already says it, or it has none)
+    and keeps the example's line as written."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        if (
+            not action.option_strings
+            or "default" in text.lower()
+            or any(action.default is v for v in (None, False, argparse.SUPPRESS))
+            or action.default == ""
+        ):
+            return text
+        return f"{text} (default: %(default)s)"
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of every subcommand."""
     parser = argparse.ArgumentParser(
@@ -520,7 +551,12 @@ def build_parser() -> argparse.ArgumentParser:
     rec.add_argument("--floorplan", help="a floorplan file (default: a generated one)")
     rec.add_argument("--seed", type=seed_int, default=0, help="plan, routers, walk and radio")
     rec.add_argument("--routers", default="2", help="a count, or positions 'x1,y1;x2,y2' (m)")
-    rec.add_argument("--trajectory", choices=["walk", "survey"], default="walk")
+    rec.add_argument(
+        "--trajectory",
+        choices=["walk", "survey"],
+        default="walk",
+        help="a person's walk from place to place, or a survey (walls, then 0.5 m passes)",
+    )
     rec.add_argument(
         "--step", type=positive_float, default=0.05, help="metres between samples (default 0.05)"
     )
@@ -616,11 +652,16 @@ def build_parser() -> argparse.ArgumentParser:
         help="ppo, or ppo_mask (MaskablePPO, for SfW-ExploreGoals-v0 and SfW-ExploreRegions-v0)",
     )
     train.add_argument("--env", default="SfW-Explore-v0", help="env id (default SfW-Explore-v0)")
-    train.add_argument("--timesteps", type=positive_int, default=1_000_000, help="total env steps")
+    train.add_argument(
+        "--timesteps",
+        type=positive_int,
+        default=None,
+        help="total env steps (default: the YAML block's n_timesteps, as rl-zoo)",
+    )
     train.add_argument(
         "--n-envs", type=positive_int, default=None, help="parallel envs (default: YAML)"
     )
-    train.add_argument("--seed", type=seed_int, default=0)
+    train.add_argument("--seed", type=seed_int, default=0, help="seed of the run (default 0)")
     train.add_argument(
         "--out", type=folder, default=None, help="output folder (default runs/ppo/ENV)"
     )
@@ -714,6 +755,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _add_episode_runner_options(bm)
     bm.set_defaults(func=_cmd_benchmark)
+    for name, command in sub.choices.items():
+        command.formatter_class = HelpWithDefaults
+        command.epilog = f"example:\n  {EXAMPLES[name]}"
     return parser
 
 

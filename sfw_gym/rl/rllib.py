@@ -31,7 +31,12 @@ import yaml
 from sfw_gym.core.atomic import atomic_dir, atomic_path, remove_stale_temps, write_text_atomic
 from sfw_gym.core.data import default_hyperparams
 from sfw_gym.core.errors import ConfigError
-from sfw_gym.rl.training import import_dotted, load_hyperparams, wrapper_specs
+from sfw_gym.rl.training import (
+    import_dotted,
+    load_hyperparams,
+    resolve_timesteps,
+    wrapper_specs,
+)
 
 #: The hyperparameters of the RLlib backend (rl-zoo format).
 RLLIB_HYPERPARAMS = default_hyperparams("rllib_ppo")
@@ -156,7 +161,7 @@ def _save(algo: Any, target: Path) -> None:
 
 def train_rllib(
     env_id: str,
-    timesteps: int,
+    timesteps: int | None,
     out_dir: str | Path,
     *,
     num_env_runners: int = 0,
@@ -168,7 +173,8 @@ def train_rllib(
     progress_bar: bool = True,
     address: str | None = None,
 ) -> dict[str, Any]:
-    """Train PPO with RLlib on ``env_id`` until ``timesteps`` env steps (whole iterations).
+    """Train PPO with RLlib on ``env_id`` until ``timesteps`` env steps (whole iterations; None:
+    the hyperparameters' ``n_timesteps``).
 
     ``num_env_runners``: Ray processes that collect episodes (0: the driver collects them).
     A checkpoint in ``OUT/checkpoints`` at the first iteration boundary after every
@@ -182,6 +188,8 @@ def train_rllib(
     require_rllib()
     import ray
 
+    params = load_hyperparams(env_id, hyperparams_path)
+    timesteps = resolve_timesteps(timesteps, params, env_id)
     for name, value in (
         ("timesteps", timesteps),
         ("checkpoint_every", checkpoint_every),
@@ -191,7 +199,6 @@ def train_rllib(
     runners_ok = isinstance(num_env_runners, int) and not isinstance(num_env_runners, bool)
     if not runners_ok or num_env_runners < 0:
         raise ConfigError(f"num_env_runners must be an integer ≥ 0, got {num_env_runners!r}")
-    params = load_hyperparams(env_id, hyperparams_path)
     wrappers = wrapper_specs(params.get("env_wrapper"))
     for name, _ in wrappers:
         import_dotted(name)

@@ -99,6 +99,20 @@ def load_hyperparams(env_id: str, path: str | Path = DEFAULT_HYPERPARAMS) -> dic
     return params
 
 
+def resolve_timesteps(timesteps: int | None, params: dict[str, Any], env_id: str) -> int:
+    """``timesteps``, or when None the YAML block's ``n_timesteps`` (rl-zoo's budget)."""
+    if timesteps is not None:
+        return timesteps
+    budget = params.get("n_timesteps")
+    if budget is None:
+        raise ConfigError(
+            f"no timesteps given and the hyperparameters of {env_id!r} set no n_timesteps"
+        )
+    if float(budget) != int(budget) or int(budget) < 1:
+        raise ConfigError(f"n_timesteps of {env_id!r} must be a whole number ≥ 1, got {budget!r}")
+    return int(budget)
+
+
 def parse_policy_kwargs(text: str) -> dict[str, Any]:
     """Evaluate rl-zoo's ``policy_kwargs`` string allowing only dict(...) calls and literals."""
 
@@ -213,7 +227,7 @@ def _make_venv(
 
 def train_ppo(
     env_id: str,
-    timesteps: int,
+    timesteps: int | None,
     out_dir: str | Path,
     *,
     n_envs: int | None = None,
@@ -229,7 +243,8 @@ def train_ppo(
     algo: str = "ppo",
     num_threads: int | None = 1,
 ) -> dict[str, Any]:
-    """Train (or resume training) PPO on ``env_id`` up to ``timesteps`` env steps in total.
+    """Train (or resume training) PPO on ``env_id`` up to ``timesteps`` env steps in total
+    (None: the hyperparameters' ``n_timesteps``, as rl-zoo).
 
     ``algo="ppo_mask"``: sb3-contrib's MaskablePPO (the env has ``action_masks()``); a
     ``behaviour_cloning`` block in the hyperparameters (``episodes``, ``epochs``) first fits
@@ -254,6 +269,12 @@ def train_ppo(
         import torch
 
         torch.set_num_threads(num_threads)
+    if algo not in ALGOS:
+        raise ConfigError(f"unknown algo {algo!r}; known: {list(ALGOS)}")
+    Algo: Any
+    EvalCallback: Any
+    params = load_hyperparams(env_id, hyperparams_path)
+    timesteps = resolve_timesteps(timesteps, params, env_id)
     for name, value in (
         ("timesteps", timesteps),
         ("checkpoint_every", checkpoint_every),
@@ -262,11 +283,6 @@ def train_ppo(
     ):
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise ConfigError(f"{name} must be an integer ≥ 1, got {value!r}")
-    if algo not in ALGOS:
-        raise ConfigError(f"unknown algo {algo!r}; known: {list(ALGOS)}")
-    Algo: Any
-    EvalCallback: Any
-    params = load_hyperparams(env_id, hyperparams_path)
     fine_tuning = dict(params.get("fine_tuning") or {})
     if algo == "ppo":
         if fine_tuning:

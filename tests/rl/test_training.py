@@ -342,3 +342,24 @@ def test_a_killed_training_leaves_no_env_worker_behind(tmp_path):
             return
         time.sleep(0.2)
     pytest.fail("a worker outlived its killed training")
+
+
+def test_the_budget_is_the_yamls_n_timesteps_unless_given(tmp_path):
+    from sfw_gym.rl.training import resolve_timesteps
+
+    assert resolve_timesteps(None, {"n_timesteps": 1e5}, "X") == 100_000  # rl-zoo's float
+    assert resolve_timesteps(64, {"n_timesteps": 1e5}, "X") == 64
+    with pytest.raises(ConfigError, match="set no n_timesteps"):
+        resolve_timesteps(None, {}, "X")
+    with pytest.raises(ConfigError, match="whole number"):
+        resolve_timesteps(None, {"n_timesteps": 10.5}, "X")
+    yml = tmp_path / "ppo.yml"
+    yml.write_text(
+        "SfW-ExploreSmall-v0:\n  policy: MultiInputPolicy\n  n_timesteps: 64\n  n_envs: 1\n"
+        "  n_steps: 32\n  batch_size: 32\n  n_epochs: 1\n  env_kwargs: {max_steps: 40}\n"
+    )
+    summary = train_ppo(
+        "SfW-ExploreSmall-v0", None, tmp_path / "run", hyperparams_path=yml, progress_bar=False,
+        checkpoint_every=64, eval_every=64, eval_episodes=1,
+    )  # fmt: skip
+    assert summary["steps"] == 64
