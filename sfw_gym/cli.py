@@ -400,7 +400,7 @@ EXAMPLES = {
     "record": "sfw-gym record walk.csv --seed 3 --routers 2",
     "slam": "sfw-gym slam drift.csv --record 7",
     "localize": "sfw-gym localize --plans 10 --json localize",
-    "bench": "sfw-gym bench --steps 5000 --resets 50",
+    "speed": "sfw-gym speed --steps 5000 --resets 50",
     "train": "sfw-gym train ppo_mask --env SfW-ExploreRegions-v0 --out runs/regions --resume",
     "evaluate": "sfw-gym evaluate --agents frontier,ppo,greedy --episodes 10 --seed 2000000",
     "benchmark": "sfw-gym benchmark --agent frontier --split test",
@@ -622,7 +622,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     loc.set_defaults(func=_cmd_localize)
 
-    bench = sub.add_parser("bench", help="env steps/s and reset ms beside CartPole-v1")
+    bench = sub.add_parser(
+        "speed",
+        aliases=["bench"],
+        help="the env's throughput: steps/s and reset ms beside CartPole-v1 (alias: bench)",
+    )
     bench.add_argument("--env", default="SfW-Explore-v0", help="env id (default SfW-Explore-v0)")
     bench.add_argument("--steps", type=positive_int, default=5000, help="random steps to time")
     bench.add_argument("--resets", type=positive_int, default=50, help="resets to time")
@@ -755,9 +759,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _add_episode_runner_options(bm)
     bm.set_defaults(func=_cmd_benchmark)
-    for name, command in sub.choices.items():
-        command.formatter_class = HelpWithDefaults
-        command.epilog = f"example:\n  {EXAMPLES[name]}"
+    for name, example in EXAMPLES.items():
+        sub.choices[name].formatter_class = HelpWithDefaults
+        sub.choices[name].epilog = f"example:\n  {example}"
     return parser
 
 

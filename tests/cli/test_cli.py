@@ -43,7 +43,7 @@ INPUTS = {
 
 WORLD = ["world", "--out", "{tmp}/w.png", "--resolution", "0.5"]
 MAP = ["map", "{tmp}/log.csv", "--routers", "0.5,0.5", "--out", "{tmp}/m.png"]
-BENCH = ["bench", "--env", SMALL, "--steps", "20", "--resets", "1"]
+BENCH = ["speed", "--env", SMALL, "--steps", "20", "--resets", "1"]
 EVALUATE = ["evaluate", "--agents", "random", "--episodes", "1", "--env", SMALL, "--workers", "1"]
 EVALUATE += ["--no-progress", "--out", "{tmp}/ev", "--env-kwargs", '{"max_steps": 30}']
 TRAIN = ["train", "ppo", "--env", SMALL, "--timesteps", "32", "--n-envs", "1", "--no-progress"]
@@ -347,14 +347,14 @@ def test_a_failure_is_one_line_and_status_1_and_debug_shows_the_traceback(monkey
         raise RuntimeError("disk on fire")
 
     monkeypatch.setattr(bench, "main_bench", broken)
-    assert main(["bench", "--steps", "1"]) == 1
+    assert main(["speed", "--steps", "1"]) == 1
     err = capsys.readouterr().err
     assert err.strip() == (
-        "sfw-gym bench: error: failed: RuntimeError: disk on fire (run with --debug for the "
+        "sfw-gym speed: error: failed: RuntimeError: disk on fire (run with --debug for the "
         "traceback)"
     )
     with pytest.raises(RuntimeError, match="disk on fire"):
-        main(["--debug", "bench", "--steps", "1"])
+        main(["--debug", "speed", "--steps", "1"])
     with pytest.raises(ConfigError):  # bad input too, with --debug
         main(["--debug", "map", "nope.csv", "--routers", "1,1"])
 
@@ -368,7 +368,7 @@ def test_every_subcommand_shows_its_defaults_and_an_example_that_parses(command)
 
     parser = build_parser()
     sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
-    assert set(sub.choices) == set(EXAMPLES)  # one example per subcommand
+    assert set(sub.choices) == {*EXAMPLES, "bench"}  # one example per subcommand (bench: speed)
     help_text = " ".join(sub.choices[command].format_help().split())
     for action in sub.choices[command]._actions:
         default = action.default
@@ -381,3 +381,4 @@ def test_every_subcommand_shows_its_defaults_and_an_example_that_parses(command)
     assert f"example: {EXAMPLES[command]}" in help_text
     args = parser.parse_args(shlex.split(EXAMPLES[command])[1:])
     assert args.command == command
+    assert sub.choices["bench"] is sub.choices["speed"]  # the old name still works
