@@ -196,6 +196,7 @@ def fresh_interpreters() -> list[dict[str, Any]]:
     return runs
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("variant", VARIANTS, ids=variant_id)
 def test_same_seeds_give_the_same_episode_in_fresh_interpreters(variant, fresh_interpreters):
     here = run_episode(*variant)

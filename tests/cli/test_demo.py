@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import pytest
+
 from sfw_gym.cli import main
 
 
+@pytest.mark.slow
 def test_demo_writes_the_report(tmp_path, capsys):
     out = tmp_path / "report"
     assert main(["demo", "--out", str(out), "--episodes", "1", "--no-progress"]) == 0

@@ -63,6 +63,7 @@ def test_radio_slam_rebuilds_the_map_exactly_along_its_corrected_trajectory():
     np.testing.assert_array_equal(env.odometry_trajectory.view, estimates[:, :2])
 
 
+@pytest.mark.slow
 def test_radio_slam_corrects_the_drift_that_odometry_leaves():
     seeds = (2_000_005, 2_000_006, 2_000_007)
     odometry = np.mean([run("odometry", steps=1500, seed=s)[1]["ate_m"] for s in seeds])

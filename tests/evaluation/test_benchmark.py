@@ -66,6 +66,7 @@ def test_running_the_benchmark_twice_gives_the_same_results_files(tmp_path):
     assert [r["seed"] for r in results["episodes"]] == [1_000_000, 1_000_000]
 
 
+@pytest.mark.slow
 def test_compare_pairs_episodes_and_refuses_other_protocols(tmp_path, capsys):
     common = ["--split", "validation", "--episodes", "1", "--workers", "1", "--no-progress"]
     for agent in ("frontier", "random"):
@@ -102,6 +103,7 @@ def _guide_blocks(language: str) -> list[str]:
     return re.findall(rf"```{language}\n(.*?)```", GUIDE.read_text(encoding="utf-8"), re.S)
 
 
+@pytest.mark.slow
 def test_the_guides_example_agent_runs_through_the_benchmark_as_written(
     tmp_path, monkeypatch, capsys
 ):
