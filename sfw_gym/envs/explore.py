@@ -554,14 +554,19 @@ class SfWExploreEnv(gym.Env):
             self._renderer = None
 
     def config_dict(self) -> dict[str, Any]:
-        """The effective configuration (JSON-serialisable), for logs and reproducibility."""
+        """The effective configuration as the env's kwargs (JSON-serialisable): for logs and
+        reproducibility, ``gym.make(env_id, **config_dict())`` builds the same env."""
+        source = self.floorplan_source
         return {
             **self.config.to_dict(),
             **self.reward_config.to_dict(),
+            "floorplan": str(source) if isinstance(source, Path) else source,
             "generator": self.generator_params,
             "radio": self.radio_config.to_dict(),
             "robot": self.robot_config.to_dict(),
             "mapper": self.mapper_config.to_dict(),
+            "slam": self.slam_config.to_dict(),
+            "lidar": None if self.lidar_config is None else self.lidar_config.to_dict(),
         }
 
 

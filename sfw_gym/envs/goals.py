@@ -141,6 +141,13 @@ class SfWGoalsEnv(gym.Env):
     def close(self) -> None:
         self.explore.close()
 
+    def config_dict(self) -> dict[str, Any]:
+        """The explore env's :meth:`~sfw_gym.envs.explore.SfWExploreEnv.config_dict` plus this
+        env's decisions (``goals``): ``gym.make(env_id, **config_dict())`` builds the same env."""
+        name = self.config.prefix  # the kwarg that takes it: goals, regions
+        assert name is not None
+        return {**self.explore.config_dict(), name: self.config.to_dict()}
+
     def robot_view(self):
         """The explore env's :meth:`~sfw_gym.envs.explore.SfWExploreEnv.robot_view`."""
         return self.explore.robot_view()

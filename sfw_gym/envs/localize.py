@@ -118,6 +118,11 @@ class SfWLocalizeEnv(gym.Env):
     def close(self) -> None:
         self.explore.close()
 
+    def config_dict(self) -> dict[str, Any]:
+        """The explore env's configuration plus ``localize``: ``gym.make(env_id,
+        **config_dict())`` builds the same env."""
+        return {**self.explore.config_dict(), "localize": self.config.to_dict()}
+
     def robot_view(self) -> Any:
         """The explore env's :meth:`~sfw_gym.envs.explore.SfWExploreEnv.robot_view` (for agents;
         its pose is the drifting odometry, not the localiser's estimate)."""

@@ -73,6 +73,10 @@ class SfWRegionsEnv(SfWGoalsEnv):
         self.observation_space = spaces.Dict({**self.observation_space.spaces, **extra})
         self.steering = RegionSteering(self.finder, self.driver, self.config.anchor_cost_per_m)
 
+    def config_dict(self) -> dict[str, Any]:
+        """As the goals env's, with ``regions`` and ``privileged``."""
+        return {**super().config_dict(), "privileged": self.privileged}
+
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
