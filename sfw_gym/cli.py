@@ -315,13 +315,11 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
     from sfw_gym.evaluation import benchmark
 
     if args.action == "compare":
-        if len(args.results) != 2:
-            raise ConfigError(f"benchmark compare takes two results files, got {args.results}")
         a, b = (benchmark.load_results(p) for p in args.results)
         print(benchmark.compare(a, b), end="")
         return 0
-    if args.results or args.agent is None:
-        raise ConfigError("sfw-gym benchmark --agent AGENT [...], or benchmark compare A B")
+    if args.agent is None:
+        raise ConfigError("sfw-gym benchmark run --agent AGENT [...], or benchmark compare A B")
     # an agent of one's own, importable from the current folder (as `python -m` would)
     sys.path.insert(0, str(Path.cwd()))
     out = args.out or f"benchmark/{args.agent.replace(':', '.')}/{args.split}"
@@ -403,7 +401,7 @@ EXAMPLES = {
     "speed": "sfw-gym speed --steps 5000 --resets 50",
     "train": "sfw-gym train ppo_mask --env SfW-ExploreRegions-v0 --out runs/regions --resume",
     "evaluate": "sfw-gym evaluate --agents frontier,ppo,greedy --episodes 10 --seed 2000000",
-    "benchmark": "sfw-gym benchmark --agent frontier --split test",
+    "benchmark": "sfw-gym benchmark run --agent frontier --split test",
 }
 
 
@@ -735,34 +733,74 @@ def build_parser() -> argparse.ArgumentParser:
     bm = sub.add_parser(
         "benchmark",
         help="run an agent through the benchmark protocol, or compare two results files",
-        description="sfw-gym benchmark --agent AGENT [options] | sfw-gym benchmark compare A B",
+        description="sfw-gym benchmark run --agent AGENT [options] | sfw-gym benchmark compare "
+        "A.json B.json (a bare 'sfw-gym benchmark --agent AGENT' runs too)",
     )
-    bm.add_argument(
-        "action", nargs="?", choices=["compare"], default=None, help="compare two results.json"
-    )
-    bm.add_argument("results", nargs="*", help="with compare: A.json B.json (B − A)")
-    bm.add_argument(
-        "--agent", default=None, help="a shipped agent name or package.module:Class of your own"
-    )
-    bm.add_argument("--protocol", default="benchmark-v1", help="protocol name or YAML path")
-    bm.add_argument(
-        "--split", default="test", choices=["train", "validation", "test"], help="default test"
-    )
-    bm.add_argument("--agent-params", default=None, help="the agent's parameters as JSON")
-    bm.add_argument("--seed", type=seed_int, default=0, help="the agent seed (default 0)")
-    bm.add_argument("--plans", default=None, help="a folder of plan files to add (by the split)")
-    bm.add_argument(
-        "--episodes", type=positive_int, default=None, help="at most this many episodes per env"
-    )
-    bm.add_argument(
-        "--out", type=folder, default=None, help="default benchmark/AGENT/SPLIT (resumes)"
-    )
-    _add_episode_runner_options(bm)
+    _add_benchmark_run_options(bm, holds_defaults=True)  # the bare form, kept working
+    actions = bm.add_subparsers(dest="action", metavar="{run,compare}")
+    run = actions.add_parser("run", help="run an agent through the protocol → OUT/results.*")
+    _add_benchmark_run_options(run, holds_defaults=False)
+    compare = actions.add_parser("compare", help="pair two results.json files (B − A)")
+    compare.add_argument("results", nargs=2, metavar="RESULTS", help="A.json B.json")
+    for parser_ in (run, compare):
+        parser_.formatter_class = HelpWithDefaults
     bm.set_defaults(func=_cmd_benchmark)
     for name, example in EXAMPLES.items():
         sub.choices[name].formatter_class = HelpWithDefaults
         sub.choices[name].epilog = f"example:\n  {example}"
     return parser
+
+
+def _add_benchmark_run_options(parser: argparse.ArgumentParser, *, holds_defaults: bool) -> None:
+    """``benchmark run``'s options, on the bare ``benchmark`` (``holds_defaults``: the values
+    when nothing is given) and on ``run`` (no defaults of its own, so that what was given
+    before ``run`` stays)."""
+    defaults = {
+        "agent": None,
+        "protocol": "benchmark-v1",
+        "split": "test",
+        "agent_params": None,
+        "seed": 0,
+        "plans": None,
+        "episodes": None,
+        "out": None,
+        "workers": 2,
+        "backend": "local",
+        "address": None,
+        "no_progress": False,
+    }
+    if holds_defaults:
+        parser.set_defaults(**defaults)
+    bare = {} if holds_defaults else {"default": argparse.SUPPRESS}
+    parser.add_argument(
+        "--agent", **bare, help="a shipped agent name or package.module:Class of your own"
+    )
+    parser.add_argument(
+        "--protocol", **bare, help="protocol name or YAML path (default benchmark-v1)"
+    )
+    parser.add_argument(
+        "--split", **bare, choices=["train", "validation", "test"], help="default test"
+    )
+    parser.add_argument("--agent-params", **bare, help="the agent's parameters as JSON")
+    parser.add_argument("--seed", type=seed_int, **bare, help="the agent seed (default 0)")
+    parser.add_argument("--plans", **bare, help="a folder of plan files to add (by the split)")
+    parser.add_argument(
+        "--episodes", type=positive_int, **bare, help="at most this many episodes per env"
+    )
+    parser.add_argument(
+        "--out", type=folder, **bare, help="default benchmark/AGENT/SPLIT (resumes)"
+    )
+    parser.add_argument("--workers", type=positive_int, **bare, help="worker processes (default 2)")
+    parser.add_argument(
+        "--backend",
+        choices=["local", "ray"],
+        **bare,
+        help="local worker processes or Ray tasks (default local; pip install sfw-gym[ray])",
+    )
+    parser.add_argument(
+        "--address", **bare, help="with --backend ray: a cluster's address ('auto')"
+    )
+    parser.add_argument("--no-progress", action="store_true", **bare, help="no progress bar")
 
 
 def _add_episode_runner_options(parser: argparse.ArgumentParser) -> None:
