@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import logging
 import math
 import sys
 import time
@@ -429,6 +430,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--debug", action="store_true", help="show the traceback of an error (else one line)"
     )
+    noise = parser.add_mutually_exclusive_group()
+    noise.add_argument(
+        "-v", "--verbose", action="count", default=0, help="the library's log: -v info, -vv debug"
+    )
+    noise.add_argument(
+        "-q", "--quiet", action="store_true", help="errors only (no warnings from the library)"
+    )
     sub = parser.add_subparsers(dest="command", required=True)
 
     from sfw_gym.demo import DEMO_EPISODES, DEMO_SEED
@@ -826,6 +834,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     import gymnasium as gym
 
     args = build_parser().parse_args(argv)
+    # -v/-vv raise the package's log only (not numba's or matplotlib's); -q: errors only.
+    levels = (logging.WARNING, logging.INFO, logging.DEBUG)
+    level = logging.ERROR if args.quiet else levels[min(args.verbose, 2)]
+    logging.basicConfig(
+        format="%(levelname)s %(name)s: %(message)s",
+        level=logging.ERROR if args.quiet else logging.WARNING,
+        force=True,
+    )
+    logging.getLogger("sfw_gym").setLevel(level)
     try:
         return args.func(args)
     except (SfwGymError, gym.error.Error) as exc:

@@ -20,6 +20,7 @@ now and then (empty cells). :func:`score_map` puts a map made from such a log (e
 from __future__ import annotations
 
 import json
+import logging
 import os
 from pathlib import Path
 from typing import Any
@@ -32,6 +33,8 @@ from sfw_gym.mapping import GridSpec
 from sfw_gym.mapping.metrics import evaluate_map
 from sfw_gym.world import Floorplan, RadioConfig, RadioModel, place_routers
 from sfw_gym.world.walks import survey, walk
+
+logger = logging.getLogger(__name__)
 
 #: The SfW logs' canvas pixel, metres.
 SFW_PIXEL_M = 0.0115
@@ -157,6 +160,8 @@ def record_log(
         },
     }
     write_text_atomic(paths["json"], json.dumps(meta, indent=2) + "\n")
+    logger.info("%s: %d samples of %s (%s, %d router(s))", out, len(xy), plan.name, trajectory,
+                n_routers)  # fmt: skip
     return paths
 
 

@@ -34,6 +34,7 @@ from __future__ import annotations
 import csv
 import itertools
 import json
+import logging
 import math
 import os
 import re
@@ -50,6 +51,8 @@ from sfw_gym.core.constants import NOT_HEARD_DBM
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.mapping import GridSpec, MapperConfig, SparseInverseKVisibility
 from sfw_gym.mapping.reference import sfw_reference_map
+
+logger = logging.getLogger(__name__)
 
 BANDS = ("2.4", "5")
 #: ``inverse-k``: sparse inverse k-visibility (ours); ``sfw-reference``: the authors' method.
@@ -480,6 +483,11 @@ def map_log(
         mapper = SparseInverseKVisibility(grid, routers_m, config or OFFLINE_CONFIG)
         times = _run_mapper(mapper, log, positions_m, rssi, passes, progress)
         occupancy = mapper.occupancy_u8
+    logger.info(
+        "%s: %d samples mapped by %s (%d pass(es)), %.1f µs a sample",
+        log.path, len(rssi), method, 1 if method == "sfw-reference" else passes,
+        times.mean() * 1e6 if len(times) else 0.0,
+    )  # fmt: skip
     return OfflineMap(
         log=log,
         occupancy_u8=occupancy,

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import copy
 import io
+import logging
 import pathlib
 from collections import defaultdict
 from collections.abc import Iterable
@@ -32,6 +33,8 @@ from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.utils import explained_variance
 from torch import nn
 from torch.nn import functional as F
+
+logger = logging.getLogger(__name__)
 
 
 def _categoricals(dist: MaskableDistribution) -> list[MaskableCategorical]:
@@ -260,8 +263,9 @@ class AnchoredMaskablePPO(MaskablePPO):
                 approx_kls.append(approx_kl)
                 if self.target_kl is not None and approx_kl > 1.5 * self.target_kl:
                     continue_training = False
-                    if self.verbose >= 1:
-                        print(f"Early stopping at step {epoch} due to reaching max kl: {approx_kl}")
+                    logger.info(
+                        "early stopping at epoch %d: KL %.4f over the target", epoch, approx_kl
+                    )
                     break
 
                 policy.optimizer.zero_grad()

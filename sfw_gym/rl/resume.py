@@ -12,6 +12,7 @@ fresh episodes, not exactly).
 
 from __future__ import annotations
 
+import logging
 import pickle
 import random
 import warnings
@@ -23,6 +24,8 @@ import numpy as np
 
 from sfw_gym.core.atomic import atomic_path
 from sfw_gym.core.errors import ConfigError
+
+logger = logging.getLogger(__name__)
 
 
 class Snapshots(gym.Wrapper):
@@ -91,6 +94,7 @@ def save_checkpoint(model: Any, venv: Any, eval_venv: Any, path: Path) -> None:
             tmp.write_bytes(blob)
     with atomic_path(path) as tmp:
         model.save(tmp)
+    logger.info("checkpoint %s", path)
 
 
 def restore_state(model: Any, venv: Any, eval_venv: Any, checkpoint: Path) -> bool:

@@ -17,6 +17,7 @@ Layout of an output folder::
 from __future__ import annotations
 
 import ast
+import logging
 import re
 import shutil
 import sys
@@ -40,6 +41,8 @@ from sfw_gym.rl.resume import (
 )
 
 #: Classes that moved, by their old dotted path: configs and models saved before still load.
+logger = logging.getLogger(__name__)
+
 MOVED_CLASSES = {
     "sfw_gym.agents.waypoint_policy.WaypointPolicy": "sfw_gym.rl.policy.WaypointPolicy",
     "sfw_gym.agents.waypoint_policy.BlockScores": "sfw_gym.rl.policy.BlockScores",
@@ -312,6 +315,8 @@ def train_ppo(
     if resume:
         remove_stale_temps(out)  # of a run killed mid-write
     previous = latest_checkpoint(out, algo) if resume else None
+    if previous is not None:
+        logger.info("%s: resuming from %s (%d steps)", out, previous[0].name, previous[1])
     start_steps = previous[1] if previous else 0
     exact = previous is not None and state_path(previous[0]).is_file()
     if previous is not None and start_steps >= timesteps:  # already there (killed after its last

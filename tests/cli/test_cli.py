@@ -382,3 +382,14 @@ def test_every_subcommand_shows_its_defaults_and_an_example_that_parses(command)
     args = parser.parse_args(shlex.split(EXAMPLES[command])[1:])
     assert args.command == command
     assert sub.choices["bench"] is sub.choices["speed"]  # the old name still works
+
+
+def test_verbose_shows_the_librarys_log_and_quiet_hides_it(tmp_path, capfd):
+    log = tmp_path / "walk.csv"
+    assert main(["-v", "record", str(log), "--routers", "1"]) == 0
+    err = capfd.readouterr().err
+    assert f"INFO sfw_gym.evaluation.logs: {log}: " in err
+    assert main(["-q", "record", str(log), "--routers", "1"]) == 0
+    assert capfd.readouterr().err == ""
+    assert main(["record", str(log), "--routers", "1"]) == 0  # the default: warnings and up
+    assert "INFO" not in capfd.readouterr().err
