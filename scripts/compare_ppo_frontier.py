@@ -1,9 +1,9 @@
-"""The earlier PPO waypoint policy (``ppo-waypoint``) vs frontier on held-out plans (issue 6).
+"""The earlier PPO waypoint policy (``waypoint-ppo``) vs frontier on held-out plans (issue 6).
 
 Usage: ``python scripts/compare_ppo_frontier.py [--episodes 50] [--seed 2000000]
 [--model agents/ppo/SfW-Explore-v0_1] [--out runs/ppo_vs_frontier] [--workers 2]``
 
-Same as ``sfw-gym evaluate --agents ppo-waypoint,frontier --episodes 50 --seed 2000000``, plus a
+Same as ``sfw-gym evaluate --agents waypoint-ppo,frontier --episodes 50 --seed 2000000``, plus a
 check that no evaluation floorplan occurs in the policy's training logs (the monitor CSVs record the
 floorplan of every training and held-out episode), then the Markdown table.
 """
@@ -37,12 +37,12 @@ def main() -> None:
     args = p.parse_args()
     out = Path(args.out)
     result = evaluate(
-        ["ppo-waypoint", "frontier"],
+        ["waypoint-ppo", "frontier"],
         args.episodes,
         args.seed,
         out=out,
         # sampled from the agent's seeded generator, as measured (its default is the mode)
-        agent_params={"ppo-waypoint": {"path": args.model, "deterministic": False}},
+        agent_params={"waypoint-ppo": {"path": args.model, "deterministic": False}},
         workers=args.workers,
     )
     seen = trained_floorplans(Path(args.model))

@@ -35,7 +35,9 @@ TUNED = {
         {"potential_scale": 1.0},
     ),
 }
-DEFAULT_AGENTS = "frontier,ppo,region-teacher,greedy-tuned,frontier-tuned,cross-pass,ppo-goals"
+DEFAULT_AGENTS = (
+    "frontier,regions-ppo,region-teacher,greedy-tuned,frontier-tuned,cross-pass,goals-ppo"
+)
 
 
 def paired_ratio(
@@ -73,8 +75,8 @@ def main() -> None:
         else:
             agents.append(name)
             label[name] = name
-    if args.model and "ppo" in agents:
-        params.setdefault("ppo", {})["path"] = args.model
+    if args.model and "regions-ppo" in agents:
+        params.setdefault("regions-ppo", {})["path"] = args.model
     result = evaluate(
         agents,
         args.episodes,

@@ -16,7 +16,7 @@ from sfw_gym.core.atomic import write_text_atomic
 from sfw_gym.core.data import scenario
 from sfw_gym.evaluation import evaluate
 
-DEMO_AGENTS = ("frontier", "cross-pass", "ppo")
+DEMO_AGENTS = ("frontier", "cross-pass", "regions-ppo")
 DEMO_ENV = "SfW-Explore-v0"  # the shipped policy's env
 #: Floorplan seeds far from those the shipped policy was trained on (its training resets used
 #: seeds 0-3 and their RNG streams; its held-out evaluation 1,000,000+): envs/scenarios.yml.
@@ -49,7 +49,7 @@ def run_demo(
         workers=workers,
         gif_episodes=1,
         progress=progress,
-        agent_params={"ppo": {"path": str(model)}} if model is not None else None,
+        agent_params={"regions-ppo": {"path": str(model)}} if model is not None else None,
     )
     index = out / "index.md"
     wall_s = time.perf_counter() - start

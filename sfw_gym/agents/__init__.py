@@ -8,6 +8,7 @@ Every agent is built with keyword parameters (all optional), bound to an episode
 from __future__ import annotations
 
 import importlib
+import warnings
 from typing import Any
 
 from sfw_gym.agents.base import STOP_REASONS, Agent, RobotView, RobotViewHandle
@@ -27,9 +28,17 @@ AGENTS: dict[str, str] = {
     "greedy": "sfw_gym.agents.greedy:GreedyInfoGainAgent",
     "random": "sfw_gym.agents.random_agent:RandomAgent",
     "region-teacher": "sfw_gym.agents.regions:RegionAgent",
-    "ppo": "sfw_gym.rl.agent:RegionsPPOAgent",
-    "ppo-goals": "sfw_gym.rl.agent:PPOAgent",
-    "ppo-waypoint": "sfw_gym.rl.waypoint_agent:WaypointPPOAgent",
+    # the learned agents, named by what trains them (sfw-gym train ppo_mask / train ppo)
+    "regions-ppo": "sfw_gym.rl.agent:RegionsPPOAgent",
+    "goals-ppo": "sfw_gym.rl.agent:PPOAgent",
+    "waypoint-ppo": "sfw_gym.rl.waypoint_agent:WaypointPPOAgent",
+}
+#: Names of an earlier release, kept for one more: each warns (FutureWarning) and builds the
+#: agent it names now.
+DEPRECATED_AGENTS: dict[str, str] = {
+    "ppo": "regions-ppo",
+    "ppo-goals": "goals-ppo",
+    "ppo-waypoint": "waypoint-ppo",
 }
 
 
@@ -42,10 +51,24 @@ def register_agent(name: str, entry_point: str) -> None:
     AGENTS[name] = entry_point
 
 
+def known_agent(name: str) -> bool:
+    """Whether ``name`` is registered (or a deprecated name of a registered agent)."""
+    return name in AGENTS or name in DEPRECATED_AGENTS
+
+
 def agent_class(name: str) -> type[Agent]:
     """The class registered as ``name``, or named by a ``"module:Class"`` entry point (which
     also reaches the evaluation's worker processes, where a :func:`register_agent` call made in
-    the parent is unknown)."""
+    the parent is unknown). A deprecated name warns and resolves to its new one."""
+    if name in DEPRECATED_AGENTS and name not in AGENTS:
+        new = DEPRECATED_AGENTS[name]
+        warnings.warn(
+            f"agent name {name!r} is deprecated: use {new!r} (the old name goes in the next "
+            "release)",
+            FutureWarning,
+            stacklevel=3,
+        )
+        name = new
     entry_point = AGENTS.get(name) or (name if ":" in name else None)
     module, _, cls = (entry_point or "").partition(":")
     if not (module and cls):
@@ -80,6 +103,7 @@ def make_agent(name: str, **params: Any) -> Agent:
 
 __all__ = [
     "AGENTS",
+    "DEPRECATED_AGENTS",
     "STOP_REASONS",
     "Agent",
     "CrossPassAgent",
@@ -90,6 +114,7 @@ __all__ = [
     "RobotView",
     "RobotViewHandle",
     "agent_class",
+    "known_agent",
     "make_agent",
     "register_agent",
 ]

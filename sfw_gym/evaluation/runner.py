@@ -372,12 +372,12 @@ def evaluate(
     """
     import gymnasium as gym
 
-    from sfw_gym.agents import AGENTS, agent_class, make_agent
+    from sfw_gym.agents import AGENTS, agent_class, known_agent, make_agent
 
     agents = list(dict.fromkeys(agents))
     if not agents:
         raise ConfigError("--agents: give at least one agent")
-    unknown = [a for a in agents if a not in AGENTS and ":" not in a]
+    unknown = [a for a in agents if not known_agent(a) and ":" not in a]
     if unknown:
         raise ConfigError(
             f"--agents: unknown agent(s) {unknown}; known: {sorted(AGENTS)} or a "

@@ -1,12 +1,13 @@
 """The learned menu explorers behind the agents' interface, on the explore env itself.
 
-``ppo`` (:class:`RegionsPPOAgent`, the shipped learned explorer): a model trained on
+``regions-ppo`` (:class:`RegionsPPOAgent`, the shipped learned explorer): a model trained on
 ``SfW-ExploreRegions-v0`` picks a region every 20 steps and the classical steering drives, as
-:class:`~sfw_gym.agents.regions.RegionAgent` does. ``ppo-goals`` (:class:`PPOAgent`): a model
+:class:`~sfw_gym.agents.regions.RegionAgent` does. ``goals-ppo`` (:class:`PPOAgent`): a model
 trained on ``SfW-ExploreGoals-v0`` picks a candidate goal at a time, driven by the same
 :class:`~sfw_gym.navigation.goal_driver.GoalDriver` as in that env. Both act exactly as in
 training and run through ``sfw-gym evaluate`` beside the classical agents (``--agents
-frontier,ppo``; a model of one's own with ``--agent-params '{"ppo": {"path": "runs/regions"}}'``).
+frontier,regions-ppo``; a model of one's own with ``--agent-params '{"regions-ppo": {"path":
+"runs/regions"}}'``).
 """
 
 from __future__ import annotations
@@ -28,8 +29,8 @@ from sfw_gym.navigation.goal_driver import GoalDriver
 
 
 class PPOAgent(Agent):
-    """Acts with a MaskablePPO model over candidate goals (``ppo-goals``: the learned explorer
-    before the region one, which is now ``ppo``).
+    """Acts with a MaskablePPO model over candidate goals (``goals-ppo``: the learned explorer
+    before the region one, which is now ``regions-ppo``).
 
     Args:
         path: A ``sfw-gym train ppo_mask`` output folder (``model.zip``, ``config.yml``) or a
@@ -43,7 +44,7 @@ class PPOAgent(Agent):
         max_steps: Optional step limit of the agent.
     """
 
-    name = "ppo-goals"
+    name = "goals-ppo"
 
     def __init__(
         self,
@@ -157,7 +158,7 @@ class RegionsPPOAgent(RegionAgent):
         max_steps: Optional step limit of the agent.
     """
 
-    name = "ppo"
+    name = "regions-ppo"
 
     def __init__(
         self,

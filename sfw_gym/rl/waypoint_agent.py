@@ -88,7 +88,7 @@ class WaypointPPOAgent(Agent):
         max_steps: Optional step limit of the agent.
     """
 
-    name = "ppo-waypoint"
+    name = "waypoint-ppo"
 
     def __init__(
         self,

@@ -14,6 +14,7 @@ import pytest
 import sfw_gym  # noqa: F401  (registers the envs)
 from sfw_gym.agents import (
     AGENTS,
+    DEPRECATED_AGENTS,
     CrossPassAgent,
     FrontierAgent,
     GreedyInfoGainAgent,
@@ -21,6 +22,7 @@ from sfw_gym.agents import (
     RobotView,
     RobotViewHandle,
     agent_class,
+    known_agent,
     make_agent,
 )
 from sfw_gym.core.errors import ConfigError
@@ -257,7 +259,7 @@ def _reachable(obj: Any, stop: tuple[type, ...]) -> list[Any]:
 
 def env_for(name: str, **kwargs: Any) -> gym.Env:
     """SMALL, except for the shipped learned agents, which need the default 64 x 64 observations."""
-    learned = ("ppo", "ppo-goals", "ppo-waypoint")
+    learned = ("regions-ppo", "goals-ppo", "waypoint-ppo")
     return gym.make("SfW-Explore-v0" if name in learned else SMALL, **kwargs)
 
 
@@ -431,3 +433,10 @@ def test_greedy_gain_prefers_goals_that_open_more_unknown():
     agent.reset(env)
     gain = agent.expected_gain(agent._view(), np.array([[5, 10], [5, 25]]))
     assert gain[1] > gain[0]
+
+
+@pytest.mark.parametrize(("old", "new"), sorted(DEPRECATED_AGENTS.items()))
+def test_an_old_agent_name_warns_and_builds_the_agent_it_names_now(old, new):
+    with pytest.warns(FutureWarning, match=f"agent name {old!r} is deprecated: use {new!r}"):
+        assert agent_class(old) is agent_class(new)
+    assert known_agent(old) and not known_agent("ppo-nonsense")

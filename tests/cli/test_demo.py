@@ -15,7 +15,7 @@ def test_demo_writes_the_report(tmp_path, capsys):
     assert f"report: {out / 'index.md'}" in printed
     assert "| agent | episodes | coverage |" in printed  # the results table, printed too
     index = (out / "index.md").read_text(encoding="utf-8")
-    for agent in ("frontier", "cross-pass", "ppo"):
+    for agent in ("frontier", "cross-pass", "regions-ppo"):
         assert f"| {agent} | 1 |" in index  # a results row per agent
         assert (out / "gifs" / f"{agent}_0000.gif").stat().st_size > 0
     for figure in ("coverage_vs_steps.png", "iou_vs_path.png"):
