@@ -54,6 +54,19 @@ def _small_sum(a):
 
 
 @njit(cache=True)
+def _nearest(x, centers, c2):
+    """The centre nearest ``x`` as scikit-learn finds it: least ``c² − 2xc``, first of ties."""
+    best = c2[0] - 2.0 * (x * centers[0])
+    lab = 0
+    for j in range(1, centers.shape[0]):
+        d = c2[j] - 2.0 * (x * centers[j])
+        if d < best:
+            best = d
+            lab = j
+    return lab
+
+
+@njit(cache=True)
 def _lloyd_1d(xc, init, max_iter, tol):
     """scikit-learn's ``_kmeans_single_lloyd`` (one thread, unit weights) on centred 1-D data.
 
@@ -85,13 +98,7 @@ def _lloyd_1d(xc, init, max_iter, tol):
             weight[j] = 0.0
         for i in range(n):
             x = xc[i]
-            best = c2[0] - 2.0 * (x * centers[0])
-            lab = 0
-            for j in range(1, k):
-                d = c2[j] - 2.0 * (x * centers[j])
-                if d < best:
-                    best = d
-                    lab = j
+            lab = _nearest(x, centers, c2)
             labels[i] = lab
             weight[lab] += 1.0
             new[lab] += x
@@ -151,15 +158,7 @@ def _lloyd_1d(xc, init, max_iter, tol):
         for j in range(k):
             c2[j] = centers[j] * centers[j]
         for i in range(n):
-            x = xc[i]
-            best = c2[0] - 2.0 * (x * centers[0])
-            lab = 0
-            for j in range(1, k):
-                d = c2[j] - 2.0 * (x * centers[j])
-                if d < best:
-                    best = d
-                    lab = j
-            labels[i] = lab
+            labels[i] = _nearest(xc[i], centers, c2)
     inertia = 0.0
     for i in range(n):
         d = xc[i] - centers[labels[i]]
