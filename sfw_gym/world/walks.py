@@ -175,15 +175,18 @@ def walk(
 ) -> np.ndarray:
     """A walk through the building, ``(N, 2)`` metres, a point every ``step_m``.
 
-    Stops are drawn uniformly in the free space (shrunk by ``clearance_m``), one per
-    ``area_per_stop_m2`` (at least 2); the walk starts at the first and always goes on to the
-    nearest stop not yet visited, along collision-free transits.
+    Stops are drawn uniformly in the free space (shrunk by ``clearance_m``; its largest part,
+    where a narrow doorway splits it), one per ``area_per_stop_m2`` (at least 2); the walk
+    starts at the first and always goes on to the nearest stop not yet visited, along
+    collision-free transits.
     """
     if not (step_m > 0 and area_per_stop_m2 > 0):
         raise ConfigError(
             f"step_m and area_per_stop_m2 must be > 0, got {step_m!r}, {area_per_stop_m2!r}"
         )
     region = _region(plan, clearance_m)
+    # one walk cannot cross between parts that a doorway narrower than 2 clearances splits
+    region = max(getattr(region, "geoms", [region]), key=lambda part: part.area)
     n_stops = max(2, round(region.area / area_per_stop_m2))
     xmin, ymin, xmax, ymax = region.bounds
     stops: list[np.ndarray] = []
