@@ -60,7 +60,7 @@ def record_log(
 
     Args:
         plan: The floorplan.
-        out: The CSV path; the ``.truth.npy`` and ``.json`` go beside it.
+        out: The CSV path; the ``.truth.npy`` and ``.truth.json`` go beside it.
         routers: A count (placed by :func:`~sfw_gym.world.place_routers`) or ``(R, 2)`` positions
             in metres. One router writes one RSSI column (2.4 GHz); more write both bands per
             router and the strongest reading as the unnamed last column.
