@@ -9,7 +9,7 @@ import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -779,7 +779,7 @@ def _add_benchmark_run_options(parser: argparse.ArgumentParser, *, holds_default
     }
     if holds_defaults:
         parser.set_defaults(**defaults)
-    bare = {} if holds_defaults else {"default": argparse.SUPPRESS}
+    bare: dict[str, Any] = {} if holds_defaults else {"default": argparse.SUPPRESS}
     parser.add_argument(
         "--agent", **bare, help="a shipped agent name or package.module:Class of your own"
     )
