@@ -15,7 +15,8 @@ import json
 from pathlib import Path
 
 import numpy as np
-from scipy import stats
+
+from sfw_gym.evaluation.stats import ci95_half_width
 
 METRICS = ("coverage", "info_gain_per_m", "free_iou", "wall_precision", "path_length_m", "wall_s")
 
@@ -45,7 +46,7 @@ def main() -> None:
             continue
         a, b = np.array(pairs, np.float64).T
         d = b - a
-        half = stats.t.ppf(0.975, len(d) - 1) * d.std(ddof=1) / np.sqrt(len(d))
+        half = ci95_half_width(d)
         print(
             f"{metric:<18} {a.mean():>10.3f} {b.mean():>10.3f} "
             f"{d.mean():>+12.3f} [{d.mean() - half:+.3f}, {d.mean() + half:+.3f}]"

@@ -16,9 +16,9 @@ from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
-from scipy import stats
 
 import sfw_gym  # noqa: F401  (registration)
+from sfw_gym.evaluation.stats import ci95_half_width
 from sfw_gym.rl.training import train_ppo
 
 ENV_ID = "SfW-ExploreSmall-v0"
@@ -65,7 +65,7 @@ def main() -> None:
     learned = [episode_return(env, s, lambda o: model.predict(o)[0]) for s in seeds]
     random = [episode_return(env, s, lambda o: env.action_space.sample()) for s in seeds]
     diff = np.array(learned) - np.array(random)
-    half = stats.t.ppf(0.975, len(diff) - 1) * diff.std(ddof=1) / np.sqrt(len(diff))
+    half = ci95_half_width(diff)
     print(
         f"{args.episodes} held-out seeds, episode return: PPO {np.mean(learned):.2f} (sampled "
         f"actions), random actions {np.mean(random):.2f}"

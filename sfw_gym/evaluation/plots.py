@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from sfw_gym.core.atomic import atomic_path
+from sfw_gym.evaluation.stats import ci95_half_width
 
 
 def _save_figure(fig: Any, path: Path) -> Path:
@@ -30,8 +31,6 @@ def _colours(agents: Sequence[str]) -> dict[str, Any]:
 
 def _mean_band(curves: list[tuple[np.ndarray, np.ndarray]], grid: np.ndarray):
     """Mean and 95 % CI of step functions sampled on ``grid`` (held at their last value)."""
-    from scipy import stats
-
     ys = []
     for x, y in curves:
         idx = np.clip(np.searchsorted(x, grid, side="right") - 1, 0, len(y) - 1)
@@ -40,8 +39,7 @@ def _mean_band(curves: list[tuple[np.ndarray, np.ndarray]], grid: np.ndarray):
     mean = a.mean(axis=0)
     if len(a) < 2:
         return mean, np.zeros_like(mean)
-    half = stats.t.ppf(0.975, len(a) - 1) * a.std(axis=0, ddof=1) / math.sqrt(len(a))
-    return mean, half
+    return mean, ci95_half_width(a)
 
 
 def plot_curves(records: list[dict[str, Any]], agents: Sequence[str], out: Path) -> list[Path]:

@@ -34,6 +34,15 @@ PAIRED_METRICS: tuple[tuple[str, str, str], ...] = (
 REACHED_METRICS = ("steps_to_coverage_50", "steps_to_coverage_90")
 
 
+def ci95_half_width(samples: np.ndarray) -> np.ndarray | float:
+    """Half-width of the 95 % confidence interval (Student t) of the mean of ``samples`` along
+    its first axis (n ≥ 2): the one t-interval of the package and its scripts."""
+    from scipy import stats
+
+    a = np.asarray(samples, np.float64)
+    return stats.t.ppf(0.975, len(a) - 1) * a.std(axis=0, ddof=1) / math.sqrt(len(a))
+
+
 def mean_ci95(values: Sequence[float]) -> tuple[float, float, int]:
     """Mean, half-width of its 95 % confidence interval (Student t), and n (nan if n = 0)."""
     v = np.asarray([x for x in values if x is not None and math.isfinite(x)], np.float64)
@@ -41,10 +50,7 @@ def mean_ci95(values: Sequence[float]) -> tuple[float, float, int]:
         return math.nan, math.nan, 0
     if len(v) == 1:
         return float(v[0]), math.nan, 1
-    from scipy import stats
-
-    half = float(stats.t.ppf(0.975, len(v) - 1) * v.std(ddof=1) / math.sqrt(len(v)))
-    return float(v.mean()), half, len(v)
+    return float(v.mean()), float(ci95_half_width(v)), len(v)
 
 
 def mean_ci95_text(values: Sequence[float], fmt: str = "{:.2f}") -> str:

@@ -217,6 +217,11 @@ def test_mean_ci95_and_summary():
     assert (mean, n) == (2.5, 4)
     assert half == pytest.approx(3.182446 * np.std([1, 2, 3, 4], ddof=1) / 2, rel=1e-5)
     assert math.isnan(ev.mean_ci95([7.0])[1]) and ev.mean_ci95([])[2] == 0
+    # the same interval column by column (the curves' bands)
+    from sfw_gym.evaluation.stats import ci95_half_width
+
+    cols = ci95_half_width(np.array([[1.0, 10.0], [2.0, 10.0], [3.0, 10.0], [4.0, 10.0]]))
+    np.testing.assert_allclose(cols, [half, 0.0])
     recs = [
         {"agent": "a", "coverage": 0.95, "steps_to_coverage_90": 100, "stop_reason": "x"},
         {"agent": "a", "coverage": 0.5, "steps_to_coverage_90": -1, "stop_reason": "y"},
