@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sfw_gym.core.angles import wrap_angle
 from sfw_gym.core.config import Config, setting
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.localization.gp import SignalModel
@@ -126,7 +127,7 @@ class WifiMCL:
         lx, ly = dx + ex, dy + ey
         self.particles[:, 0] += c * lx - s * ly
         self.particles[:, 1] += s * lx + c * ly
-        self.particles[:, 2] = np.remainder(th + dth + et + np.pi, 2 * np.pi) - np.pi
+        self.particles[:, 2] = wrap_angle(th + dth + et)
 
     def update(self, rssi_dbm: np.ndarray) -> None:
         """Weigh by one reading (Eq. 12–13), resample when the effective sample size drops, and

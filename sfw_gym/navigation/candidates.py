@@ -30,6 +30,7 @@ import numpy as np
 from numba import njit
 from scipy import ndimage
 
+from sfw_gym.core.angles import wrap_angle, wrap_angle_compiled
 from sfw_gym.core.config import Config, setting
 from sfw_gym.core.constants import NOT_HEARD_DBM, U8_FREE_MIN, U8_WALL_MAX
 from sfw_gym.mapping.grid import belief_classes
@@ -354,7 +355,7 @@ class GoalFinder:
         """|bearing from the robot to each cell − heading|, radians in [0, π]."""
         x, y, th = view.odometry_pose
         bearing = np.arctan2(self._row_y[cells[:, 0]] - y, self._col_x[cells[:, 1]] - x) - th
-        return np.abs((bearing + np.pi) % (2 * np.pi) - np.pi)
+        return np.abs(wrap_angle(bearing))
 
     def exclusion(self, view: RobotView) -> np.ndarray:
         """Cells that are no frontier goals: near a bump (walls), failed or walled off, or in a
@@ -792,7 +793,7 @@ def _frontier_menu(
             r = members[k] // w
             c = members[k] - r * w
             bearing = math.atan2(row_y[r] - y, col_x[c] - x) - heading
-            cost[k] = cost[k] + turn * abs((bearing + math.pi) % (2 * math.pi) - math.pi)
+            cost[k] = cost[k] + turn * abs(wrap_angle_compiled(bearing))
     if anchor_r >= 0 and anchor_cost > 0:
         for k in range(len(members)):
             r = members[k] // w

@@ -19,6 +19,7 @@ import numpy as np
 from numba import njit
 from scipy import ndimage
 
+from sfw_gym.core.angles import wrap_angle
 from sfw_gym.mapping.grid import GridSpec, belief_classes
 
 
@@ -387,11 +388,6 @@ def _densified(path, spacing):  # pragma: no cover (compiled)
 def cells_to_world(grid: GridSpec, cells_rc: np.ndarray) -> np.ndarray:
     """World ``(x, y)`` of cell centres, ``(N, 2)``."""
     return grid.cell_to_world(np.asarray(cells_rc).reshape(-1, 2))
-
-
-def wrap_angle(a: float) -> float:
-    """Angle wrapped to [-π, π)."""
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
 @dataclass

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from sfw_gym.core.angles import wrap_angle
 from sfw_gym.core.errors import ConfigError
 
 
@@ -52,5 +53,5 @@ def relative_pose_error(
     c, s = np.cos(mt[:, 2]), np.sin(mt[:, 2])
     dx, dy = me[:, 0] - mt[:, 0], me[:, 1] - mt[:, 1]
     ex, ey = c * dx + s * dy, -s * dx + c * dy  # in the true end frame
-    rot = np.remainder(me[:, 2] - mt[:, 2] + np.pi, 2 * np.pi) - np.pi
+    rot = wrap_angle(me[:, 2] - mt[:, 2])
     return float(np.sqrt(np.mean(ex**2 + ey**2))), float(np.sqrt(np.mean(rot**2)))

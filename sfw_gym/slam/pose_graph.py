@@ -12,20 +12,17 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
+from sfw_gym.core.angles import wrap_angle
 from sfw_gym.core.errors import ConfigError
 
 ROBUST_KERNELS = ("none", "huber", "cauchy")
-
-
-def _wrap(angle: np.ndarray) -> np.ndarray:
-    return (angle + np.pi) % (2.0 * np.pi) - np.pi
 
 
 def relative_pose(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float]:
     """Pose ``b`` seen from pose ``a``: ``(dx, dy, dθ)`` in ``a``'s frame (an odometry edge)."""
     c, s = math.cos(a[2]), math.sin(a[2])
     dx, dy = b[0] - a[0], b[1] - a[1]
-    return c * dx + s * dy, -s * dx + c * dy, float(_wrap(b[2] - a[2]))
+    return c * dx + s * dy, -s * dx + c * dy, float(wrap_angle(b[2] - a[2]))
 
 
 def compose_pose(a: np.ndarray, delta: tuple[float, float, float]) -> np.ndarray:
@@ -48,7 +45,7 @@ def chain(anchor_estimate: np.ndarray, anchor_odometry: np.ndarray, odometry: np
     out = np.empty_like(odometry)
     out[:, 0] = anchor_estimate[..., 0] + c * d[:, 0] - s * d[:, 1]
     out[:, 1] = anchor_estimate[..., 1] + s * d[:, 0] + c * d[:, 1]
-    out[:, 2] = _wrap(odometry[:, 2] + turn)
+    out[:, 2] = wrap_angle(odometry[:, 2] + turn)
     return out
 
 
@@ -100,7 +97,7 @@ class PoseGraph:
         odo, rng = edges
         # the first pose is held where it starts (the gauge)
         prior_w = 1e6
-        res = [prior_w * np.r_[x[0, :2] - anchor[:2], _wrap(x[0, 2] - anchor[2])]]
+        res = [prior_w * np.r_[x[0, :2] - anchor[:2], wrap_angle(x[0, 2] - anchor[2])]]
         rows, cols, vals = [np.arange(3)], [np.arange(3)], [np.full(3, prior_w)]
         n_res = 3
         if len(odo):
@@ -111,7 +108,7 @@ class PoseGraph:
             c, s = np.cos(x[i, 2]), np.sin(x[i, 2])
             local = np.stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]], 1)
             r = np.column_stack(
-                [(local - z[:, :2]) * wxy[:, None], _wrap(x[j, 2] - x[i, 2] - z[:, 2]) * wth]
+                [(local - z[:, :2]) * wxy[:, None], wrap_angle(x[j, 2] - x[i, 2] - z[:, 2]) * wth]
             )
             res.append(r.ravel())
             k = n_res + 3 * np.arange(len(e))
@@ -186,7 +183,7 @@ class PoseGraph:
             while True:
                 step = spsolve(h + sp.diags(lam * diag), -g, permc_spec="MMD_AT_PLUS_A")
                 trial = x + step.reshape(-1, 3)
-                trial[:, 2] = _wrap(trial[:, 2])
+                trial[:, 2] = wrap_angle(trial[:, 2])
                 r_new, _, _ = self._linearize(trial, anchor, weights, edges)
                 new_cost = float(r_new @ r_new)
                 predicted = -2.0 * float(step @ g) - float(step @ (h @ step))

@@ -18,6 +18,7 @@ from typing import ClassVar
 import numpy as np
 from scipy.spatial import cKDTree
 
+from sfw_gym.core.angles import wrap_angle
 from sfw_gym.core.config import Config, brief_repr, float_array, setting
 from sfw_gym.core.errors import ConfigError
 
@@ -191,7 +192,7 @@ def icp(
         c, s = math.cos(dth), math.sin(dth)
         x, y, th = c * x - s * y + tx, s * x + c * y + ty, th + dth
         converged = math.hypot(tx, ty) < cfg.tolerance and abs(dth) < cfg.tolerance
-    th = (th + math.pi) % (2.0 * math.pi) - math.pi
+    th = wrap_angle(th)
     p, idx, dist = pairs((x, y, th))
     if len(p) < 3:
         return failed(len(p), iterations)
