@@ -9,7 +9,7 @@ import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -319,8 +319,6 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
         a, b = (benchmark.load_results(p) for p in args.results)
         print(benchmark.compare(a, b), end="")
         return 0
-    if args.agent is None:
-        raise ConfigError("sfw-gym benchmark run --agent AGENT [...], or benchmark compare A B")
     # an agent of one's own, importable from the current folder (as `python -m` would)
     sys.path.insert(0, str(Path.cwd()))
     out = args.out or f"benchmark/{args.agent.replace(':', '.')}/{args.split}"
@@ -744,10 +742,9 @@ def build_parser() -> argparse.ArgumentParser:
         description="sfw-gym benchmark run --agent AGENT [options] | sfw-gym benchmark compare "
         "A.json B.json (a bare 'sfw-gym benchmark --agent AGENT' runs too)",
     )
-    _add_benchmark_run_options(bm, holds_defaults=True)  # the bare form, kept working
-    actions = bm.add_subparsers(dest="action", metavar="{run,compare}")
+    actions = bm.add_subparsers(dest="action", metavar="{run,compare}", required=True)
     run = actions.add_parser("run", help="run an agent through the protocol → OUT/results.*")
-    _add_benchmark_run_options(run, holds_defaults=False)
+    _add_benchmark_run_options(run)
     compare = actions.add_parser("compare", help="pair two results.json files (B − A)")
     compare.add_argument("results", nargs=2, metavar="RESULTS", help="A.json B.json")
     for parser_ in (run, compare):
@@ -759,56 +756,35 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _add_benchmark_run_options(parser: argparse.ArgumentParser, *, holds_defaults: bool) -> None:
-    """``benchmark run``'s options, on the bare ``benchmark`` (``holds_defaults``: the values
-    when nothing is given) and on ``run`` (no defaults of its own, so that what was given
-    before ``run`` stays)."""
-    defaults = {
-        "agent": None,
-        "protocol": "benchmark-v1",
-        "split": "test",
-        "agent_params": None,
-        "seed": 0,
-        "plans": None,
-        "episodes": None,
-        "out": None,
-        "workers": 2,
-        "backend": "local",
-        "address": None,
-        "no_progress": False,
-    }
-    if holds_defaults:
-        parser.set_defaults(**defaults)
-    bare: dict[str, Any] = {} if holds_defaults else {"default": argparse.SUPPRESS}
+def _add_benchmark_run_options(parser: argparse.ArgumentParser) -> None:
+    """``benchmark run``'s options."""
     parser.add_argument(
-        "--agent", **bare, help="a shipped agent name or package.module:Class of your own"
+        "--agent", required=True, help="a shipped agent name or package.module:Class of your own"
+    )
+    parser.add_argument("--protocol", default="benchmark-v1", help="protocol name or YAML path")
+    parser.add_argument("--split", default="test", choices=["train", "validation", "test"])
+    parser.add_argument("--agent-params", default=None, help="the agent's parameters as JSON")
+    parser.add_argument("--seed", type=seed_int, default=0, help="the agent seed")
+    parser.add_argument(
+        "--plans", default=None, help="a folder of plan files to add (by the split)"
     )
     parser.add_argument(
-        "--protocol", **bare, help="protocol name or YAML path (default benchmark-v1)"
+        "--episodes", type=positive_int, default=None, help="at most this many episodes per env"
     )
     parser.add_argument(
-        "--split", **bare, choices=["train", "validation", "test"], help="default test"
+        "--out", type=folder, default=None, help="default benchmark/AGENT/SPLIT (resumes)"
     )
-    parser.add_argument("--agent-params", **bare, help="the agent's parameters as JSON")
-    parser.add_argument("--seed", type=seed_int, **bare, help="the agent seed (default 0)")
-    parser.add_argument("--plans", **bare, help="a folder of plan files to add (by the split)")
-    parser.add_argument(
-        "--episodes", type=positive_int, **bare, help="at most this many episodes per env"
-    )
-    parser.add_argument(
-        "--out", type=folder, **bare, help="default benchmark/AGENT/SPLIT (resumes)"
-    )
-    parser.add_argument("--workers", type=positive_int, **bare, help="worker processes (default 2)")
-    parser.add_argument(
-        "--backend",
-        choices=["local", "ray"],
-        **bare,
-        help="local worker processes or Ray tasks (default local; pip install sfw-gym[ray])",
-    )
-    parser.add_argument(
-        "--address", **bare, help="with --backend ray: a cluster's address ('auto')"
-    )
-    parser.add_argument("--no-progress", action="store_true", **bare, help="no progress bar")
+    _add_episode_runner_options(parser)
+
+
+def _bare_benchmark_runs(argv: list[str]) -> list[str]:
+    """The form before the subcommands, ``benchmark --agent A ...``, read as ``benchmark run``."""
+    i = next((j for j, token in enumerate(argv) if not token.startswith("-")), None)
+    if i is not None and argv[i] == "benchmark":
+        rest = argv[i + 1 :]
+        if rest and rest[0] not in ("run", "compare", "-h", "--help"):
+            return [*argv[: i + 1], "run", *rest]
+    return argv
 
 
 def _add_episode_runner_options(parser: argparse.ArgumentParser) -> None:
@@ -833,6 +809,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     a one-line error for any other failure (``--debug``: the traceback instead); 130 on Ctrl-C."""
     import gymnasium as gym
 
+    argv = _bare_benchmark_runs(list(sys.argv[1:] if argv is None else argv))
     args = build_parser().parse_args(argv)
     # -v/-vv raise the package's log only (not numba's or matplotlib's); -q: errors only.
     levels = (logging.WARNING, logging.INFO, logging.DEBUG)

@@ -97,14 +97,11 @@ def record_log(
     columns = []
     for band in bands:
         factor = wall_loss_5ghz_factor if band == "5" else 1.0
-        base = RadioConfig.preset("default", band)
+        losses = RadioConfig.preset("default", band).wall_loss_db
         cfg = RadioConfig.preset(
-            "default",
-            band,
-            wall_loss_db={m: v * factor for m, v in base.wall_loss_db.items()},
-            noise_sigma_db=noise_sigma_db,
+            "default", band, wall_loss_db={m: v * factor for m, v in losses.items()}
         )
-        model = RadioModel(plan, routers, cfg, rng)
+        model = RadioModel(plan, routers, cfg, rng)  # mean RSSI; the noise is drawn below
         mean = model.mean_rssi(xy) + rng.uniform(-tx_offset_db, tx_offset_db, n_routers)
         reading = np.rint(mean + rng.normal(0.0, noise_sigma_db, mean.shape))
         reading[(reading < cfg.sensitivity_dbm) | (rng.random(mean.shape) < missed_fraction)] = (

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import ast
 import logging
+import math
 import re
 import shutil
 import sys
@@ -111,9 +112,13 @@ def resolve_timesteps(timesteps: int | None, params: dict[str, Any], env_id: str
         raise ConfigError(
             f"no timesteps given and the hyperparameters of {env_id!r} set no n_timesteps"
         )
-    if float(budget) != int(budget) or int(budget) < 1:
+    try:
+        steps = float(budget)  # rl-zoo writes 1e5 (!!float), YAML may leave "1e5" a string
+    except (TypeError, ValueError):
+        steps = math.nan
+    if not (steps.is_integer() and steps >= 1):
         raise ConfigError(f"n_timesteps of {env_id!r} must be a whole number ≥ 1, got {budget!r}")
-    return int(budget)
+    return int(steps)
 
 
 def parse_policy_kwargs(text: str) -> dict[str, Any]:

@@ -125,13 +125,12 @@ def survey(
         route.extend(seq)
 
     if wall_follow:
-        for poly in getattr(region, "geoms", [region]):
-            for ring in (poly.exterior, *poly.interiors):
-                loop = list(ring.coords)[:-1]
-                if route:  # enter the loop at its point nearest the robot
-                    i = int(np.argmin(np.linalg.norm(np.asarray(loop) - route[-1], axis=1)))
-                    loop = loop[i:] + loop[:i]
-                go([*loop, loop[0]])
+        for ring in (region.exterior, *region.interiors):
+            loop = list(ring.coords)[:-1]
+            if route:  # enter the loop at its point nearest the robot
+                i = int(np.argmin(np.linalg.norm(np.asarray(loop) - route[-1], axis=1)))
+                loop = loop[i:] + loop[:i]
+            go([*loop, loop[0]])
     xmin, ymin, xmax, ymax = region.bounds
     segs, rows = [], []
     for row, y in enumerate(np.arange(ymin + spacing_m / 2, ymax, spacing_m)):
@@ -176,17 +175,15 @@ def walk(
     """A walk through the building, ``(N, 2)`` metres, a point every ``step_m``.
 
     Stops are drawn uniformly in the free space (shrunk by ``clearance_m``; its largest part,
-    where a narrow doorway splits it), one per ``area_per_stop_m2`` (at least 2); the walk
-    starts at the first and always goes on to the nearest stop not yet visited, along
-    collision-free transits.
+    where a narrow doorway splits it), one per ``area_per_stop_m2`` (at least 2); the walk starts
+    at the first and always goes on to the nearest stop not yet visited, along collision-free
+    transits.
     """
     if not (step_m > 0 and area_per_stop_m2 > 0):
         raise ConfigError(
             f"step_m and area_per_stop_m2 must be > 0, got {step_m!r}, {area_per_stop_m2!r}"
         )
     region = _region(plan, clearance_m)
-    # one walk cannot cross between parts that a doorway narrower than 2 clearances splits
-    region = max(getattr(region, "geoms", [region]), key=lambda part: part.area)
     n_stops = max(2, round(region.area / area_per_stop_m2))
     xmin, ymin, xmax, ymax = region.bounds
     stops: list[np.ndarray] = []
@@ -205,10 +202,11 @@ def walk(
 
 
 def _region(plan: Floorplan, clearance_m: float):
-    """The free space shrunk by ``clearance_m``: where a path's points may lie."""
+    """Where a path's points may lie: the free space shrunk by ``clearance_m``, its largest part
+    where a doorway narrower than two clearances splits it (no path may jump between parts)."""
     region = plan.free_space.buffer(-clearance_m)
     if region.is_empty:
         raise ConfigError(
             f"floorplan {plan.name!r}: no free space is {clearance_m} m from every wall"
         )
-    return region
+    return max(getattr(region, "geoms", [region]), key=lambda part: part.area)

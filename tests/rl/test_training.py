@@ -348,11 +348,14 @@ def test_the_budget_is_the_yamls_n_timesteps_unless_given(tmp_path):
     from sfw_gym.rl.training import resolve_timesteps
 
     assert resolve_timesteps(None, {"n_timesteps": 1e5}, "X") == 100_000  # rl-zoo's float
+    assert resolve_timesteps(None, {"n_timesteps": "2e3"}, "X") == 2_000  # YAML without !!float
     assert resolve_timesteps(64, {"n_timesteps": 1e5}, "X") == 64
     with pytest.raises(ConfigError, match="set no n_timesteps"):
         resolve_timesteps(None, {}, "X")
     with pytest.raises(ConfigError, match="whole number"):
         resolve_timesteps(None, {"n_timesteps": 10.5}, "X")
+    with pytest.raises(ConfigError, match="whole number"):
+        resolve_timesteps(None, {"n_timesteps": "many"}, "X")
     yml = tmp_path / "ppo.yml"
     yml.write_text(
         "SfW-ExploreSmall-v0:\n  policy: MultiInputPolicy\n  n_timesteps: 64\n  n_envs: 1\n"
