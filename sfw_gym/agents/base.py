@@ -16,6 +16,10 @@ An agent is built with keyword parameters only (every one has a default), bound 
 handle can call ``env.unwrapped.robot_view()`` (the robot's belief map, odometry pose, router
 positions, RSSI history, bump flag) and nothing more. Ground truth (the floorplan, the true pose,
 the true k-values) stays out of reach.
+
+Without the env at hand (a ``gymnasium.vector`` env, another process, RLlib), an agent acts on
+what the env returns: wrap it in :class:`~sfw_gym.envs.robot_view_info.RobotViewInInfo`, then
+``agent.reset(info=info, seed=0)`` and ``agent.act(obs, info)`` read ``info["robot_view"]``.
 """
 
 from __future__ import annotations
@@ -104,6 +108,18 @@ class RobotViewHandle:
         raise TypeError("a RobotViewHandle is bound to a live env and cannot be pickled")
 
 
+def _view_in(info: Any, agent: str, method: str) -> RobotView:
+    """``info["robot_view"]``, or a ConfigError naming the agent and the method."""
+    view = info.get("robot_view") if isinstance(info, dict) else None
+    if not isinstance(view, RobotView):
+        got = type(info).__name__ if not isinstance(info, dict) else f"keys {sorted(info)}"
+        raise ConfigError(
+            f"{agent}.{method}(info=...) needs info['robot_view'] (a RobotView; wrap the env in "
+            f"RobotViewInInfo), got {got}"
+        )
+    return view
+
+
 class Agent(ABC):
     """Base class of the baseline agents.
 
@@ -130,21 +146,36 @@ class Agent(ABC):
         self.stop_reason: str | None = None
         self.steps = 0
         self._view: RobotViewHandle | None = None
+        self._episode_started = False
         self.rng = np.random.default_rng()
         self.action_type = "continuous"
         self.trajectory: list[tuple[float, float]] = []
         self.last_command = (0.0, 0.0)
         self.decisions: list[Decision] = []
 
-    def reset(self, env: Any, seed: int | None = None) -> None:
-        """Bind the agent to ``env``'s current episode (call after ``env.reset``).
+    def reset(
+        self, env: Any = None, seed: int | None = None, *, info: dict[str, Any] | None = None
+    ) -> None:
+        """Start an episode (call after ``env.reset``).
 
         Args:
             env: The environment; only its ``unwrapped.robot_view()`` is kept and used.
             seed: Seed of the agent's own random generator.
+            info: Instead of ``env``: the reset's info holding ``"robot_view"``
+                (:class:`~sfw_gym.envs.robot_view_info.RobotViewInInfo`); then every
+                :meth:`act` needs the step's info too.
         """
-        self._view = RobotViewHandle(env)
-        view = self._view()
+        if info is not None:
+            self._view = None
+            view = _view_in(info, type(self).__name__, "reset")
+        elif env is not None:
+            self._view = RobotViewHandle(env)
+            view = self._view()
+        else:
+            raise ConfigError(
+                f"{type(self).__name__}.reset() needs the env or the reset's info "
+                "(with info['robot_view']: wrap the env in RobotViewInInfo)"
+            )
         if view.action_type not in self.action_types:
             raise ConfigError(
                 f"{type(self).__name__} supports action types {self.action_types}, "
@@ -152,6 +183,7 @@ class Agent(ABC):
             )
         self.action_type = view.action_type
         self.rng = np.random.default_rng(seed)
+        self._episode_started = True
         self.stop_reason = None
         self.steps = 0
         self.trajectory = []
@@ -159,11 +191,22 @@ class Agent(ABC):
         self.decisions = []
         self._on_reset(view)
 
-    def act(self, obs: Any = None) -> Any:
-        """The next action: ``np.float32 (linear, angular)`` or a discrete action ``int``."""
-        if self._view is None:
-            raise RuntimeError(f"{type(self).__name__}.act() called before reset(env)")
-        view = self._view()
+    def act(self, obs: Any = None, info: dict[str, Any] | None = None) -> Any:
+        """The next action: ``np.float32 (linear, angular)`` or a discrete action ``int``.
+
+        ``info``: the last step's info; its ``"robot_view"`` is used when there (see
+        :meth:`reset`), else the env bound at reset.
+        """
+        if info is not None and "robot_view" in info:
+            view = _view_in(info, type(self).__name__, "act")
+        elif self._view is not None:
+            view = self._view()
+        elif not self._episode_started:
+            raise RuntimeError(f"{type(self).__name__}.act() called before reset()")
+        else:
+            raise ConfigError(
+                f"{type(self).__name__}.act() needs info['robot_view'] (it was reset from an info)"
+            )
         self.trajectory.append((float(view.odometry_pose[0]), float(view.odometry_pose[1])))
         if self.max_steps is not None and self.steps >= self.max_steps:
             self._stop("max_steps")

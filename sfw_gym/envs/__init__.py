@@ -94,6 +94,10 @@ def __getattr__(name: str) -> Any:
         from sfw_gym.envs.regions import SfWRegionsEnv
 
         return SfWRegionsEnv
+    if name == "RobotViewInInfo":
+        from sfw_gym.envs.robot_view_info import RobotViewInInfo
+
+        return RobotViewInInfo
     if name == "WaypointWrapper":
         from sfw_gym.envs.waypoint import WaypointWrapper
 

@@ -349,6 +349,58 @@ def test_act_before_reset_and_bad_parameters_raise():
         make_agent("frontier", nope=1)
 
 
+# ------------------------------------------------------------------------------ acting on info
+def _env_bound_actions(name: str, seed: int, steps: int) -> list[np.ndarray]:
+    env, agent = gym.make(SMALL), make_agent(name)
+    obs, _ = env.reset(seed=seed)
+    agent.reset(env, seed=seed)
+    actions = []
+    for _ in range(steps):
+        actions.append(np.asarray(agent.act(obs)))
+        obs, *_ = env.step(actions[-1])
+    return actions
+
+
+@pytest.mark.parametrize("name", ["frontier", "cross-pass"])
+def test_an_agent_acts_on_the_info_of_a_vector_env_as_it_does_on_the_env(name):
+    from sfw_gym.envs import RobotViewInInfo
+
+    seeds, steps = [5, 6], 60
+    envs = gym.make_vec(SMALL, num_envs=2, vectorization_mode="sync", wrappers=[RobotViewInInfo])
+    agents = [make_agent(name) for _ in seeds]
+    _, info = envs.reset(seed=seeds)
+    for i, agent in enumerate(agents):
+        agent.reset(info={"robot_view": info["robot_view"][i]}, seed=seeds[i])
+    got: list[list[np.ndarray]] = [[], []]
+    for _ in range(steps):
+        actions = []
+        for i, agent in enumerate(agents):
+            actions.append(np.asarray(agent.act(None, {"robot_view": info["robot_view"][i]})))
+            got[i].append(actions[-1])
+        _, _, terminated, truncated, info = envs.step(np.stack(actions))
+        assert not (terminated | truncated).any()
+    for i, seed in enumerate(seeds):
+        expected = _env_bound_actions(name, seed, steps)
+        np.testing.assert_array_equal(np.array(got[i]), np.array(expected))
+
+
+def test_acting_on_info_without_the_view_is_a_clear_error():
+    from sfw_gym.envs import RobotViewInInfo
+
+    env = RobotViewInInfo(gym.make(SMALL))
+    obs, info = env.reset(seed=0)
+    agent = FrontierAgent()
+    with pytest.raises(ConfigError, match="needs the env or the reset's info"):
+        agent.reset(seed=0)
+    with pytest.raises(ConfigError, match=r"info\['robot_view'\].*got keys"):
+        agent.reset(info={"coverage": 0.0})
+    agent.reset(info=info, seed=0)
+    with pytest.raises(ConfigError, match=r"needs info\['robot_view'\]"):
+        agent.act(obs)
+    with pytest.raises(ConfigError, match="robot_view"):
+        RobotViewInInfo(gym.make("CartPole-v1"))
+
+
 # ------------------------------------------------------------------------------ planning
 def test_costs_make_walls_obstacles_and_unknown_dearer():
     b = np.full((10, 10), F, np.uint8)
