@@ -107,7 +107,7 @@ def run(job: dict[str, Any]) -> dict[str, Any]:
         record[f"lidar_map_{name}"] = _scores(m, est, truth_u8)
         maps[f"LiDAR map, {name}"] = est
     for name, poses in (("radio_slam", trajectories["radio_slam"]), ("true", truth)):
-        mapper = SparseInverseKVisibility(u.grid, u.scene.radio.routers, u.mapper_config)
+        mapper = SparseInverseKVisibility(u.grid, u.scene.radio.routers, u.config.mapper)
         x0, y0, x1, y1 = u.grid.bounds
         for (x, y, theta), reading, bump in zip(poses, rssi, bumps, strict=True):
             if x0 <= x < x1 and y0 <= y < y1:  # as the env: nothing fused off the map

@@ -118,7 +118,7 @@ def remap_with_router_error(record: dict[str, Any], error_m: float, seed: int) -
     routers = np.array(record["routers"]) + error_m * np.column_stack(
         [np.cos(angle), np.sin(angle)]
     )
-    mapper = SparseInverseKVisibility(u.grid, routers, u.mapper_config)
+    mapper = SparseInverseKVisibility(u.grid, routers, u.config.mapper)
     for (x, y, theta), rssi, bump in zip(
         record["log"]["truth"], record["rssi"], record["log"]["bump"], strict=True
     ):

@@ -198,7 +198,7 @@ def _record_slam_log(path: str, env_id: str, seed: int, steps: int) -> RadioSlam
     from sfw_gym.evaluation.drives import record_frontier_drive
     from sfw_gym.slam.offline import write_slam_log
 
-    if not unwrap_sfw(gym.make(env_id)).n_background_aps:
+    if not unwrap_sfw(gym.make(env_id)).config.explore.n_background_aps:
         raise ConfigError(f"--env {env_id}: has no background access points to fingerprint")
     drive = record_frontier_drive(env_id, seed, steps)
     write_slam_log(
@@ -223,6 +223,9 @@ def _cmd_localize(args: argparse.Namespace) -> int:
         particles=args.particles,
         direct=not args.no_direct,
         workers=args.workers,
+        backend=args.backend,
+        address=args.address,
+        progress=not args.no_progress,
     )
     print(summary["markdown"])
     print(f"wrote {args.json}/results.json, tables.md, gridmaps.png, error_over_time.png")
@@ -620,7 +623,7 @@ def build_parser() -> argparse.ArgumentParser:
     loc.add_argument(
         "--no-direct", action="store_true", help="skip MCL on direct GP prediction (the slow part)"
     )
-    loc.add_argument("--workers", type=positive_int, default=2, help="worker processes")
+    _add_episode_runner_options(loc)
     loc.add_argument(
         "--json", type=folder, default="localize", help="output folder (default localize/)"
     )
@@ -788,7 +791,8 @@ def _bare_benchmark_runs(argv: list[str]) -> list[str]:
 
 
 def _add_episode_runner_options(parser: argparse.ArgumentParser) -> None:
-    """Where episodes run: ``--workers``, ``--backend``, ``--address``, ``--no-progress``."""
+    """Where the jobs (episodes, the study's plans) run, the executor's options: ``--workers``,
+    ``--backend``, ``--address``, ``--no-progress``."""
     parser.add_argument(
         "--workers", type=positive_int, default=2, help="worker processes (default 2)"
     )
@@ -796,7 +800,7 @@ def _add_episode_runner_options(parser: argparse.ArgumentParser) -> None:
         "--backend",
         choices=["local", "ray"],
         default="local",
-        help="run episodes in local worker processes or as Ray tasks (pip install sfw-gym[ray])",
+        help="run the jobs in local worker processes or as Ray tasks (pip install sfw-gym[ray])",
     )
     parser.add_argument(
         "--address", default=None, help="with --backend ray: a cluster's address ('auto')"

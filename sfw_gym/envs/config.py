@@ -1,12 +1,19 @@
-"""The env's own settings (beside the radio, robot, mapper and generator configs it composes)."""
+"""Every setting of an SfW-Explore env as one tree (:class:`EnvConfig`), read once from the
+``gym.make`` keyword arguments and written back as them (:meth:`EnvConfig.to_kwargs`)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import ClassVar
+from dataclasses import dataclass, fields
+from pathlib import Path
+from typing import Any, ClassVar
 
-from sfw_gym.core.config import Config, setting
+from sfw_gym.core.config import Config, setting, unknown_key_error
 from sfw_gym.core.errors import ConfigError
+from sfw_gym.mapping import MapperConfig
+from sfw_gym.slam import RadioSlamConfig
+from sfw_gym.world import RadioConfig, RobotConfig
+from sfw_gym.world.generator import GeneratorConfig
+from sfw_gym.world.lidar import LidarConfig
 from sfw_gym.world.radio import BANDS, PRESETS
 
 ACTION_TYPES = ("continuous", "discrete")
@@ -56,3 +63,97 @@ class ExploreConfig(Config):
                 f"pose_source={self.pose_source!r} closes loops with background access points: "
                 "pass n_background_aps >= 1 (SfW-ExploreRadioSLAM-v0 has 16)"
             )
+
+
+#: The ``gym.make`` keywords that are dicts of a subsystem's overrides.
+SUBSYSTEMS = ("generator", "radio", "robot", "mapper", "slam", "lidar")
+
+
+@dataclass(frozen=True)
+class EnvConfig:
+    """The env's whole configuration: its own settings, the reward, and each subsystem's config.
+
+    Built once by :meth:`from_kwargs` (which fills the defaults that depend on other settings:
+    the mapper's no-wall level from the radio, Radio SLAM's odometry weights from the robot's
+    noise); :meth:`to_kwargs` gives keyword arguments that build the same env.
+    """
+
+    explore: ExploreConfig
+    reward: RewardConfig
+    floorplan: int | str | None
+    generator: GeneratorConfig
+    radio: RadioConfig
+    robot: RobotConfig
+    mapper: MapperConfig
+    slam: RadioSlamConfig
+    lidar: LidarConfig | None  # None: no LiDAR
+
+    @classmethod
+    def from_kwargs(cls, floorplan: Any = None, **kwargs: Any) -> EnvConfig:
+        """The tree from ``gym.make`` keywords (see ``SfWExploreEnv``); a ConfigError names an
+        unknown keyword with the nearest valid one."""
+        flat = {f.name for f in fields(ExploreConfig)} | {f.name for f in fields(RewardConfig)}
+        for key in kwargs:
+            if key not in flat and key not in SUBSYSTEMS:
+                raise unknown_key_error(
+                    "SfW-Explore kwargs", key, [*flat, *SUBSYSTEMS, "floorplan"]
+                )
+        explore = ExploreConfig(**{k: v for k, v in kwargs.items() if k in _fields(ExploreConfig)})
+        reward = RewardConfig(**{k: v for k, v in kwargs.items() if k in _fields(RewardConfig)})
+        sub = {name: _overrides(name, kwargs.get(name)) for name in SUBSYSTEMS}
+        radio = RadioConfig.preset(explore.radio_preset, band=explore.radio_band, **sub["radio"])
+        robot = RobotConfig.from_dict(sub["robot"], "robot")
+        # The robot knows its routers: their RSSI at 1 m with no wall (P_tx − PL(1 m)) calibrates
+        # k = 0, so a router first heard through a wall is not read one wall short
+        # (distance-aware estimation only: raw RSSI has no fixed no-wall level).
+        mapper_defaults: dict[str, Any] = {"robot_radius_m": robot.radius_m}
+        if sub["mapper"].get("k_estimator", "distance_aware") == "distance_aware":
+            mapper_defaults["k0_level_dbm"] = radio.tx_power_dbm - radio.d0_loss_db
+        # Radio SLAM weighs odometry by the robot's own noise model (per step, at full speed).
+        full_step_m = robot.max_linear_speed_m_s * robot.control_period_s
+        slam_defaults = {
+            "odometry_sigma_m": max(robot.odometry_translation_std * full_step_m, 1e-3),
+            "odometry_sigma_rad": max(robot.odometry_heading_std_rad, 1e-3),
+        }
+        lidar = kwargs.get("lidar")
+        config = cls(
+            explore=explore,
+            reward=reward,
+            floorplan=str(floorplan) if isinstance(floorplan, Path) else floorplan,
+            generator=GeneratorConfig.from_dict(sub["generator"], "generator"),
+            radio=radio,
+            robot=robot,
+            mapper=MapperConfig.from_dict({**mapper_defaults, **sub["mapper"]}, "mapper"),
+            slam=RadioSlamConfig.from_dict({**slam_defaults, **sub["slam"]}, "slam"),
+            lidar=None if lidar is None else LidarConfig.from_dict(lidar, "lidar"),
+        )
+        if explore.pose_source == "radio_lidar" and config.lidar is None:
+            raise ConfigError("pose_source='radio_lidar' matches LiDAR scans: pass lidar={} (on)")
+        return config
+
+    def to_kwargs(self) -> dict[str, Any]:
+        """JSON-serialisable ``gym.make`` keywords: ``gym.make(id, **to_kwargs())`` builds the
+        same env (every subsystem in full, so a changed default cannot change a logged run)."""
+        return {
+            **self.explore.to_dict(),
+            **self.reward.to_dict(),
+            "floorplan": self.floorplan,
+            "generator": self.generator.to_dict(),
+            "radio": self.radio.to_dict(),
+            "robot": self.robot.to_dict(),
+            "mapper": self.mapper.to_dict(),
+            "slam": self.slam.to_dict(),
+            "lidar": None if self.lidar is None else self.lidar.to_dict(),
+        }
+
+
+def _fields(cls: type) -> set[str]:
+    return {f.name for f in fields(cls)}
+
+
+def _overrides(name: str, values: Any) -> dict[str, Any]:
+    if values is None:
+        return {}
+    if not isinstance(values, dict):
+        raise ConfigError(f"{name} must be a dict of overrides, got {type(values).__name__}")
+    return values

@@ -15,7 +15,7 @@ from sfw_gym.core.buffers import AppendOnlyArray
 from sfw_gym.core.config import brief_repr, float_array, unknown_key_error
 from sfw_gym.core.constants import DISCRETE_ACTION_NAMES, DISCRETE_ACTIONS, NOT_HEARD_DBM
 from sfw_gym.core.errors import ConfigError
-from sfw_gym.envs.config import RESET_OPTIONS, ExploreConfig, RewardConfig
+from sfw_gym.envs.config import RESET_OPTIONS, EnvConfig
 from sfw_gym.envs.episode import EpisodeScene, GroundTruth, build_scene
 from sfw_gym.envs.map_history import MapHistory
 from sfw_gym.envs.map_tracker import MapTracker
@@ -25,12 +25,11 @@ from sfw_gym.envs.observation import (
     lidar_observation,
     observation_space,
 )
-from sfw_gym.mapping import GridSpec, MapperConfig, SparseInverseKVisibility
+from sfw_gym.mapping import GridSpec, SparseInverseKVisibility
 from sfw_gym.navigation.view import RobotView
-from sfw_gym.slam import OnlineRadioLidarSlam, OnlineRadioSlam, RadioSlamConfig
-from sfw_gym.world import Floorplan, Pose, RadioConfig, RobotConfig
-from sfw_gym.world.generator import GeneratorConfig
-from sfw_gym.world.lidar import Lidar, LidarConfig
+from sfw_gym.slam import OnlineRadioLidarSlam, OnlineRadioSlam
+from sfw_gym.world import Floorplan, Pose
+from sfw_gym.world.lidar import Lidar
 
 
 class SfWExploreEnv(gym.Env):
@@ -149,77 +148,38 @@ class SfWExploreEnv(gym.Env):
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "
                 f"got {render_mode!r}"
             )
-        self.config = ExploreConfig(
+        self.config = EnvConfig.from_kwargs(
             action_type=action_type,
+            floorplan=floorplan,
+            generator=generator,
             n_routers=n_routers,
             radio_preset=radio_preset,
             radio_band=radio_band,
+            radio=radio,
+            robot=robot,
+            mapper=mapper,
             resolution_m=resolution_m,
             map_px=map_px,
             crop_px=crop_px,
+            coverage_target=coverage_target,
+            collision_penalty=collision_penalty,
+            reward_scale=reward_scale,
             max_steps=max_steps,
             steps_per_m2=steps_per_m2,
             n_background_aps=n_background_aps,
             pose_source=pose_source,
+            slam=slam,
+            lidar=lidar,
         )
-        self.reward_config = RewardConfig(
-            reward_scale=reward_scale,
-            collision_penalty=collision_penalty,
-            coverage_target=coverage_target,
-        )
-        cfg = self.config
-        self.action_type = cfg.action_type
-        self.floorplan_source = floorplan
-        self.generator_params = GeneratorConfig.from_dict(generator, "generator").to_dict()
-        self.n_routers = cfg.n_routers
-        self.radio_config = RadioConfig.preset(
-            cfg.radio_preset, band=cfg.radio_band, **_overrides("radio", radio)
-        )
-        self.robot_config = RobotConfig.from_dict(robot, "robot")
-        # The robot knows its routers: their RSSI at 1 m with no wall (P_tx − PL(1 m)) calibrates
-        # k = 0, so a router first heard through a wall is not read one wall short.
-        # (distance-aware estimation only: raw RSSI has no fixed no-wall level).
-        mapper_defaults: dict[str, Any] = {"robot_radius_m": self.robot_config.radius_m}
-        if _overrides("mapper", mapper).get("k_estimator", "distance_aware") == "distance_aware":
-            k0 = self.radio_config.tx_power_dbm - self.radio_config.d0_loss_db
-            mapper_defaults["k0_level_dbm"] = k0
-        self.mapper_config = MapperConfig.from_dict(
-            {**mapper_defaults, **_overrides("mapper", mapper)}, "mapper"
-        )
-        self.resolution_m = cfg.resolution_m
-        self.map_px, self.crop_px = cfg.map_px, cfg.crop_px
-        self.coverage_target = self.reward_config.coverage_target
-        self.collision_penalty = self.reward_config.collision_penalty
-        self.reward_scale = self.reward_config.reward_scale
-        self.max_steps = cfg.max_steps
-        self.steps_per_m2 = cfg.steps_per_m2
+        cfg = self.config.explore
         self.render_mode = render_mode
         self.render_size = _frame_size(render_size)
-        self._folder_plans = _folder_plans(floorplan)
-
-        self.n_background_aps = cfg.n_background_aps
-        self.pose_source = cfg.pose_source
-        # Radio SLAM weighs odometry by the robot's own noise model (per step, at full speed).
-        rc = self.robot_config
-        full_step_m = rc.max_linear_speed_m_s * rc.control_period_s
-        slam_defaults = {
-            "odometry_sigma_m": max(rc.odometry_translation_std * full_step_m, 1e-3),
-            "odometry_sigma_rad": max(rc.odometry_heading_std_rad, 1e-3),
-        }
-        self.slam_config = RadioSlamConfig.from_dict(
-            {**slam_defaults, **_overrides("slam", slam)}, "slam"
-        )
-        self.lidar_config = None if lidar is None else LidarConfig.from_dict(lidar, "lidar")
-        if self.pose_source == "radio_lidar" and self.lidar_config is None:
-            raise ConfigError("pose_source='radio_lidar' matches LiDAR scans: pass lidar={} (on)")
+        self._folder_plans = _folder_plans(self.config.floorplan)
+        lidar_beams = self.config.lidar.beams if self.config.lidar else 0
         self.observation_space = observation_space(
-            n_routers,
-            map_px,
-            crop_px,
-            cfg.n_background_aps,
-            self.lidar_config.beams if self.lidar_config else 0,
+            cfg.n_routers, cfg.map_px, cfg.crop_px, cfg.n_background_aps, lidar_beams
         )
-        if action_type == "continuous":
+        if cfg.action_type == "continuous":
             self.action_space = spaces.Box(-1.0, 1.0, (2,), np.float32)
         else:
             self.action_space = spaces.Discrete(len(DISCRETE_ACTIONS))
@@ -237,30 +197,32 @@ class SfWExploreEnv(gym.Env):
             if key not in RESET_OPTIONS:
                 raise unknown_key_error("reset options", key, RESET_OPTIONS)
         plan = options.get("floorplan", self._default_floorplan())
+        config = self.config
+        explore = config.explore
         self.scene = build_scene(
             plan,
-            routers=options.get("routers", self.n_routers),
-            max_routers=self.n_routers,
+            routers=options.get("routers", explore.n_routers),
+            max_routers=explore.n_routers,
             start_pose=options.get("start_pose"),
-            radio_config=self.radio_config,
-            robot_config=self.robot_config,
-            resolution_m=self.resolution_m,
+            radio_config=config.radio,
+            robot_config=config.robot,
+            resolution_m=explore.resolution_m,
             rng=self.np_random,
-            generator_params=self.generator_params,
-            n_background_aps=self.n_background_aps,
+            generator_params=config.generator.to_dict(),
+            n_background_aps=explore.n_background_aps,
         )
         s = self.scene
-        self.grid = GridSpec(s.grid_origin, self.resolution_m, s.truth_u8.shape)
+        self.grid = GridSpec(s.grid_origin, explore.resolution_m, s.truth_u8.shape)
         self._grid_bounds = self.grid.bounds
-        self.mapper = SparseInverseKVisibility(self.grid, s.radio.routers, self.mapper_config)
+        self.mapper = SparseInverseKVisibility(self.grid, s.radio.routers, config.mapper)
         self.tracker = MapTracker(s.truth_u8)
         self.obs_builder = ObservationBuilder(
-            self.grid, s.radio.routers, self.n_routers, self.map_px, self.crop_px
+            self.grid, s.radio.routers, explore.n_routers, explore.map_px, explore.crop_px
         )
-        self.episode_max_steps = self.max_steps
-        if self.steps_per_m2 is not None:
-            budget = math.ceil(self.steps_per_m2 * s.floorplan.area_m2)
-            self.episode_max_steps = max(1, min(self.max_steps, budget))
+        self.episode_max_steps = explore.max_steps
+        if explore.steps_per_m2 is not None:
+            budget = math.ceil(explore.steps_per_m2 * s.floorplan.area_m2)
+            self.episode_max_steps = max(1, min(explore.max_steps, budget))
         self.steps = 0
         self.path_length_m = 0.0
         self.collisions = 0
@@ -275,15 +237,15 @@ class SfWExploreEnv(gym.Env):
         self.pose_estimates = AppendOnlyArray(3, np.float64)
         self.pose_estimate = s.robot.odometry_pose
         self._squared_pose_errors = 0.0
-        self.lidar = None if self.lidar_config is None else Lidar(s.floorplan, self.lidar_config)
+        self.lidar = None if config.lidar is None else Lidar(s.floorplan, config.lidar)
         self.slam: OnlineRadioSlam | None = None
         self.map_history: MapHistory | None = None
-        if self.pose_source == "radio_slam":
-            self.slam = OnlineRadioSlam(self.slam_config)
-        elif self.pose_source == "radio_lidar":
-            self.slam = OnlineRadioLidarSlam(self.slam_config)
+        if explore.pose_source == "radio_slam":
+            self.slam = OnlineRadioSlam(config.slam)
+        elif explore.pose_source == "radio_lidar":
+            self.slam = OnlineRadioLidarSlam(config.slam)
         if self.slam is not None:
-            self.map_history = MapHistory(self.slam_config.solve_every)
+            self.map_history = MapHistory(config.slam.solve_every)
         self.last_gain_bits = 0.0
         self.last_rays: np.ndarray = np.zeros(0, np.int64)
         obs = self._sense_and_map(bumped=False)
@@ -299,12 +261,13 @@ class SfWExploreEnv(gym.Env):
         self.path_length_m += result.distance_m
         self.collisions += int(result.bumped)
         obs = self._sense_and_map(bumped=result.bumped)
-        reward = self.reward_scale * self.last_gain_bits - self.collision_penalty * result.bumped
+        paid = self.config.reward
+        reward = paid.reward_scale * self.last_gain_bits - paid.collision_penalty * result.bumped
         coverage = self.tracker.coverage
         for level in self.steps_to:
             if self.steps_to[level] < 0 and coverage >= level:
                 self.steps_to[level] = self.steps
-        terminated = coverage >= self.coverage_target
+        terminated = coverage >= paid.coverage_target
         truncated = not terminated and self.steps >= self.episode_max_steps
         info = self._info(terminal=terminated or truncated)
         if self.render_mode == "human":
@@ -312,7 +275,7 @@ class SfWExploreEnv(gym.Env):
         return obs, float(reward), terminated, truncated, info
 
     def _default_floorplan(self) -> Floorplan | int | str:
-        source = self.floorplan_source
+        source = self.config.floorplan
         if self._folder_plans:
             return str(self._folder_plans[int(self.np_random.integers(len(self._folder_plans)))])
         if source is None:
@@ -320,8 +283,8 @@ class SfWExploreEnv(gym.Env):
         return source
 
     def _command(self, action: Any) -> tuple[float, float]:
-        cfg = self.robot_config
-        if self.action_type == "discrete":
+        cfg = self.config.robot
+        if self.config.explore.action_type == "discrete":
             try:
                 a = np.asarray(action)
             except (TypeError, ValueError):  # ragged lists
@@ -368,13 +331,13 @@ class SfWExploreEnv(gym.Env):
             est_k = self.mapper.last_k
             heard = (rssi > NOT_HEARD_DBM) & (est_k >= 0)
             # k = K means "K or more walls" (sfw_gym.mapping.metrics.k_value_accuracy with max_k)
-            true_k = np.minimum(true_k, self.mapper_config.max_k)
+            true_k = np.minimum(true_k, self.config.mapper.max_k)
             self.k_correct += int((est_k[heard] == true_k[heard]).sum())
             self.k_total += int(heard.sum())
         if self.slam is not None:  # a replay moved the entropy too: the gain is the difference
             self.last_gain_bits = entropy_before - self.mapper.entropy_bits
         self.obs_builder.mark_visited(pose[0], pose[1])
-        rssi_slots = np.full(self.n_routers, float(NOT_HEARD_DBM))
+        rssi_slots = np.full(self.config.explore.n_routers, float(NOT_HEARD_DBM))
         rssi_slots[: len(rssi)] = rssi
         obs = self.obs_builder.build(
             self.mapper.occupancy_u8, rssi_slots, bumped, pose, self.tracker.known_fraction
@@ -389,7 +352,7 @@ class SfWExploreEnv(gym.Env):
         """This step's pose estimate from the env's pose source (Radio SLAM: after a solve that
         moved past poses, the map is rebuilt along them first)."""
         assert self.scene is not None
-        if self.pose_source == "true":
+        if self.config.explore.pose_source == "true":
             return true_pose
         odometry = self.scene.robot.odometry_pose
         if self.slam is None:
@@ -485,7 +448,7 @@ class SfWExploreEnv(gym.Env):
         s = self.scene
         if s is None:
             raise gym.error.ResetNeeded("call reset() before robot_view()")
-        cfg = self.robot_config
+        cfg = self.config.robot
         odom_x, odom_y, odom_theta = self.pose_estimate
         return RobotView(
             belief_u8=self.mapper.occupancy_u8,
@@ -500,7 +463,7 @@ class SfWExploreEnv(gym.Env):
             max_linear_speed_m_s=cfg.max_linear_speed_m_s,
             max_angular_speed_rad_s=cfg.max_angular_speed_rad_s,
             control_period_s=cfg.control_period_s,
-            action_type=self.action_type,
+            action_type=self.config.explore.action_type,
         )
 
     def ground_truth(self) -> GroundTruth:
@@ -537,7 +500,7 @@ class SfWExploreEnv(gym.Env):
             odometry_pose=self.pose_estimate,
             trajectory=self.trajectory,
             odometry_trajectory=self.odometry_trajectory.view,
-            robot_radius_m=self.robot_config.radius_m,
+            robot_radius_m=self.config.robot.radius_m,
             size=self.render_size,
         )
         if self.render_mode == "human":
@@ -556,18 +519,7 @@ class SfWExploreEnv(gym.Env):
     def config_dict(self) -> dict[str, Any]:
         """The effective configuration as the env's kwargs (JSON-serialisable): for logs and
         reproducibility, ``gym.make(env_id, **config_dict())`` builds the same env."""
-        source = self.floorplan_source
-        return {
-            **self.config.to_dict(),
-            **self.reward_config.to_dict(),
-            "floorplan": str(source) if isinstance(source, Path) else source,
-            "generator": self.generator_params,
-            "radio": self.radio_config.to_dict(),
-            "robot": self.robot_config.to_dict(),
-            "mapper": self.mapper_config.to_dict(),
-            "slam": self.slam_config.to_dict(),
-            "lidar": None if self.lidar_config is None else self.lidar_config.to_dict(),
-        }
+        return self.config.to_kwargs()
 
 
 def unwrap_sfw(env: gym.Env) -> SfWExploreEnv:
@@ -590,14 +542,6 @@ def _frame_size(size: Any) -> tuple[int, int] | None:
             f"render_size must be None or (width, height) in [16, 8192] px, got {size!r}"
         )
     return int(size[0]), int(size[1])
-
-
-def _overrides(name: str, values: Any) -> dict[str, Any]:
-    if values is None:
-        return {}
-    if not isinstance(values, dict):
-        raise ConfigError(f"{name} must be a dict of overrides, got {type(values).__name__}")
-    return values
 
 
 def _folder_plans(source: Any) -> list[Path]:

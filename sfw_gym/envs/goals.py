@@ -194,7 +194,7 @@ class SfWGoalsEnv(gym.Env):
         return {**obs, **extra}
 
     def _command(self, linear: float, angular: float) -> Any:
-        if self.explore.action_type == "discrete":
+        if self.explore.config.explore.action_type == "discrete":
             return to_discrete(linear, angular)
         return np.array([linear, angular], np.float32)
 

@@ -73,7 +73,7 @@ class SfWLocalizeEnv(gym.Env):
         self.config = LocalizeConfig.from_dict(localize, "localize")
         explore_kwargs.setdefault("n_background_aps", 16)
         self.explore = SfWExploreEnv(render_mode=render_mode, **explore_kwargs)
-        if not self.explore.n_background_aps:
+        if not self.explore.config.explore.n_background_aps:
             raise ConfigError("SfW-Localize needs background access points: n_background_aps >= 1")
         self.render_mode = render_mode
         self.action_space = self.explore.action_space
@@ -151,8 +151,8 @@ class SfWLocalizeEnv(gym.Env):
             scene.floorplan,
             scene.truth_u8,
             scene.grid_origin,
-            self.explore.resolution_m,
-            self.explore.robot_config.radius_m,
+            self.explore.config.explore.resolution_m,
+            self.explore.config.robot.radius_m,
             None,
             self.np_random,
         )

@@ -65,7 +65,7 @@ class SfWRegionsEnv(SfWGoalsEnv):
     ) -> None:
         super().__init__(regions, render_mode=render_mode, **explore_kwargs)
         self.privileged = check("privileged", privileged, choices=(False, True))
-        k, px = self.config.max_candidates, self.explore.map_px
+        k, px = self.config.max_candidates, self.explore.config.explore.map_px
         extra: dict[str, spaces.Space] = {"candidate_px": spaces.Box(0.0, 1.0, (k, 2), np.float32)}
         if self.privileged:
             extra["true_map"] = spaces.Box(0, 255, (1, px, px), np.uint8)
@@ -98,7 +98,10 @@ class SfWRegionsEnv(SfWGoalsEnv):
         out = super()._observe(obs)
         assert self.menu is not None
         out["candidate_px"] = candidate_pixels(
-            self.menu, self.explore.grid, self.config.max_candidates, self.explore.map_px
+            self.menu,
+            self.explore.grid,
+            self.config.max_candidates,
+            self.explore.config.explore.map_px,
         )
         if self.privileged:
             truth = self.explore.ground_truth().truth_u8

@@ -38,7 +38,7 @@ def record_frontier_drive(env_id: str, seed: int, steps: int, **env_kwargs: Any)
     lidar: dict[str, Any] = {}
     if sfw.lidar is not None:  # the ranges, and each keyframe's scan points (lidar_slam's input)
         ranges = np.array([i["lidar_ranges"] for i in infos])
-        keys = keyframes(len(infos), sfw.slam_config.keyframe_every)
+        keys = keyframes(len(infos), sfw.config.slam.keyframe_every)
         scans = {int(k): sfw.lidar.points((0, 0, 0), ranges[k]) for k in keys}
         lidar = {"lidar_ranges": ranges, "keyframe_scans": scans}
     return {
@@ -49,6 +49,6 @@ def record_frontier_drive(env_id: str, seed: int, steps: int, **env_kwargs: Any)
         "odometry": np.array([i["odometry_pose"] for i in infos]),
         "fingerprints": np.array([i["fingerprint"] for i in infos]),
         "bounds": sfw.ground_truth().floorplan.bounds,
-        "period_s": sfw.robot_config.control_period_s,
-        "slam_config": sfw.slam_config,
+        "period_s": sfw.config.robot.control_period_s,
+        "slam_config": sfw.config.slam,
     }

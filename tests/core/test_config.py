@@ -102,4 +102,4 @@ def test_env_config_dict_holds_every_subsystem():
     cfg = env.unwrapped.config_dict()
     assert cfg["map_px"] == 36 and cfg["generator"]["area_m2"] == 45.0
     assert {"radio", "robot", "mapper", "reward_scale", "coverage_target"} <= set(cfg)
-    assert RobotConfig.from_dict(cfg["robot"]) == env.unwrapped.robot_config
+    assert RobotConfig.from_dict(cfg["robot"]) == env.unwrapped.config.robot

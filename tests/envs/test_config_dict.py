@@ -4,6 +4,7 @@ the env built from it alone is the same env (same configuration, same rollout), 
 
 from __future__ import annotations
 
+import inspect
 import json
 
 import gymnasium as gym
@@ -30,3 +31,42 @@ def test_config_dict_holds_every_subsystem_of_the_lidar_env():
     assert {"radio", "robot", "mapper", "slam", "lidar", "generator", "floorplan"} <= set(cfg)
     assert cfg["pose_source"] == "radio_lidar" and cfg["lidar"]["beams"] > 0
     assert gym.make("SfW-Explore-v0").unwrapped.config_dict()["lidar"] is None
+
+
+#: A valid non-default value for every keyword of the explore env (a new keyword must be added).
+NON_DEFAULT = {
+    "action_type": "discrete",
+    "floorplan": 7,
+    "generator": {"area_m2": 45.0},
+    "n_routers": 3,
+    "radio_preset": "thick",
+    "radio_band": "5",
+    "radio": {"tx_power_dbm": 18.0},
+    "robot": {"radius_m": 0.2},
+    "mapper": {"max_k": 4},
+    "resolution_m": 0.2,
+    "map_px": 40,
+    "crop_px": 40,
+    "coverage_target": 0.9,
+    "collision_penalty": 0.2,
+    "reward_scale": 0.02,
+    "max_steps": 100,
+    "steps_per_m2": 10.0,
+    "n_background_aps": 4,
+    "pose_source": "true",
+    "slam": {"sigma_db": 5.0},
+    "lidar": {"beams": 90},
+}
+
+
+@pytest.mark.parametrize("key", sorted(NON_DEFAULT))
+def test_every_keyword_shows_in_the_config_and_survives_the_round_trip(key):
+    from sfw_gym.envs.explore import SfWExploreEnv
+
+    params = set(inspect.signature(SfWExploreEnv).parameters)
+    assert params - {"render_mode", "render_size", "unknown"} == set(NON_DEFAULT)
+    default = SfWExploreEnv().config_dict()
+    cfg = json.loads(json.dumps(SfWExploreEnv(**{key: NON_DEFAULT[key]}).config_dict()))
+    changed = {k for k in cfg if cfg[k] != default[k]}
+    assert key in changed
+    assert SfWExploreEnv(**cfg).config_dict() == cfg

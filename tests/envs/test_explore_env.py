@@ -92,7 +92,7 @@ def test_robot_view_is_read_only_views_not_copies():
     assert np.shares_memory(view.log_odds, u.mapper.log_odds)
     for array in (view.belief_u8, view.log_odds, view.rssi_history, view.routers_xy):
         assert not array.flags.writeable
-    assert view.rssi_history.shape == (u.steps + 1, u.n_routers)
+    assert view.rssi_history.shape == (u.steps + 1, u.config.explore.n_routers)
     assert view.probability == pytest.approx(u.mapper.probability)
     kept = view.rssi_history.copy()
     drive(env, 5)
@@ -114,5 +114,5 @@ def test_mapper_options_reach_the_mapper():
     env.reset(seed=0)
     cfg = env.unwrapped.mapper.config
     assert cfg.k_estimator == "kmeans" and cfg.router_policy == "all" and cfg.k0_level_dbm is None
-    default = gym.make("SfW-Explore-v0").unwrapped.mapper_config
+    default = gym.make("SfW-Explore-v0").unwrapped.config.mapper
     assert default.k0_level_dbm == pytest.approx(20.0 - 40.18, abs=0.01)  # P_tx − PL(1 m)

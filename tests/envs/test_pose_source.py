@@ -41,7 +41,7 @@ def test_radio_slam_rebuilds_the_map_exactly_along_its_corrected_trajectory():
     estimates = env.pose_estimates.view
     assert np.abs(estimates[:, :2] - env.slam.odometry[:, :2]).max() > 0.2  # it corrected
     # the live map equals one built from scratch along the final estimate...
-    mapper = SparseInverseKVisibility(env.grid, env.scene.radio.routers, env.mapper_config)
+    mapper = SparseInverseKVisibility(env.grid, env.scene.radio.routers, env.config.mapper)
     x0, y0, x1, y1 = env.grid.bounds
     for (x, y, theta), rssi, bump in zip(
         estimates, env.rssi_history.view, env.map_history.bumps, strict=True
@@ -93,10 +93,10 @@ def test_radio_slam_without_access_points_is_refused_by_name():
 def test_radio_slam_weighs_odometry_by_the_robots_noise_unless_told_otherwise():
     env = gym.make("SfW-ExploreRadioSLAM-v0").unwrapped
     # 5 % of a full-speed step (0.5 m/s x 0.2 s), 0.02 rad per step
-    assert env.slam_config.odometry_sigma_m == pytest.approx(0.005)
-    assert env.slam_config.odometry_sigma_rad == pytest.approx(0.02)
+    assert env.config.slam.odometry_sigma_m == pytest.approx(0.005)
+    assert env.config.slam.odometry_sigma_rad == pytest.approx(0.02)
     own = gym.make("SfW-ExploreRadioSLAM-v0", slam={"odometry_sigma_m": 0.03}).unwrapped
-    assert own.slam_config.odometry_sigma_m == 0.03
+    assert own.config.slam.odometry_sigma_m == 0.03
 
 
 def test_radio_lidar_slam_needs_the_lidar_and_access_points_by_name():

@@ -56,7 +56,7 @@ def _run(env_id: str, steps: int = 3, options=None, actions=None, **kwargs) -> g
 def test_make_kwargs(kwargs):
     def make() -> None:
         env = _run(SMALL, **kwargs)
-        cfg = env.unwrapped.config  # an accepted setting is the one used
+        cfg = env.unwrapped.config.explore  # an accepted setting is the one used
         for key in ("action_type", "n_routers", "map_px", "crop_px", "max_steps"):
             if key in kwargs:
                 assert getattr(cfg, key) == kwargs[key], key
