@@ -31,7 +31,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from sfw_gym.core.config import check
+from sfw_gym.core.config import Config, setting
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.navigation.candidates import FEATURES, CandidateGoals
 from sfw_gym.navigation.view import RobotView
@@ -120,15 +120,30 @@ def _view_in(info: Any, agent: str, method: str) -> RobotView:
     return view
 
 
+@dataclass(frozen=True)
+class AgentSettings(Config):
+    """The parameters every agent has; each agent's own settings class derives from this one.
+
+    Attributes:
+        max_steps: Optional step limit of the agent (then ``stop_reason = "max_steps"``).
+    """
+
+    prefix: ClassVar[str | None] = ""  # named as the keyword arguments they are
+
+    max_steps: int | None = setting(None, integer=True, ge=1, optional=True)
+
+
 class Agent(ABC):
     """Base class of the baseline agents.
 
-    Subclasses take keyword parameters with defaults (``Agent()`` must work), set ``name``, and
-    implement :meth:`_act`. Randomness comes from the agent's own generator, seeded in
-    :meth:`reset`.
+    Subclasses declare their parameters as a frozen :class:`AgentSettings` subclass (every field
+    with a default and a checked range, so ``Agent()`` works and ``Agent(bad=1)`` names the
+    nearest valid key), set ``name`` and ``settings_class``, and implement :meth:`_act`.
+    Randomness comes from the agent's own generator, seeded in :meth:`reset`.
 
     Attributes:
         name: Short name used on the command line and in tables (``"frontier"``).
+        settings: The parameters (an instance of ``settings_class``).
         stop_reason: ``None`` while the agent pursues goals; else why its goal search came up
             empty at its latest attempt (one of :data:`STOP_REASONS`). The baselines keep acting
             meanwhile (they fall back to sweeping), so an episode never stalls; the reason is
@@ -140,9 +155,11 @@ class Agent(ABC):
 
     name: ClassVar[str] = "agent"
     action_types: ClassVar[tuple[str, ...]] = ("continuous", "discrete")
+    #: The frozen, checked parameters: ``Agent(**params)`` builds ``settings_class(**params)``.
+    settings_class: ClassVar[type[AgentSettings]] = AgentSettings
 
-    def __init__(self, max_steps: int | None = None) -> None:
-        self.max_steps = check("max_steps", max_steps, integer=True, ge=1, optional=True)
+    def __init__(self, **params: Any) -> None:
+        self.settings = self.settings_class.from_dict(params, f"agent {self.name!r}")
         self.stop_reason: str | None = None
         self.steps = 0
         self._view: RobotViewHandle | None = None
@@ -208,7 +225,8 @@ class Agent(ABC):
                 f"{type(self).__name__}.act() needs info['robot_view'] (it was reset from an info)"
             )
         self.trajectory.append((float(view.odometry_pose[0]), float(view.odometry_pose[1])))
-        if self.max_steps is not None and self.steps >= self.max_steps:
+        max_steps = self.settings.max_steps
+        if max_steps is not None and self.steps >= max_steps:
             self._stop("max_steps")
             linear, angular = 0.0, 0.0
         else:
@@ -218,19 +236,8 @@ class Agent(ABC):
         return self._to_action(linear, angular)
 
     def params(self) -> dict[str, Any]:
-        """The constructor parameters (for logs and result files)."""
-        return {k: v for k, v in vars(self).items() if k in self._param_names()}
-
-    @classmethod
-    def _param_names(cls) -> set[str]:
-        import inspect
-
-        names: set[str] = set()
-        for klass in cls.__mro__:
-            init = klass.__dict__.get("__init__")
-            if init is not None:
-                names |= set(inspect.signature(init).parameters) - {"self"}
-        return names
+        """The parameters (for logs and result files): :attr:`settings` as a dict."""
+        return self.settings.to_dict()
 
     # -- for subclasses -----------------------------------------------------------------------
     def _on_reset(self, view: RobotView) -> None:  # noqa: B027 (optional hook)

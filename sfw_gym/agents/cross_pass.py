@@ -23,23 +23,24 @@ weighting). Cells within ``band_m`` of an estimated zone border form the bands. 
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
 from scipy import ndimage
 
 from sfw_gym.agents.base import RobotView
-from sfw_gym.agents.frontier import FrontierAgent, Goal
-from sfw_gym.core.config import check
+from sfw_gym.agents.frontier import FrontierAgent, FrontierSettings, Goal
+from sfw_gym.core.config import setting
 from sfw_gym.mapping.grid import GridSpec
 from sfw_gym.navigation.planning import CostField, belief_classes, mark_disk
 from sfw_gym.navigation.radio_zones import dominance_bands, router_scores, wall_crossings
 
 
-class CrossPassAgent(FrontierAgent):
-    """:class:`FrontierAgent` that favours router-zone border bands and crosses them in passes.
+@dataclass(frozen=True)
+class CrossPassSettings(FrontierSettings):
+    """The parameters of :class:`CrossPassAgent`.
 
-    Args:
+    Attributes:
         band_m: Half-width of the band along a zone border whose unknown cells a pass targets.
         min_band_area_m2: Unknown band clusters smaller than this get no pass.
         pass_trigger_m: A pass is inserted only for bands within this path distance.
@@ -50,36 +51,31 @@ class CrossPassAgent(FrontierAgent):
             ``1 + band_bonus`` times (the main route favours the bands).
         wall_loss_db: Loss per believed wall in the zone model (a prior).
         pass_spacing_m: No new pass within this distance of an earlier one.
-        **frontier_params: Parameters of :class:`FrontierAgent`.
+    """
+
+    band_m: float = setting(0.8, ge=0.05)
+    min_band_area_m2: float = setting(0.3, ge=0.0)
+    pass_trigger_m: float = setting(5.0, ge=0.0)
+    pass_length_m: float = setting(1.5, ge=0.1)
+    pass_offset_m: float = setting(0.5, ge=0.05)
+    zones_every_steps: int = setting(50, integer=True, ge=1)
+    band_bonus: float = setting(2.0, ge=0.0)
+    wall_loss_db: float = setting(10.0, ge=0.0)
+    pass_spacing_m: float = setting(3.0, ge=0.0)
+
+
+class CrossPassAgent(FrontierAgent):
+    """:class:`FrontierAgent` that favours router-zone border bands and crosses them in passes.
+
+    Parameters: :class:`CrossPassSettings` (keyword arguments, checked).
     """
 
     name = "cross-pass"
     _bounded_search = False
     _committed_kinds = ("pass",)
 
-    def __init__(
-        self,
-        band_m: float = 0.8,
-        min_band_area_m2: float = 0.3,
-        pass_trigger_m: float = 5.0,
-        pass_length_m: float = 1.5,
-        pass_offset_m: float = 0.5,
-        zones_every_steps: int = 50,
-        band_bonus: float = 2.0,
-        wall_loss_db: float = 10.0,
-        pass_spacing_m: float = 3.0,
-        **frontier_params: Any,
-    ) -> None:
-        super().__init__(**frontier_params)
-        self.pass_spacing_m = check("pass_spacing_m", pass_spacing_m, ge=0.0)
-        self.band_bonus = check("band_bonus", band_bonus, ge=0.0)
-        self.wall_loss_db = check("wall_loss_db", wall_loss_db, ge=0.0)
-        self.band_m = check("band_m", band_m, ge=0.05)
-        self.min_band_area_m2 = check("min_band_area_m2", min_band_area_m2, ge=0.0)
-        self.pass_trigger_m = check("pass_trigger_m", pass_trigger_m, ge=0.0)
-        self.pass_length_m = check("pass_length_m", pass_length_m, ge=0.1)
-        self.pass_offset_m = check("pass_offset_m", pass_offset_m, ge=0.05)
-        self.zones_every_steps = check("zones_every_steps", zones_every_steps, integer=True, ge=1)
+    settings_class = CrossPassSettings
+    settings: CrossPassSettings
 
     def _on_reset(self, view: RobotView) -> None:
         super()._on_reset(view)
@@ -91,7 +87,10 @@ class CrossPassAgent(FrontierAgent):
         self.band: np.ndarray | None = None
 
     def _update_zones(self, view: RobotView) -> None:
-        if self.steps - self._zones_at < self.zones_every_steps and self.scores is not None:
+        if (
+            self.steps - self._zones_at < self.settings.zones_every_steps
+            and self.scores is not None
+        ):
             return
         self._zones_at = self.steps
         traj = np.asarray(self.trajectory, np.float64).reshape(-1, 2)
@@ -104,9 +103,11 @@ class CrossPassAgent(FrontierAgent):
             traj[len(traj) - n :],
             hist[len(hist) - n :],
             walls=walls | self.bumps,
-            wall_loss_db=self.wall_loss_db,
+            wall_loss_db=self.settings.wall_loss_db,
         )
-        self.zone, self.band = dominance_bands(self.scores, self.band_m / view.grid.resolution_m)
+        self.zone, self.band = dominance_bands(
+            self.scores, self.settings.band_m / view.grid.resolution_m
+        )
 
     def _choose_goal(self, view: RobotView, paths: CostField) -> Goal | None:
         if len(view.routers_xy) > 1:
@@ -122,11 +123,13 @@ class CrossPassAgent(FrontierAgent):
     ) -> np.ndarray:
         """Frontier's utility, each band cell of a cluster counting ``1 + band_bonus`` cells."""
         size = np.array([len(c) for c in clusters], np.int64)
-        if self.band is not None and self.band_bonus > 0:
+        if self.band is not None and self.settings.band_bonus > 0:
             in_band = [int(self.band[c[:, 0], c[:, 1]].sum()) for c in clusters]
-            size = size + self.band_bonus * np.array(in_band, np.int64)
+            size = size + self.settings.band_bonus * np.array(in_band, np.int64)
         res = view.grid.resolution_m
-        return self.gain_scale * size * res - self.potential_scale * np.asarray(path_m, float)
+        return self.settings.gain_scale * size * res - self.settings.potential_scale * np.asarray(
+            path_m, float
+        )
 
     def unknown_band(self, view: RobotView) -> np.ndarray:
         """Unknown cells in the estimated border bands not yet targeted by a pass."""
@@ -144,12 +147,12 @@ class CrossPassAgent(FrontierAgent):
         sizes = np.bincount(labels.ravel(), minlength=n + 1)
         sizes[0] = 0
         cost = np.where(labels > 0, paths.cumulative, np.inf)
-        min_cells = self.min_band_area_m2 / res**2
+        min_cells = self.settings.min_band_area_m2 / res**2
         best_cost = ndimage.minimum(cost, labels, index=np.arange(1, n + 1))
         order = np.argsort(best_cost)
         for i in order:
             lab = i + 1
-            if best_cost[i] > self.pass_trigger_m:
+            if best_cost[i] > self.settings.pass_trigger_m:
                 break
             if sizes[lab] < min_cells:
                 continue
@@ -158,7 +161,7 @@ class CrossPassAgent(FrontierAgent):
             waypoints = self._pass_waypoints(view, paths, rows, cols)
             if len(waypoints) >= 2:
                 centre = (int(np.median(rows)), int(np.median(cols)))
-                mark_disk(self.passed, centre, self.pass_spacing_m / res)
+                mark_disk(self.passed, centre, self.settings.pass_spacing_m / res)
                 return Goal(waypoints[0], waypoints[0], "pass", waypoints=waypoints[1:])
         return None
 
@@ -184,8 +187,10 @@ class CrossPassAgent(FrontierAgent):
         # Move the centre onto the border: along the normal by diff / |gradient| (dB / dB-per-m).
         slope = float(np.hypot(gx[c_rc], gy[c_rc])) / grid.resolution_m
         if np.isfinite(slope) and slope > 1e-6:
-            centre = centre - normal * np.clip(diff[c_rc] / slope, -self.band_m, self.band_m)
-        half, off = 0.5 * self.pass_length_m, self.pass_offset_m
+            centre = centre - normal * np.clip(
+                diff[c_rc] / slope, -self.settings.band_m, self.settings.band_m
+            )
+        half, off = 0.5 * self.settings.pass_length_m, self.settings.pass_offset_m
         _, walls, _ = belief_classes(view.belief_u8)
         crossing = np.stack([centre - normal * off, centre + normal * off])
         if wall_crossings(grid, walls | self.bumps, crossing[:1], crossing[1:])[0, 0]:

@@ -45,8 +45,8 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 
-from sfw_gym.agents.base import Agent, RobotView
-from sfw_gym.core.config import check
+from sfw_gym.agents.base import Agent, AgentSettings, RobotView
+from sfw_gym.core.config import setting
 from sfw_gym.core.constants import U8_FREE_MIN, U8_WALL_MAX
 from sfw_gym.navigation.candidates import (
     GAIN_SCALE,
@@ -91,10 +91,11 @@ class Goal:
 _UNCERTAIN = Goal((-1, -1), (-1, -1), "uncertain")
 
 
-class FrontierAgent(Agent):
-    """Frontier exploration with explore_lite's utility, a grid planner and pure pursuit.
+@dataclass(frozen=True)
+class FrontierSettings(AgentSettings):
+    """The parameters of :class:`FrontierAgent`.
 
-    Args:
+    Attributes:
         gain_scale: Weight of a cluster's size (metres of frontier) in its utility.
         potential_scale: Weight of the path distance (metres) to it.
         min_frontier_size_m: Clusters shorter than this (cells × resolution) are ignored.
@@ -132,7 +133,35 @@ class FrontierAgent(Agent):
         stall_steps, stall_gain_m2: The exploration has stalled when the map grew by less than
             ``stall_gain_m2`` over the last ``stall_steps`` steps; the agent then drives to the
             cheapest hidden room, if there is one, before it takes frontier goals again.
-        max_steps: Optional step limit of the agent (then ``stop_reason = "max_steps"``).
+    """
+
+    gain_scale: float = setting(GAIN_SCALE, ge=0.0)
+    potential_scale: float = setting(POTENTIAL_SCALE, ge=0.0)
+    min_frontier_size_m: float = setting(0.3, ge=0.0)
+    progress_timeout_steps: int = setting(30, integer=True, ge=1)
+    blacklist_radius_m: float = setting(0.3, ge=0.0)
+    replan_every_steps: int = setting(5, integer=True, ge=1)
+    search_radius_m: float = setting(4.0, gt=0.0)
+    unknown_cost: float = setting(1.5, ge=1.0)
+    bump_exclusion_m: float = setting(0.3, ge=0.0)
+    lookahead_m: float = setting(0.4, ge=0.05)
+    backoff_steps: int = setting(1, integer=True, ge=0)
+    turn_cost_m_per_rad: float = setting(TURN_COST_M_PER_RAD, ge=0.0)
+    max_bumps_per_goal: int = setting(2, integer=True, ge=1)
+    blacklist_ttl_steps: int = setting(600, integer=True, ge=1)
+    unreachable_ttl_steps: int = setting(200, integer=True, ge=1)
+    min_unknown_region_m2: float = setting(0.5, ge=0.0)
+    escape_wall_cost: float = setting(25.0, ge=1.0)
+    min_hidden_room_depth_m: float = setting(0.5, ge=0.0)
+    escape_blacklist_radius_m: float = setting(1.0, ge=0.0)
+    stall_steps: int = setting(300, integer=True, ge=1)
+    stall_gain_m2: float = setting(1.0, ge=0.0)
+
+
+class FrontierAgent(Agent):
+    """Frontier exploration with explore_lite's utility, a grid planner and pure pursuit.
+
+    Parameters: :class:`FrontierSettings` (keyword arguments, checked).
     """
 
     name = "frontier"
@@ -142,67 +171,8 @@ class FrontierAgent(Agent):
     #: utility falls with the path's cost; the subclasses' menus need every cost).
     _bounded_search = True
 
-    def __init__(
-        self,
-        gain_scale: float = GAIN_SCALE,
-        potential_scale: float = POTENTIAL_SCALE,
-        min_frontier_size_m: float = 0.3,
-        progress_timeout_steps: int = 30,
-        blacklist_radius_m: float = 0.3,
-        replan_every_steps: int = 5,
-        search_radius_m: float = 4.0,
-        unknown_cost: float = 1.5,
-        bump_exclusion_m: float = 0.3,
-        lookahead_m: float = 0.4,
-        backoff_steps: int = 1,
-        turn_cost_m_per_rad: float = TURN_COST_M_PER_RAD,
-        max_bumps_per_goal: int = 2,
-        blacklist_ttl_steps: int = 600,
-        unreachable_ttl_steps: int = 200,
-        min_unknown_region_m2: float = 0.5,
-        escape_wall_cost: float = 25.0,
-        min_hidden_room_depth_m: float = 0.5,
-        escape_blacklist_radius_m: float = 1.0,
-        stall_steps: int = 300,
-        stall_gain_m2: float = 1.0,
-        max_steps: int | None = None,
-    ) -> None:
-        super().__init__(max_steps=max_steps)
-        self.gain_scale = check("gain_scale", gain_scale, ge=0.0)
-        self.potential_scale = check("potential_scale", potential_scale, ge=0.0)
-        self.min_frontier_size_m = check("min_frontier_size_m", min_frontier_size_m, ge=0.0)
-        self.blacklist_radius_m = check("blacklist_radius_m", blacklist_radius_m, ge=0.0)
-        self.unknown_cost = check("unknown_cost", unknown_cost, ge=1.0)
-        self.bump_exclusion_m = check("bump_exclusion_m", bump_exclusion_m, ge=0.0)
-        self.lookahead_m = check("lookahead_m", lookahead_m, ge=0.05)
-        self.progress_timeout_steps = check(
-            "progress_timeout_steps", progress_timeout_steps, integer=True, ge=1
-        )
-        self.replan_every_steps = check(
-            "replan_every_steps", replan_every_steps, integer=True, ge=1
-        )
-        self.search_radius_m = check("search_radius_m", search_radius_m, gt=0.0)
-        self.backoff_steps = check("backoff_steps", backoff_steps, integer=True, ge=0)
-        self.max_bumps_per_goal = check(
-            "max_bumps_per_goal", max_bumps_per_goal, integer=True, ge=1
-        )
-        self.blacklist_ttl_steps = check(
-            "blacklist_ttl_steps", blacklist_ttl_steps, integer=True, ge=1
-        )
-        self.unreachable_ttl_steps = check(
-            "unreachable_ttl_steps", unreachable_ttl_steps, integer=True, ge=1
-        )
-        self.stall_steps = check("stall_steps", stall_steps, integer=True, ge=1)
-        self.stall_gain_m2 = check("stall_gain_m2", stall_gain_m2, ge=0.0)
-        self.min_unknown_region_m2 = check("min_unknown_region_m2", min_unknown_region_m2, ge=0.0)
-        self.turn_cost_m_per_rad = check("turn_cost_m_per_rad", turn_cost_m_per_rad, ge=0.0)
-        self.escape_wall_cost = check("escape_wall_cost", escape_wall_cost, ge=1.0)
-        self.min_hidden_room_depth_m = check(
-            "min_hidden_room_depth_m", min_hidden_room_depth_m, ge=0.0
-        )
-        self.escape_blacklist_radius_m = check(
-            "escape_blacklist_radius_m", escape_blacklist_radius_m, ge=0.0
-        )
+    settings_class = FrontierSettings
+    settings: FrontierSettings
 
     # -- episode ---------------------------------------------------------------------------------
     def _on_reset(self, view: RobotView) -> None:
@@ -214,7 +184,7 @@ class FrontierAgent(Agent):
         self._visit_radius_cells = view.radius_m / res
         self.goal: Goal | None = None
         self.follower = PurePursuit(
-            lookahead_m=self.lookahead_m, goal_tolerance_m=self.finder.goal_tolerance_m
+            lookahead_m=self.settings.lookahead_m, goal_tolerance_m=self.finder.goal_tolerance_m
         )
         self._since_plan = 0
         self._path_cells: tuple[np.ndarray, np.ndarray] = (np.zeros(0, int), np.zeros(0, int))
@@ -231,12 +201,12 @@ class FrontierAgent(Agent):
 
     def _candidate_settings(self) -> CandidateSettings:
         return CandidateSettings(
-            unknown_cost=self.unknown_cost,
-            min_frontier_size_m=self.min_frontier_size_m,
-            bump_exclusion_m=self.bump_exclusion_m,
-            min_unknown_region_m2=self.min_unknown_region_m2,
-            turn_cost_m_per_rad=self.turn_cost_m_per_rad,
-            min_hidden_room_depth_m=self.min_hidden_room_depth_m,
+            unknown_cost=self.settings.unknown_cost,
+            min_frontier_size_m=self.settings.min_frontier_size_m,
+            bump_exclusion_m=self.settings.bump_exclusion_m,
+            min_unknown_region_m2=self.settings.min_unknown_region_m2,
+            turn_cost_m_per_rad=self.settings.turn_cost_m_per_rad,
+            min_hidden_room_depth_m=self.settings.min_hidden_room_depth_m,
         )
 
     def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
@@ -256,8 +226,8 @@ class FrontierAgent(Agent):
             self._mark_bump(view)
         if bumped_ahead or self._slides >= 3:
             self._slides = 0
-            if self.action_type == "continuous" and self.backoff_steps:
-                self._backoff = self.backoff_steps
+            if self.action_type == "continuous" and self.settings.backoff_steps:
+                self._backoff = self.settings.backoff_steps
         self._track_progress(view, bumped_ahead)
         if self._backoff > 0:
             self._backoff -= 1
@@ -307,8 +277,8 @@ class FrontierAgent(Agent):
         else:
             goal.steps_without_progress += 1
         if (
-            goal.steps_without_progress >= self.progress_timeout_steps
-            or goal.bumps >= self.max_bumps_per_goal
+            goal.steps_without_progress >= self.settings.progress_timeout_steps
+            or goal.bumps >= self.settings.max_bumps_per_goal
         ):
             self._blacklist(goal)
             self.follower.set_path(np.zeros((0, 2)))
@@ -319,7 +289,7 @@ class FrontierAgent(Agent):
         goal = self.goal
         if goal is None or bumped or not self.follower.has_path:
             return True
-        if self._since_plan >= self.replan_every_steps or self._path_blocked(view):
+        if self._since_plan >= self.settings.replan_every_steps or self._path_blocked(view):
             return True
         return goal.kind == "frontier" and not self._still_unknown(view, goal.target)
 
@@ -339,10 +309,10 @@ class FrontierAgent(Agent):
     # -- bookkeeping -----------------------------------------------------------------------------
     def _blacklist(self, goal: Goal) -> None:
         """Blacklist the cells within ``blacklist_radius_m`` of the goal's target."""
-        radius_m = self.escape_blacklist_radius_m if goal.kind == "escape" else None
-        res_cells = (radius_m or self.blacklist_radius_m) / self._res
+        radius_m = self.settings.escape_blacklist_radius_m if goal.kind == "escape" else None
+        res_cells = (radius_m or self.settings.blacklist_radius_m) / self._res
         self.finder.blacklist(
-            goal.target, max(res_cells, 0.5), self.steps + self.blacklist_ttl_steps
+            goal.target, max(res_cells, 0.5), self.steps + self.settings.blacklist_ttl_steps
         )
         self.n_blacklisted += 1
         self.goal = None
@@ -379,7 +349,7 @@ class FrontierAgent(Agent):
     # -- planning --------------------------------------------------------------------------------
     def _costs(self, view: RobotView, relaxed: bool = False) -> np.ndarray:
         """Planner costs; ``relaxed``: believed walls and bumps cost ``escape_wall_cost``."""
-        return self.finder.costs(view, self.escape_wall_cost if relaxed else None)
+        return self.finder.costs(view, self.settings.escape_wall_cost if relaxed else None)
 
     def _plan(self, view: RobotView) -> None:
         """Pick a goal and a path to it (or fall back to sweeping); re-path a committed goal."""
@@ -392,7 +362,7 @@ class FrontierAgent(Agent):
         res = view.grid.resolution_m
         # A bounded first search, unless there is no frontier to prove a choice about.
         bounded = self._bounded_search and not committed and self.finder.frontier(view).any()
-        bound = self.search_radius_m if bounded else np.inf
+        bound = self.settings.search_radius_m if bounded else np.inf
         paths = cost_field(costs, view.cell, res, max_cost_m=bound)
         if committed:
             assert goal is not None
@@ -426,11 +396,17 @@ class FrontierAgent(Agent):
         b = view.belief_u8
         known = int(np.count_nonzero(b <= U8_WALL_MAX)) + int(np.count_nonzero(b >= U8_FREE_MIN))
         self._known_log.append((self.steps, known))
-        while len(self._known_log) > 1 and self._known_log[1][0] <= self.steps - self.stall_steps:
+        while (
+            len(self._known_log) > 1
+            and self._known_log[1][0] <= self.steps - self.settings.stall_steps
+        ):
             self._known_log.pop(0)
         step0, known0 = self._known_log[0]
         grown_m2 = (known - known0) * view.grid.resolution_m**2
-        return self.steps - step0 >= self.stall_steps and grown_m2 < self.stall_gain_m2
+        return (
+            self.steps - step0 >= self.settings.stall_steps
+            and grown_m2 < self.settings.stall_gain_m2
+        )
 
     def _escape_goal(
         self, view: RobotView, paths: CostField, rooms_only: bool = False
@@ -463,7 +439,9 @@ class FrontierAgent(Agent):
             goal.bumps = prev.bumps
         else:
             self.n_goals += 1
-            self.finder.note_tried(goal.target, max(self.blacklist_radius_m / self._res, 0.5))
+            self.finder.note_tried(
+                goal.target, max(self.settings.blacklist_radius_m / self._res, 0.5)
+            )
         self.goal = goal
         cells = paths.path(goal.cell)
         # Cells that were passable when planned (the start may be inside an inflated wall).
@@ -493,7 +471,7 @@ class FrontierAgent(Agent):
         menu = self.finder.find(
             view, paths, sources=("frontier",), features=("path_cost_m", "heading_change_rad")
         )
-        cost = menu.feature("path_cost_m") + self.turn_cost_m_per_rad * menu.feature(
+        cost = menu.feature("path_cost_m") + self.settings.turn_cost_m_per_rad * menu.feature(
             "heading_change_rad"
         )
         # A cluster's cost (path + turn) is exact when it is within the search's bound: every
@@ -503,7 +481,9 @@ class FrontierAgent(Agent):
         bound = np.full(len(far), paths.max_cost_m)
         beyond = self._utilities(view, [menu.clusters[i] for i in far], bound).max(initial=-np.inf)
         for i in np.flatnonzero(exact & ~menu.valid):  # walled off on the belief map
-            self.finder.mark_unreachable(menu.clusters[i], self.steps + self.unreachable_ttl_steps)
+            self.finder.mark_unreachable(
+                menu.clusters[i], self.steps + self.settings.unreachable_ttl_steps
+            )
             self.n_blacklisted += 1
         ok = np.flatnonzero(exact & menu.valid)
         u = self._utilities(view, [menu.clusters[i] for i in ok], cost[ok])
@@ -530,7 +510,9 @@ class FrontierAgent(Agent):
     ) -> np.ndarray:
         """:meth:`_utility` of each cluster at its ``path_m``."""
         size_m = np.array([len(c) for c in clusters], np.int64) * view.grid.resolution_m
-        return self.gain_scale * size_m - self.potential_scale * np.asarray(path_m, np.float64)
+        return self.settings.gain_scale * size_m - self.settings.potential_scale * np.asarray(
+            path_m, np.float64
+        )
 
     def _sweep_goal(self, view: RobotView, paths: CostField) -> Goal | None:
         """Fallback: the reachable cell farthest from the path so far (keeps the rays sweeping)."""

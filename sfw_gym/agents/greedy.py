@@ -2,18 +2,33 @@
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
 
 from sfw_gym.agents.base import RobotView
-from sfw_gym.agents.frontier import FrontierAgent, Goal
-from sfw_gym.core.config import check
+from sfw_gym.agents.frontier import FrontierAgent, FrontierSettings, Goal
+from sfw_gym.core.config import setting
 from sfw_gym.navigation.candidates import (
     CandidateSettings,
     bits_per_metre,
 )
 from sfw_gym.navigation.planning import CostField
+
+
+@dataclass(frozen=True)
+class GreedySettings(FrontierSettings):
+    """The parameters of :class:`GreedyInfoGainAgent`.
+
+    Attributes:
+        max_candidates: Candidates scored per replan (an even subsample of frontier cells).
+        distance_offset_m: Added to the path distance (keeps near goals from dominating).
+        zones_every_steps: Re-fit the router model this often.
+    """
+
+    max_candidates: int = setting(300, integer=True, ge=1)
+    distance_offset_m: float = setting(1.0, ge=0.01)
+    zones_every_steps: int = setting(25, integer=True, ge=1)
 
 
 class GreedyInfoGainAgent(FrontierAgent):
@@ -28,11 +43,7 @@ class GreedyInfoGainAgent(FrontierAgent):
     ``distance_offset_m``. Motion, bumps, blacklisting and the
     fallback sweep are :class:`FrontierAgent`'s.
 
-    Args:
-        max_candidates: Candidates scored per replan (an even subsample of frontier cells).
-        distance_offset_m: Added to the path distance (keeps near goals from dominating).
-        zones_every_steps: Re-fit the router model this often.
-        **frontier_params: Parameters of :class:`FrontierAgent`.
+    Parameters: :class:`GreedySettings` (keyword arguments, checked).
 
     Attributes:
         candidates: The latest choice's menu: ``(cell, score)`` per candidate; the goal is the
@@ -42,24 +53,15 @@ class GreedyInfoGainAgent(FrontierAgent):
     name = "greedy"
     _bounded_search = False
 
-    def __init__(
-        self,
-        max_candidates: int = 300,
-        distance_offset_m: float = 1.0,
-        zones_every_steps: int = 25,
-        **frontier_params: Any,
-    ) -> None:
-        super().__init__(**frontier_params)
-        self.max_candidates = check("max_candidates", max_candidates, integer=True, ge=1)
-        self.distance_offset_m = check("distance_offset_m", distance_offset_m, ge=0.01)
-        self.zones_every_steps = check("zones_every_steps", zones_every_steps, integer=True, ge=1)
+    settings_class = GreedySettings
+    settings: GreedySettings
 
     def _candidate_settings(self) -> CandidateSettings:
         return CandidateSettings(
             **{
                 **super()._candidate_settings().to_dict(),
-                "info_gain_samples": self.max_candidates,
-                "zones_every_steps": self.zones_every_steps,
+                "info_gain_samples": self.settings.max_candidates,
+                "zones_every_steps": self.settings.zones_every_steps,
             }
         )
 
@@ -75,11 +77,13 @@ class GreedyInfoGainAgent(FrontierAgent):
         menu = self.finder.find(
             view, paths, sources=("info_gain",), features=("path_cost_m", "expected_gain_bits")
         )
-        self.finder.mark_unreachable(menu.walled_off_rc, self.steps + self.unreachable_ttl_steps)
+        self.finder.mark_unreachable(
+            menu.walled_off_rc, self.steps + self.settings.unreachable_ttl_steps
+        )
         if len(menu) == 0:
             self._stop("all_blacklisted")
             return None
-        score = bits_per_metre(menu, self.distance_offset_m)
+        score = bits_per_metre(menu, self.settings.distance_offset_m)
         self.candidates = [
             ((int(r), int(c)), s)
             for (r, c), s in zip(menu.target_rc.tolist(), score.tolist(), strict=True)

@@ -2,13 +2,25 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
-from sfw_gym.agents.base import Agent, RobotView
-from sfw_gym.core.config import check
+from sfw_gym.agents.base import Agent, AgentSettings, RobotView
+from sfw_gym.core.config import setting
 from sfw_gym.core.constants import DISCRETE_ACTIONS
 
 #: (linear, angular) of the discrete actions 0 forward, 1 turn left, 2 turn right.
+
+
+@dataclass(frozen=True)
+class RandomSettings(AgentSettings):
+    """The parameters of :class:`RandomAgent`.
+
+    Attributes:
+        hold_steps: Steps each drawn action is repeated.
+    """
+
+    hold_steps: int = setting(5, integer=True, ge=1)
 
 
 class RandomAgent(Agent):
@@ -18,16 +30,13 @@ class RandomAgent(Agent):
     actions. With ``hold_steps=1`` this is the usual i.i.d. random policy; holding makes a
     correlated random walk that gets somewhere, a fairer reference.
 
-    Args:
-        hold_steps: Steps each drawn action is repeated.
-        max_steps: Optional step limit of the agent.
+    Parameters: :class:`RandomSettings` (keyword arguments, checked).
     """
 
     name = "random"
 
-    def __init__(self, hold_steps: int = 5, max_steps: int | None = None) -> None:
-        super().__init__(max_steps=max_steps)
-        self.hold_steps = check("hold_steps", hold_steps, integer=True, ge=1)
+    settings_class = RandomSettings
+    settings: RandomSettings
 
     def _on_reset(self, view: RobotView) -> None:
         self._held = 0
@@ -40,6 +49,6 @@ class RandomAgent(Agent):
             else:
                 lin, ang = self.rng.uniform(-1.0, 1.0, 2)
                 self._command = (float(lin), float(ang))
-            self._held = self.hold_steps
+            self._held = self.settings.hold_steps
         self._held -= 1
         return self._command

@@ -10,12 +10,13 @@ learned region policy (:class:`sfw_gym.rl.agent.RegionsPPOAgent`) starts from.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from sfw_gym.agents.base import Agent, RobotView
-from sfw_gym.core.config import check
+from sfw_gym.agents.base import Agent, AgentSettings, RobotView
+from sfw_gym.core.config import setting
 from sfw_gym.envs.goals import action_masks, menu_observation
 from sfw_gym.envs.regions import RegionsConfig, region_anchor
 from sfw_gym.navigation.candidates import TEACHERS, CandidateGoals, GoalFinder
@@ -23,30 +24,39 @@ from sfw_gym.navigation.goal_driver import GoalDriver
 from sfw_gym.navigation.regions import RegionSteering
 
 
-class RegionAgent(Agent):
-    """Region decisions every ``decision_steps`` steps, steered as ``SfW-ExploreRegions-v0``.
+@dataclass(frozen=True)
+class RegionAgentSettings(AgentSettings):
+    """The parameters of :class:`RegionAgent`.
 
-    Args:
+    Attributes:
         regions: :class:`~sfw_gym.envs.regions.RegionsConfig` fields (dict), as the env's.
         teacher: Whose choice on the menu (:data:`~sfw_gym.navigation.candidates.TEACHERS`):
             ``greedy`` (expected bits per metre, the tuned greedy agent's offset: the region
             teacher, level with frontier) or ``explore_lite`` (the frontier agent's utility,
             which lost coverage on region actions).
-        max_steps: Optional step limit of the agent.
+    """
+
+    regions: dict[str, Any] | None = None
+    teacher: str = setting("greedy", choices=sorted(TEACHERS))
+
+    def validate(self) -> None:
+        RegionsConfig.from_dict(self.regions, "regions")
+
+
+class RegionAgent(Agent):
+    """Region decisions every ``decision_steps`` steps, steered as ``SfW-ExploreRegions-v0``.
+
+    Parameters: :class:`RegionAgentSettings` (keyword arguments, checked).
     """
 
     name = "region-teacher"
 
-    def __init__(
-        self,
-        regions: dict[str, Any] | None = None,
-        teacher: str = "greedy",
-        max_steps: int | None = None,
-    ) -> None:
-        super().__init__(max_steps=max_steps)
-        self.regions = dict(regions or {})
-        self.config = RegionsConfig.from_dict(self.regions, "regions")
-        self.teacher = check("teacher", teacher, choices=sorted(TEACHERS))
+    settings_class = RegionAgentSettings
+    settings: RegionAgentSettings
+
+    def __init__(self, **params: Any) -> None:
+        super().__init__(**params)
+        self.config = RegionsConfig.from_dict(self.settings.regions, "regions")
 
     def _on_reset(self, view: RobotView) -> None:
         cfg = self.config
@@ -80,7 +90,7 @@ class RegionAgent(Agent):
         """The region: a candidate index (the ``teacher``'s choice on the menu, the first
         allowed candidate when it has none). ``extra``: the menu's observation entries
         (``candidates``, ``candidate_mask``)."""
-        choice = TEACHERS[self.teacher](menu)
+        choice = TEACHERS[self.settings.teacher](menu)
         if choice is None:
             return int(np.argmax(action_masks(menu, self.config.max_candidates)))
         return choice

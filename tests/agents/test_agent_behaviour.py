@@ -21,6 +21,7 @@ tests do not flake; the margins leave room for numerical differences across plat
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 
 import gymnasium as gym
@@ -134,7 +135,7 @@ def test_cross_pass_utility_counts_band_cells_one_plus_bonus_times():
     agent.band[0, :3] = True
     f = Frontier(np.array([[0, c] for c in range(5)]), (0.0, 2.0))  # 3 of 5 cells in the band
     assert agent._utility(view, f.cells, 1.0) == pytest.approx((5 + 2.0 * 3) * 0.1 - 3.0 * 1.0)
-    agent.band_bonus = 0.0
+    agent.settings = dataclasses.replace(agent.settings, band_bonus=0.0)
     assert agent._utility(view, f.cells, 1.0) == pytest.approx(5 * 0.1 - 3.0)
 
 

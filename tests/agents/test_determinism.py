@@ -12,6 +12,7 @@ learned agents act deterministically by default, so their default ignores the ag
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import pickle
@@ -37,13 +38,19 @@ ENV_IDS = {"continuous": "SfW-Explore-v0", "discrete": "SfW-ExploreDiscrete-v0"}
 ALWAYS_STOCHASTIC = {"random"}
 
 
+def _fields(settings_class: type) -> set[str]:
+    return {f.name for f in dataclasses.fields(settings_class)}
+
+
 def variants() -> list[tuple[str, dict[str, Any], str]]:
     """(agent, params, action type) of every registered agent and action type; the agents
     with a ``deterministic`` parameter also with ``deterministic=False`` (sampling)."""
     out = []
     for name in AGENTS:
         cls = agent_class(name)
-        sampling = [{"deterministic": False}] if "deterministic" in cls._param_names() else []
+        sampling = (
+            [{"deterministic": False}] if "deterministic" in _fields(cls.settings_class) else []
+        )
         for params in [{}, *sampling]:
             for action_type in cls.action_types:
                 out.append((name, params, action_type))
@@ -138,7 +145,7 @@ def test_same_seeds_give_the_same_episode_whatever_the_global_generators(variant
     assert_same(first, again)
     # no draw from numpy's, Python's or torch's global generator while resetting and acting
     assert first["global_rng_untouched"] and again["global_rng_untouched"]
-    if "deterministic" in agent_class(name)._param_names():
+    if "deterministic" in _fields(agent_class(name).settings_class):
         assert first["decisions"] >= 5  # the policy chose several times
 
 
@@ -146,7 +153,7 @@ def test_same_seeds_give_the_same_episode_whatever_the_global_generators(variant
 def test_the_agent_seed_steers_exactly_the_stochastic_agents(variant):
     name, params, action_type = variant
     stochastic_agent = stochastic(name, params)
-    learned = "deterministic" in agent_class(name)._param_names()
+    learned = "deterministic" in _fields(agent_class(name).settings_class)
     if not (stochastic_agent or learned):
         pytest.skip(f"{name} makes no random choice")
     if learned and action_type != "continuous":
