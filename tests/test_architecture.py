@@ -12,7 +12,17 @@ from pathlib import Path
 import pytest
 import tomllib
 
+from sfw_gym.core import data
+
 REPO = Path(__file__).resolve().parents[1]
+
+
+#: The shipped trained agents' folders (rl-zoo's <algo>/<env-id>_<n>) and their env ids.
+SHIPPED_MODELS = {
+    data.DEFAULT_WAYPOINT_MODEL_DIR: "SfW-Explore-v0",
+    data.DEFAULT_MODEL_DIR: "SfW-ExploreGoals-v0",
+    data.DEFAULT_REGIONS_MODEL_DIR: "SfW-ExploreRegions-v0",
+}
 
 
 def test_layer_contracts_hold():
@@ -35,6 +45,17 @@ def test_no_import_cycle_between_modules():
     assert not cycles, "import cycles:\n" + "\n".join(" → ".join(c) for c in cycles)
 
 
+def test_every_module_says_its_job_in_a_docstring():
+    import ast
+
+    missing = [
+        str(path.relative_to(REPO))
+        for path in sorted((REPO / "sfw_gym").rglob("*.py"))
+        if not ast.get_docstring(ast.parse(path.read_text(encoding="utf-8")))
+    ]
+    assert not missing, f"modules without a docstring: {missing}"
+
+
 @pytest.mark.slow
 def test_type_checker_is_clean():
     from mypy import api
@@ -53,20 +74,14 @@ def test_making_and_stepping_an_env_imports_no_torch():
 
 
 def test_every_data_file_the_package_reads_is_in_the_wheel():
-    from sfw_gym.core import data
-
     patterns = tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["setuptools"][
         "package-data"
     ]["sfw_gym"]
     package = REPO / "sfw_gym"
-    read = [
-        data.DEFAULT_WAYPOINT_MODEL_DIR / "model.zip",
-        data.DEFAULT_WAYPOINT_MODEL_DIR / "config.yml",
-        data.DEFAULT_MODEL_DIR / "model.zip",
-        data.DEFAULT_MODEL_DIR / "config.yml",
-        data.DEFAULT_HYPERPARAMS,
-        data.SCENARIOS,
-    ]
+    read = [data.DEFAULT_HYPERPARAMS, data.SCENARIOS]
+    for folder, env_id in SHIPPED_MODELS.items():  # each with rl-zoo's files, for rl_zoo3.enjoy
+        read += [folder / f"{env_id}.zip", folder / "config.yml"]
+        read += [folder / env_id / "config.yml", folder / env_id / "args.yml"]
     for path in read:
         assert path.is_file(), path
         rel = path.resolve().relative_to(package.resolve()).as_posix()
@@ -78,15 +93,21 @@ def test_checkout_agents_and_envs_are_the_package_data_not_copies():
         assert (REPO / name).resolve() == (REPO / "sfw_gym" / "data" / name).resolve()
 
 
-def test_models_saved_under_the_old_policy_path_still_load():
-    from sfw_gym.core.data import DEFAULT_WAYPOINT_MODEL_DIR
-    from sfw_gym.rl.training import import_dotted
+@pytest.mark.parametrize("folder", list(SHIPPED_MODELS), ids=lambda f: f.name)
+def test_shipped_models_load_plainly_with_their_policies_where_they_live(folder):
+    """No custom unpickler, no custom_objects: ``PPO.load`` / ``MaskablePPO.load`` as rl-zoo
+    calls them; every class the model pickled is importable from the path it names."""
+    pytest.importorskip("sb3_contrib")
+    import yaml
+    from sb3_contrib import MaskablePPO
+    from stable_baselines3 import PPO
 
-    with zipfile.ZipFile(DEFAULT_WAYPOINT_MODEL_DIR / "model.zip") as archive:
-        assert b"sfw_gym.agents.waypoint_policy" in archive.read("data")  # pickled before the move
-    from sfw_gym.rl.policy import WaypointPolicy
-
-    assert import_dotted("sfw_gym.agents.waypoint_policy.WaypointPolicy") is WaypointPolicy
-    from sfw_gym.rl import WaypointPPOAgent
-
-    assert isinstance(WaypointPPOAgent().model.policy, WaypointPolicy)
+    env_id = SHIPPED_MODELS[folder]
+    model_zip = folder / f"{env_id}.zip"
+    with zipfile.ZipFile(model_zip) as archive:
+        assert b"sfw_gym.agents.waypoint_policy" not in archive.read("data")  # the old path
+    assert not (folder / "model.zip").exists()
+    algo = {"ppo": PPO, "ppo_mask": MaskablePPO}[folder.parent.name]
+    model = algo.load(model_zip, device="cpu")
+    policy = yaml.safe_load((folder / env_id / "config.yml").read_text(encoding="utf-8"))["policy"]
+    assert f"{type(model.policy).__module__}.{type(model.policy).__name__}" == policy
