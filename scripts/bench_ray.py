@@ -22,7 +22,7 @@ import time
 from pathlib import Path
 
 from sfw_gym.evaluation import evaluate
-from sfw_gym.evaluation.runner import _append_record
+from sfw_gym.evaluation.checkpoint import append_record
 
 AGENTS = ["frontier", "random"]
 
@@ -49,7 +49,7 @@ def driver_cost_s(folder: Path, records: int = 200) -> float:
     path = folder / "append.jsonl"
     start = time.perf_counter()
     for _ in range(records):
-        _append_record(path, record)
+        append_record(path, record)
     return (time.perf_counter() - start) / records
 
 

@@ -11,7 +11,8 @@ import re
 from pathlib import Path
 
 from sfw_gym.agents import AGENTS
-from sfw_gym.evaluation.benchmark import METRIC_LABELS, format_interval, run_benchmark
+from sfw_gym.evaluation.benchmark import format_interval, run_benchmark
+from sfw_gym.evaluation.metric_table import METRICS
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "benchmark.md"
 COLUMNS = ("coverage", "info_gain_per_m", "path_length_m", "free_iou", "wall_precision", "ate_m")
@@ -36,14 +37,11 @@ def main() -> None:
     for env_id in first["summary"]:
         columns = [c for c in COLUMNS if any(c in r["summary"][env_id] for r in results.values())]
         lines += ["", f"**{env_id}** ({first['summary'][env_id]['coverage']['n']} episodes)", ""]
-        lines.append("| agent | " + " | ".join(METRIC_LABELS[c][0] for c in columns) + " |")
+        lines.append("| agent | " + " | ".join(METRICS[c].label for c in columns) + " |")
         lines.append("|---|" + "---:|" * len(columns))
         for name, r in results.items():
             stats = r["summary"][env_id]
-            cells = [
-                format_interval(stats[c], METRIC_LABELS[c][1]) if c in stats else "–"
-                for c in columns
-            ]
+            cells = [format_interval(stats[c], c) if c in stats else "–" for c in columns]
             lines.append(f"| {name} | " + " | ".join(cells) + " |")
     text = DOC.read_text(encoding="utf-8")
     block = "<!-- benchmark:begin -->\n" + "\n".join(lines) + "\n<!-- benchmark:end -->"

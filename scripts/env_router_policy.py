@@ -2,7 +2,8 @@
 id with the mapper's ``router_policy`` "strongest" (the env's default) vs "all", paired on the
 same seeds (the same plan, routers, radio and, up to the maps' influence on frontier, route).
 Prints the final maps' free-space IoU, wall precision and interior-wall recall per policy and the
-paired differences (all − strongest) with 95 % confidence intervals.
+paired differences (all − strongest) with 95 % intervals (the package's paired comparison: a
+seeded bootstrap over the seeds).
 
     python scripts/env_router_policy.py --episodes 12 --seed 2000000
 """
@@ -17,7 +18,7 @@ import numpy as np
 
 import sfw_gym  # noqa: F401  (registers the envs)
 from sfw_gym.agents import make_agent
-from sfw_gym.evaluation.stats import mean_ci95
+from sfw_gym.evaluation.stats import compare_paired
 from sfw_gym.mapping.metrics import evaluate_map
 
 METRICS = ("free_iou", "wall_precision", "interior_wall_recall")
@@ -56,11 +57,10 @@ def main() -> None:
     print("| metric | strongest | all | all − strongest [95 % CI] |\n|---|---|---|---|")
     for m in METRICS:
         a, b = (np.array([r[m] for r in by[p]], float) for p in POLICIES)
-        ok = np.isfinite(a) & np.isfinite(b)
-        mean, half, n = mean_ci95((b - a)[ok])
+        d = compare_paired(a, b)
         print(
             f"| {m} | {np.nanmean(a):.3f} | {np.nanmean(b):.3f} | "
-            f"{mean:+.3f} [{mean - half:+.3f}, {mean + half:+.3f}] (n={n}) |"
+            f"{d.mean:+.3f} [{d.low:+.3f}, {d.high:+.3f}] (n={d.n}) |"
         )
 
 

@@ -6,7 +6,8 @@ layout, the disagreeing radio: shadowing, per-router/band transmit offsets, dear
 missed readings), maps it with every method through :func:`sfw_gym.mapping.offline.map_log`
 exactly as ``sfw-gym map`` does, and scores each map on the recorded truth. Prints, per router
 count, the mean of each metric per method and each method's paired difference from the reference
-with its 95 % confidence interval (Student t over logs); writes every row to ``OUT/rows.csv``.
+with its 95 % interval (the package's paired comparison, a seeded bootstrap over logs); writes
+every row to ``OUT/rows.csv``.
 
     python scripts/mapper_logs_study.py --generated 10 --out runs/logs_study
 """
@@ -21,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from sfw_gym.evaluation.logs import read_log_meta, record_log, score_map
-from sfw_gym.evaluation.stats import mean_ci95
+from sfw_gym.evaluation.stats import compare_paired
 from sfw_gym.mapping import MapperConfig
 from sfw_gym.mapping.offline import map_log
 from sfw_gym.world import generate_floorplan, load_floorplan
@@ -110,11 +111,10 @@ def main() -> None:
             for m in METRICS:
                 vals = np.array([table[p, label][m] for p in plans], float)
                 ref = np.array([table[p, REFERENCE][m] for p in plans], float)
-                ok = np.isfinite(vals) & np.isfinite(ref)
                 cell = f"{np.nanmean(vals):.3f}"
                 if label != REFERENCE and REFERENCE in methods:
-                    mean, half, n = mean_ci95((vals - ref)[ok])
-                    cell += f" ({mean:+.3f} [{mean - half:+.3f}, {mean + half:+.3f}], n={n})"
+                    d = compare_paired(ref, vals)
+                    cell += f" ({d.mean:+.3f} [{d.low:+.3f}, {d.high:+.3f}], n={d.n})"
                 cells.append(cell)
             us = np.mean([table[p, label]["us_mean"] for p in plans])
             print(f"| {label} | " + " | ".join(cells) + f" | {us:.1f} |")

@@ -6,7 +6,8 @@ Trains ``sfw-gym train ppo`` on ``SfW-ExploreSmall-v0`` (raw continuous actions,
 ``MultiInputPolicy``, the hyperparameters and ``env_kwargs`` of ``ppo.yml``; resumable), prints
 the held-out return at each evaluation (the learning curve), then the episode return of the trained
 policy and of uniformly random actions on the same held-out seeds (2,000,000 + i), paired: mean
-difference with a 95 % CI (Student t). If this does not rise, nothing above it will.
+difference with a 95 % interval (the package's paired comparison: a seeded bootstrap). If this
+does not rise, nothing above it will.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import gymnasium as gym
 import numpy as np
 
 import sfw_gym  # noqa: F401  (registration)
-from sfw_gym.evaluation.stats import ci95_half_width
+from sfw_gym.evaluation.stats import compare_paired
 from sfw_gym.rl.training import train_ppo
 
 ENV_ID = "SfW-ExploreSmall-v0"
@@ -58,20 +59,18 @@ def main() -> None:
 
     from stable_baselines3 import PPO
 
-    model = PPO.load(out / "model.zip", device="cpu")
+    model = PPO.load(out / f"{ENV_ID}.zip", device="cpu")
     env = gym.make(ENV_ID, **summary["env_kwargs"])  # as trained (the YAML's env_kwargs)
     env.action_space.seed(0)
     seeds = range(2_000_000, 2_000_000 + args.episodes)
     learned = [episode_return(env, s, lambda o: model.predict(o)[0]) for s in seeds]
     random = [episode_return(env, s, lambda o: env.action_space.sample()) for s in seeds]
-    diff = np.array(learned) - np.array(random)
-    half = ci95_half_width(diff)
+    d = compare_paired(random, learned)
     print(
         f"{args.episodes} held-out seeds, episode return: PPO {np.mean(learned):.2f} (sampled "
         f"actions), random actions {np.mean(random):.2f}"
     )
-    lo, hi = diff.mean() - half, diff.mean() + half
-    print(f"  PPO − random, paired: {diff.mean():+.2f} [{lo:+.2f}, {hi:+.2f}]")
+    print(f"  PPO − random, paired: {d.mean:+.2f} [{d.low:+.2f}, {d.high:+.2f}]")
 
 
 if __name__ == "__main__":

@@ -14,7 +14,8 @@ from typing import Any
 
 from sfw_gym.core.atomic import write_text_atomic
 from sfw_gym.core.data import scenario
-from sfw_gym.evaluation import evaluate
+from sfw_gym.evaluation import evaluate, results_markdown
+from sfw_gym.evaluation.metric_table import METRICS
 
 DEMO_AGENTS = ("frontier", "cross-pass", "regions-ppo")
 DEMO_ENV = "SfW-Explore-v0"  # the shipped policy's env
@@ -80,11 +81,11 @@ def _index_markdown(
         "",
         "## Results (mean ± 95 % CI over episodes)",
         "",
-        (out / "results.md").read_text(encoding="utf-8").rstrip(),
+        results_markdown(result["rows"]).rstrip(),
         "",
-        "*info gain*: the map's entropy decrease per metre driven (bits/m), what the reward pays "
-        "for per unit of effort. Full table: [results.csv](results.csv); per-episode records: "
-        "[episodes.jsonl](episodes.jsonl).",
+        f"*{METRICS['info_gain_per_m'].label}*: the map's entropy decrease per metre driven, what "
+        "the reward pays for per unit of effort. Full table: [results.csv](results.csv); "
+        "per-episode records: [episodes.jsonl](episodes.jsonl).",
         "",
         "## Curves",
         "",

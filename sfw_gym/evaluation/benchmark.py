@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 import time
 from pathlib import Path
 from typing import Any
@@ -22,21 +21,15 @@ import yaml
 from sfw_gym.core.atomic import write_text_atomic
 from sfw_gym.core.data import data_path
 from sfw_gym.core.errors import ConfigError
+from sfw_gym.evaluation.checkpoint import require_same_run
+from sfw_gym.evaluation.executor import Executor
+from sfw_gym.evaluation.metric_table import METRICS
+from sfw_gym.evaluation.report import paired_table
+from sfw_gym.evaluation.stats import bootstrap_ci, paired_comparison
 
 SPLITS = ("train", "validation", "test")
 #: Record fields that are timings (left out of results.json's episodes).
 TIMING_FIELDS = ("wall_s", "steps_per_s")
-#: Each metric's column label and number format.
-METRIC_LABELS = {
-    "coverage": ("coverage", "{:.3f}"),
-    "steps_to_coverage_90": ("steps to 90 %", "{:.0f}"),
-    "info_gain_per_m": ("info gain [bits/m]", "{:.1f}"),
-    "path_length_m": ("path [m]", "{:.0f}"),
-    "free_iou": ("free IoU", "{:.3f}"),
-    "wall_precision": ("wall precision", "{:.3f}"),
-    "interior_wall_recall": ("wall recall", "{:.3f}"),
-    "ate_m": ("ATE [m]", "{:.2f}"),
-}
 
 
 # ---------------------------------------------------------------------------------- protocol
@@ -64,9 +57,9 @@ def load_protocol(name: str | Path = "benchmark-v1") -> dict[str, Any]:
     for env in protocol["envs"]:
         if not isinstance(env, dict) or "id" not in env or "episodes" not in env:
             raise ConfigError(f"{where}: each env needs an id and episodes per split: {env}")
-    unknown = set(protocol["metrics"]) - set(METRIC_LABELS)
+    unknown = set(protocol["metrics"]) - set(METRICS)
     if unknown:
-        known = list(METRIC_LABELS)
+        known = list(METRICS)
         raise ConfigError(f"{where}: unknown metrics {sorted(unknown)}; known: {known}")
     protocol["sha256"] = hashlib.sha256(text.encode()).hexdigest()
     return protocol
@@ -124,7 +117,8 @@ def run_benchmark(
     ``episodes`` caps the episodes per env (a quick look; recorded in the results);
     ``workers``, ``backend`` and ``address`` as :func:`~sfw_gym.evaluation.evaluate`'s."""
     from sfw_gym import __version__
-    from sfw_gym.evaluation.runner import EpisodeSpec, run_specs
+    from sfw_gym.evaluation.rollout import EpisodeSpec
+    from sfw_gym.evaluation.runner import run_specs
 
     proto = load_protocol(protocol)
     first, last = split_seeds(proto, split)
@@ -153,11 +147,17 @@ def run_benchmark(
                     npz_path=None,
                 )
             )
-    _check_same_run(out, proto, agent, agent_params, split, plans)
+    executor = Executor(workers=workers, backend=backend, address=address, progress=progress)
+    run = {
+        "protocol_sha256": proto["sha256"],
+        "agent": agent,
+        "agent_params": json.loads(json.dumps(agent_params or {})),
+        "split": split,
+        "plans": None if plans is None else str(plans),
+    }
+    require_same_run(out, run, "benchmark")
     start = time.perf_counter()
-    records = run_specs(
-        specs, out, workers=workers, backend=backend, address=address, progress=progress
-    )
+    records = run_specs(specs, out, executor)
     results = {
         "protocol": proto["name"],
         "protocol_version": proto["version"],
@@ -178,35 +178,6 @@ def run_benchmark(
     return results
 
 
-def _check_same_run(
-    out: Path,
-    protocol: dict[str, Any],
-    agent: str,
-    agent_params: dict[str, Any] | None,
-    split: str,
-    plans: str | Path | None,
-) -> None:
-    """Resuming in ``out`` is allowed for the same run only (its checkpoint's records would
-    otherwise count as this run's): ``OUT/run.json`` records what ran."""
-    run = {
-        "protocol_sha256": protocol["sha256"],
-        "agent": agent,
-        "agent_params": json.loads(json.dumps(agent_params or {})),
-        "split": split,
-        "plans": None if plans is None else str(plans),
-    }
-    path = out / "run.json"
-    if path.is_file():
-        previous = json.loads(path.read_text(encoding="utf-8"))
-        if previous != run:
-            changed = sorted(k for k in run if previous.get(k) != run[k])
-            raise ConfigError(
-                f"{out} holds another benchmark run (different {', '.join(changed)}): "
-                "choose another --out"
-            )
-    write_text_atomic(path, json.dumps(run, indent=1, sort_keys=True) + "\n")
-
-
 def _episode_row(record: dict[str, Any], protocol: dict[str, Any]) -> dict[str, Any]:
     row = {k: record[k] for k in ("env_id", "seed", "floorplan", "steps")}
     for metric in protocol["metrics"]:
@@ -221,23 +192,21 @@ def _key(row: dict[str, Any]) -> tuple[str, int, str]:
     return row["env_id"], row["seed"], row["floorplan"]
 
 
-def bootstrap_ci(values: np.ndarray, protocol: dict[str, Any]) -> tuple[float, float]:
-    """The protocol's bootstrap interval of the mean of ``values`` (equal values: a point)."""
-    from scipy import stats
-
+def intervals(protocol: dict[str, Any]) -> dict[str, Any]:
+    """The protocol's bootstrap settings, as :func:`~sfw_gym.evaluation.stats.bootstrap_ci`'s
+    keywords."""
     iv = protocol["intervals"]
-    if len(values) < 2 or np.ptp(values) == 0:
-        mean = float(np.mean(values)) if len(values) else math.nan
-        return mean, mean
-    res = stats.bootstrap(
-        (values,),
-        np.mean,
-        confidence_level=float(iv["confidence"]),
-        n_resamples=int(iv["resamples"]),
-        method="percentile",
-        random_state=np.random.default_rng(int(iv["random_state"])),
-    )
-    return float(res.confidence_interval.low), float(res.confidence_interval.high)
+    return {
+        "confidence": float(iv["confidence"]),
+        "resamples": int(iv["resamples"]),
+        "random_state": int(iv["random_state"]),
+    }
+
+
+def _all_zero(values: list[Any]) -> bool:
+    """No value, or all zero (as ATE where the odometry does not drift): not reported."""
+    v = np.array([x for x in values if x is not None], np.float64)
+    return not len(v) or bool(np.allclose(v, 0.0))
 
 
 def summarize_results(results: dict[str, Any], protocol: dict[str, Any]) -> dict[str, Any]:
@@ -248,10 +217,10 @@ def summarize_results(results: dict[str, Any], protocol: dict[str, Any]) -> dict
         rows = [r for r in results["episodes"] if r["env_id"] == env_id]
         summary[env_id] = {}
         for metric in protocol["metrics"]:
-            values = np.array([r[metric] for r in rows if r[metric] is not None], np.float64)
-            if not len(values) or np.allclose(values, 0.0):
+            if _all_zero([r[metric] for r in rows]):
                 continue
-            low, high = bootstrap_ci(values, protocol)
+            values = np.array([r[metric] for r in rows if r[metric] is not None], np.float64)
+            low, high = bootstrap_ci(values, **intervals(protocol))
             summary[env_id][metric] = {
                 "mean": float(values.mean()),
                 "ci_low": low,
@@ -261,12 +230,10 @@ def summarize_results(results: dict[str, Any], protocol: dict[str, Any]) -> dict
     return summary
 
 
-def format_interval(stats: dict[str, Any], fmt: str) -> str:
-    """``mean [low, high]`` of a summary entry."""
-    return (
-        f"{fmt.format(stats['mean'])} [{fmt.format(stats['ci_low'])}, "
-        f"{fmt.format(stats['ci_high'])}]"
-    )
+def format_interval(stats: dict[str, Any], metric: str) -> str:
+    """``mean [low, high]`` of a summary entry, in the metric's format."""
+    m = METRICS[metric]
+    return f"{m.format(stats['mean'])} [{m.format(stats['ci_low'])}, {m.format(stats['ci_high'])}]"
 
 
 def results_markdown(results: dict[str, Any]) -> str:
@@ -281,8 +248,7 @@ def results_markdown(results: dict[str, Any]) -> str:
         n = max((s["n"] for s in metrics.values()), default=0)
         lines += ["", f"## {env_id} ({n} episodes)", "", "| metric | value |", "|---|---:|"]
         for metric, stats in metrics.items():
-            label, fmt = METRIC_LABELS[metric]
-            lines.append(f"| {label} | {format_interval(stats, fmt)} |")
+            lines.append(f"| {METRICS[metric].label} | {format_interval(stats, metric)} |")
     return "\n".join(lines) + "\n"
 
 
@@ -314,28 +280,15 @@ def compare(a: dict[str, Any], b: dict[str, Any], protocol: str | Path | None = 
     pairs = [(rows_a[_key(r)], r) for r in b["episodes"] if _key(r) in rows_a]
     if not pairs:
         raise ConfigError("the two results share no episode (env, seed, plan)")
-    lines = [
-        f"{b['agent']} − {a['agent']} on {a['protocol']} / {a['split']}, paired by episode; "
-        "mean difference [95 % bootstrap interval].",
-        "",
-        "| env | metric | pairs | " + f"{a['agent']} | {b['agent']} | difference |",
-        "|---|---|---:|---:|---:|---:|",
-    ]
+    groups = []
     for env_id in dict.fromkeys(_key(x)[0] for x, _ in pairs):
         env_pairs = [(x, y) for x, y in pairs if x["env_id"] == env_id]
-        for metric in proto["metrics"]:
-            both = [(x[metric], y[metric]) for x, y in env_pairs]
-            both = [(p, q) for p, q in both if p is not None and q is not None]
-            values = np.array(both, np.float64).reshape(-1, 2)
-            if not len(values) or np.allclose(values, 0.0):
-                continue
-            label, fmt = METRIC_LABELS[metric]
-            diff = values[:, 1] - values[:, 0]
-            low, high = bootstrap_ci(diff, proto)
-            signed = fmt.replace("{:", "{:+")
-            lines.append(
-                f"| {env_id} | {label} | {len(diff)} | {fmt.format(values[:, 0].mean())} | "
-                f"{fmt.format(values[:, 1].mean())} | {signed.format(diff.mean())} "
-                f"[{signed.format(low)}, {signed.format(high)}] |"
-            )
-    return "\n".join(lines) + "\n"
+        metrics = [
+            m for m in proto["metrics"] if not _all_zero([v[m] for pair in env_pairs for v in pair])
+        ]
+        groups.append((env_id, paired_comparison(env_pairs, metrics, **intervals(proto))))
+    head = (
+        f"{b['agent']} − {a['agent']} on {a['protocol']} / {a['split']}, paired by episode; "
+        "mean difference [95 % bootstrap interval]."
+    )
+    return head + "\n\n" + paired_table(groups, group="env", a=a["agent"], b=b["agent"])

@@ -13,18 +13,16 @@ its mean and its max.
 from __future__ import annotations
 
 import json
-import multiprocessing as mp
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from sfw_gym.core.atomic import atomic_path, write_text_atomic
-from sfw_gym.core.processes import die_with_parent
 from sfw_gym.evaluation.drives import record_frontier_drive
+from sfw_gym.evaluation.executor import Executor
 from sfw_gym.evaluation.stats import mean_ci95
 from sfw_gym.localization import GaussianGridmaps, MclConfig, SignalModel, Survey, WifiMCL
 from sfw_gym.slam import relative_pose
@@ -183,9 +181,15 @@ def run_localization_study(
     particles: int = 500,
     direct: bool = True,
     workers: int = 2,
+    backend: str = "local",
+    address: str | None = None,
+    progress: bool = True,
 ) -> dict[str, Any]:
     """Run the study; writes ``results.json``, ``tables.md``, ``gridmaps.png`` and
-    ``error_over_time.png`` into ``out_dir``; returns the results."""
+    ``error_over_time.png`` into ``out_dir``; returns the results. A plan is a job of the
+    :class:`~sfw_gym.evaluation.executor.Executor` (``workers``, ``backend``, ``address``,
+    ``progress``: a bar over the plans)."""
+    executor = Executor(workers=workers, backend=backend, address=address, progress=progress)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     jobs = [
@@ -201,16 +205,7 @@ def run_localization_study(
         for i in range(plans)
     ]
     start = time.perf_counter()
-    if workers == 1:
-        results = [study_plan(job) for job in jobs]
-    else:
-        with ProcessPoolExecutor(
-            workers,
-            mp_context=mp.get_context("spawn"),
-            initializer=die_with_parent,
-            initargs=(os.getpid(),),
-        ) as pool:
-            results = list(pool.map(study_plan, jobs))
+    results = executor.map(study_plan, jobs, desc="localisation study", unit="plan")
     wall = time.perf_counter() - start
     summary = summarise(results, plans, runs, particles, test_steps, wall)
     figure = results[0]

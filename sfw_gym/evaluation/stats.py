@@ -1,37 +1,28 @@
-"""Statistics over episode records: means with 95 % confidence intervals, per agent."""
+"""Statistics over episode records: means with 95 % confidence intervals (Student t) per agent,
+bootstrap intervals of a mean, and the one paired comparison (the mean difference over paired
+episodes with a seeded bootstrap interval) that evaluate, the benchmark and the scripts use."""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-#: Metrics of the results table: (record key, column label, format).
-TABLE_METRICS: tuple[tuple[str, str, str], ...] = (
-    ("coverage", "coverage", "{:.3f}"),
-    ("map_iou", "IoU", "{:.3f}"),
-    ("free_iou", "free IoU", "{:.3f}"),
-    ("k_accuracy", "k-accuracy", "{:.3f}"),
-    ("path_length_m", "path [m]", "{:.0f}"),
-    ("info_gain_per_m", "info gain [bits/m]", "{:.0f}"),
-    ("collisions", "collisions", "{:.0f}"),
-    ("steps_to_coverage_50", "steps to 50 %", "{:.0f}"),
-    ("steps_to_coverage_90", "steps to 90 %", "{:.0f}"),
-    ("zone_band_unknown", "unknown zone-band cells", "{:.0f}"),
-    ("zone_band_unknown_frac", "unknown zone-band fraction", "{:.3f}"),
+from sfw_gym.evaluation.metric_table import (
+    HIGHER,
+    LOWER,
+    PAIRED_METRICS,
+    REACHED_METRICS,
+    TABLE_METRICS,
 )
-#: Metrics of the paired table (agent − reference on the same plans and seeds).
-PAIRED_METRICS: tuple[tuple[str, str, str], ...] = (
-    ("coverage", "Δ coverage", "{:+.3f}"),
-    ("info_gain_per_m", "Δ bits/m", "{:+.1f}"),
-    ("path_length_m", "Δ path [m]", "{:+.0f}"),
-    ("free_iou", "Δ free IoU", "{:+.3f}"),
-    ("wall_precision", "Δ wall precision", "{:+.3f}"),
-)
-#: "steps to x %" metrics are averaged over the episodes that got there (count reported).
-REACHED_METRICS = ("steps_to_coverage_50", "steps_to_coverage_90")
+
+#: The bootstrap of every interval that is not a Student t (the benchmark protocol's
+#: ``intervals`` block gives its own; benchmark-v1's are these): confidence level, resamples
+#: and the seed of the resampling (the same numbers on every run).
+BOOTSTRAP: dict[str, Any] = {"confidence": 0.95, "resamples": 10_000, "random_state": 0}
 
 
 def ci95_half_width(samples: np.ndarray) -> np.ndarray | float:
@@ -65,12 +56,12 @@ def summarize(records: list[dict[str, Any]], agents: Sequence[str]) -> list[dict
     for name in agents:
         recs = [r for r in records if r["agent"] == name]
         row: dict[str, Any] = {"agent": name, "episodes": len(recs)}
-        for key, _, _ in TABLE_METRICS:
-            vals = [r.get(key) for r in recs]
-            if key in REACHED_METRICS:
+        for m in TABLE_METRICS:
+            vals = [r.get(m.key) for r in recs]
+            if m.key in REACHED_METRICS:
                 vals = [v for v in vals if v is not None and v >= 0]
             mean, ci, n = mean_ci95([v for v in vals if v is not None])
-            row[f"{key}_mean"], row[f"{key}_ci95"], row[f"{key}_n"] = mean, ci, n
+            row[f"{m.key}_mean"], row[f"{m.key}_ci95"], row[f"{m.key}_n"] = mean, ci, n
         cov = [r.get("coverage", 0.0) for r in recs]
         row["episodes_coverage_ge_90"] = int(sum(c >= 0.9 for c in cov))
         row["episodes_coverage_ge_80"] = int(sum(c >= 0.8 for c in cov))
@@ -82,26 +73,140 @@ def summarize(records: list[dict[str, Any]], agents: Sequence[str]) -> list[dict
     return rows
 
 
+# ---------------------------------------------------------------------------------- bootstrap
+def bootstrap_ci(
+    values: Sequence[float] | np.ndarray,
+    *,
+    confidence: float = BOOTSTRAP["confidence"],
+    resamples: int = BOOTSTRAP["resamples"],
+    random_state: int = BOOTSTRAP["random_state"],
+) -> tuple[float, float]:
+    """The percentile-bootstrap interval of the mean of ``values`` (scipy.stats.bootstrap,
+    seeded: the same interval every time); fewer than two values or equal values: the mean."""
+    from scipy import stats
+
+    v = np.asarray(values, np.float64)
+    if len(v) < 2 or np.ptp(v) == 0:
+        mean = float(np.mean(v)) if len(v) else math.nan
+        return mean, mean
+    res = stats.bootstrap(
+        (v,),
+        np.mean,
+        confidence_level=float(confidence),
+        n_resamples=int(resamples),
+        method="percentile",
+        random_state=np.random.default_rng(int(random_state)),
+    )
+    return float(res.confidence_interval.low), float(res.confidence_interval.high)
+
+
+# ---------------------------------------------------------------------------------- pairing
+@dataclass(frozen=True)
+class PairedDifference:
+    """One metric compared over paired episodes: ``b − a``.
+
+    Attributes:
+        metric: The record key.
+        n: Pairs where both values are finite.
+        mean_a, mean_b: The two sides' means over those pairs.
+        mean: Mean of the differences ``b − a``.
+        low, high: Its bootstrap interval (:func:`bootstrap_ci`).
+    """
+
+    metric: str
+    n: int
+    mean_a: float
+    mean_b: float
+    mean: float
+    low: float
+    high: float
+
+    def resolved(self, direction: int) -> str:
+        """Where the interval leaves out zero (n ≥ 2): ``"better"``/``"worse"`` for b, by the
+        metric's direction (:mod:`~sfw_gym.evaluation.metric_table`), or ``"higher"``/
+        ``"lower"`` where neither way is better; ``""`` where it holds zero."""
+        if self.n < 2 or self.low <= 0.0 <= self.high:
+            return ""
+        up = self.low > 0.0
+        if direction in (HIGHER, LOWER):
+            return "better" if up == (direction == HIGHER) else "worse"
+        return "higher" if up else "lower"
+
+
+def _finite(x: Any) -> bool:
+    return x is not None and math.isfinite(float(x))
+
+
+def compare_paired(
+    a: Sequence[float | None] | np.ndarray,
+    b: Sequence[float | None] | np.ndarray,
+    *,
+    metric: str = "",
+    **intervals: Any,
+) -> PairedDifference:
+    """The paired comparison: ``a[i]`` and ``b[i]`` are one episode's values on either side
+    (the same plan and seed); pairs with a missing or non-finite value are left out. The mean of
+    ``b − a`` with its bootstrap interval (``intervals``: :func:`bootstrap_ci`'s keywords)."""
+    if len(a) != len(b):
+        raise ValueError(f"compare_paired: {len(a)} values against {len(b)}")
+    both = np.array(
+        [(x, y) for x, y in zip(a, b, strict=True) if _finite(x) and _finite(y)], np.float64
+    )
+    if not len(both):
+        return PairedDifference(metric, 0, *(math.nan,) * 5)
+    diff = both[:, 1] - both[:, 0]
+    low, high = bootstrap_ci(diff, **intervals)
+    return PairedDifference(
+        metric,
+        len(diff),
+        float(both[:, 0].mean()),
+        float(both[:, 1].mean()),
+        float(diff.mean()),
+        low,
+        high,
+    )
+
+
+def paired_comparison(
+    pairs: Sequence[tuple[Mapping[str, Any], Mapping[str, Any]]],
+    metrics: Sequence[str],
+    **intervals: Any,
+) -> list[PairedDifference]:
+    """:func:`compare_paired` of each metric over ``pairs`` of records ``(a, b)``."""
+    return [
+        compare_paired(
+            [x.get(key) for x, _ in pairs], [y.get(key) for _, y in pairs], metric=key, **intervals
+        )
+        for key in metrics
+    ]
+
+
 def paired_differences(
-    records: list[dict[str, Any]], agents: Sequence[str], reference: str
+    records: list[dict[str, Any]], agents: Sequence[str], reference: str, **intervals: Any
 ) -> list[dict[str, Any]]:
-    """Per agent other than ``reference``: mean, 95 % CI and n of (agent − reference) for each
-    paired metric, over the episodes both ran (episode ``i``: the same plan and seed)."""
+    """Per agent other than ``reference``: the paired comparison (agent − reference) of each
+    paired-table metric over the episodes both ran (episode ``i``: the same plan and seed).
+
+    Returns:
+        Rows ``{"agent", "reference", "pairs", "differences": [PairedDifference, ...]}``.
+    """
     by_episode = {(r["agent"], r["episode"]): r for r in records}
     rows = []
     for name in agents:
         if name == reference:
             continue
         pairs = [
-            (rec, by_episode[(reference, episode)])
+            (by_episode[(reference, episode)], rec)
             for (agent, episode), rec in sorted(by_episode.items())
             if agent == name and (reference, episode) in by_episode
         ]
-        row: dict[str, Any] = {"agent": name, "reference": reference, "pairs": len(pairs)}
-        for key, _, _ in PAIRED_METRICS:
-            values = [(a.get(key), b.get(key)) for a, b in pairs]
-            diffs = [x - y for x, y in values if x is not None and y is not None]
-            mean, ci, n = mean_ci95(diffs)
-            row[f"{key}_diff"], row[f"{key}_ci95"], row[f"{key}_n"] = mean, ci, n
-        rows.append(row)
+        keys = [m.key for m in PAIRED_METRICS]
+        rows.append(
+            {
+                "agent": name,
+                "reference": reference,
+                "pairs": len(pairs),
+                "differences": paired_comparison(pairs, keys, **intervals),
+            }
+        )
     return rows

@@ -22,3 +22,19 @@ def test_demo_writes_the_report(tmp_path, capsys):
         assert f"]({figure})" in index and (out / figure).exists()
     overlays = sorted((out / "trajectories").glob("*.png"))
     assert len(overlays) == 1 and f"trajectories/{overlays[0].name}" in index
+
+
+def test_the_report_shows_the_results_table_of_the_one_metric_table(tmp_path):
+    from sfw_gym.demo import _index_markdown
+    from sfw_gym.evaluation import results_markdown, summarize
+    from sfw_gym.evaluation.metric_table import METRICS
+
+    records = [
+        {"agent": "frontier", "episode": 0, "floorplan": "gen-7", "area_m2": 80.0,
+         "coverage": 0.9, "info_gain_per_m": 21.25, "stop_reason": "max_steps"},
+    ]  # fmt: skip
+    result = {"records": records, "rows": summarize(records, ["frontier"])}
+    index = _index_markdown(tmp_path, result, 7, 1.0, "shipped")
+    assert results_markdown(result["rows"]).rstrip() in index
+    assert "| frontier | 1 | 0.900 |" in index and "| 21.2 |" in index  # the table's formats
+    assert f"*{METRICS['info_gain_per_m'].label}*" in index

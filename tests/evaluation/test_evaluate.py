@@ -49,7 +49,7 @@ def test_tiny_run_writes_table_curves_and_trajectories(tmp_path):
     md = (tmp_path / "results.md").read_text()
     assert "| frontier | 2 |" in md and "±" in md
     paired = (tmp_path / "paired.md").read_text()
-    assert "| random − frontier | 2 |" in paired
+    assert "| random − frontier | coverage | 2 |" in paired
     ev.evaluate(["frontier"], 2, seed=5, out=tmp_path, **TINY)  # one agent: nothing to pair
     assert not (tmp_path / "paired.md").exists()
     rec = recs[0]
@@ -204,7 +204,7 @@ def test_cli_evaluate(tmp_path, capsys):
     printed = capsys.readouterr().out
     assert "| random | 1 |" in printed
     assert "paired on the same plans and seeds:\n| agent − reference" in printed
-    assert "| frontier − random | 1 |" in printed
+    assert "| frontier − random | coverage | 1 |" in printed
     assert main(["evaluate", "--agents", "bogus", "--out", str(tmp_path)]) == 2
     assert "unknown agent" in capsys.readouterr().err
     assert (
@@ -242,11 +242,65 @@ def test_paired_differences_pair_episodes_not_agents_means():
     ]
     (row,) = ev.paired_differences(recs, ["f", "g"], reference="f")
     assert (row["agent"], row["reference"], row["pairs"]) == ("g", "f", 2)
-    assert row["coverage_diff"] == pytest.approx(0.0) and row["coverage_n"] == 2
-    # differences +0.1 and -0.1: the interval is t(0.975, 1) * sd / sqrt(2)
-    assert row["coverage_ci95"] == pytest.approx(12.7062 * math.sqrt(0.02) / math.sqrt(2), rel=1e-4)
-    assert row["info_gain_per_m_diff"] == pytest.approx(3.0) and row["info_gain_per_m_n"] == 1
-    assert "| g − f | 2 | +0.000 [" in ev.paired_markdown([row])
+    by_metric = {d.metric: d for d in row["differences"]}
+    cov, gain = by_metric["coverage"], by_metric["info_gain_per_m"]
+    # differences +0.1 and -0.1 (agent − reference, episode by episode)
+    assert (cov.n, cov.mean_a, cov.mean_b) == (2, pytest.approx(0.7), pytest.approx(0.7))
+    assert cov.mean == pytest.approx(0.0)
+    assert cov.low == pytest.approx(-0.1) and cov.high == pytest.approx(0.1)  # the bootstrap's
+    assert (gain.n, gain.mean) == (1, pytest.approx(3.0))  # the pair with a None is left out
+    table = ev.paired_markdown([row])
+    assert "| g − f | coverage | 2 | 0.700 | 0.700 | +0.000 [-0.100, +0.100] |  |" in table
+    assert "| g − f | info gain [bits/m] | 1 | 30.0 | 33.0 | +3.0 |  |" in table  # no interval
+
+
+def test_the_paired_comparison_is_a_seeded_bootstrap_of_the_mean_difference():
+    from scipy import stats
+
+    rng = np.random.default_rng(3)
+    a = rng.normal(0.6, 0.1, 30)
+    b = a + rng.normal(0.05, 0.03, 30)
+    b[4] = np.nan  # a pair with a missing side is left out
+    d = ev.compare_paired(a, b, metric="coverage")
+    keep = np.isfinite(b)
+    diff = b[keep] - a[keep]
+    assert d.n == 29 and d.mean == pytest.approx(diff.mean())
+    expected = stats.bootstrap(
+        (diff,),
+        np.mean,
+        n_resamples=10_000,
+        method="percentile",
+        random_state=np.random.default_rng(0),
+    ).confidence_interval
+    assert (d.low, d.high) == (expected.low, expected.high)
+    assert ev.compare_paired(a, b) == ev.compare_paired(a, b)  # the same numbers every run
+    assert d.low > 0 and d.resolved(+1) == "better" and d.resolved(-1) == "worse"
+    assert d.resolved(0) == "higher"
+    assert ev.compare_paired([1.0, 2.0], [2.0, 1.0]).resolved(+1) == ""  # holds zero
+    assert ev.compare_paired([None], [1.0]).n == 0
+    with pytest.raises(ValueError, match="2 values against 1"):
+        ev.compare_paired([1.0, 2.0], [1.0])
+
+
+def test_one_metric_table_formats_every_table():
+    from sfw_gym.evaluation import benchmark as bm
+    from sfw_gym.evaluation.metric_table import METRICS
+
+    protocol = bm.load_protocol("benchmark-v1")
+    assert set(protocol["metrics"]) <= set(METRICS)  # the benchmark's metrics are the table's
+    gain = METRICS["info_gain_per_m"]
+    row = ev.summarize(
+        [
+            {"agent": "a", "info_gain_per_m": 24.25, "stop_reason": "x"},
+            {"agent": "a", "info_gain_per_m": 24.75, "stop_reason": "x"},
+        ],
+        ["a"],
+    )[0]
+    evaluate_cell = ev.results_markdown([row]).splitlines()[2].split(" | ")[7]
+    assert evaluate_cell.startswith(gain.format(24.5) + " ± ")  # "24.5 ± 3.2"
+    stats_entry = {"mean": 24.5, "ci_low": 24.0, "ci_high": 25.0}
+    assert bm.format_interval(stats_entry, "info_gain_per_m") == "24.5 [24.0, 25.0]"
+    assert gain.format_signed(-0.25) == "-0.2" and gain.label in ev.results_markdown([row])
 
 
 def test_zone_band_metric_counts_unknown_cells_near_the_true_zone_border():
@@ -256,3 +310,33 @@ def test_zone_band_metric_counts_unknown_cells_near_the_true_zone_border():
     assert m["zone_band_cells"] > 0
     assert 0.9 * m["zone_band_cells"] < m["zone_band_unknown"] <= m["zone_band_cells"]  # 1 update
     assert json.dumps(m)
+
+
+class _Radio:
+    """Two routers; the left one is the strongest left of x = 3 m."""
+
+    routers = ((0.5, 0.5), (5.5, 0.5))
+
+    def mean_rssi(self, xy):
+        left = xy[:, 0] < 3.0
+        return np.stack([np.where(left, -40.0, -60.0), np.where(left, -60.0, -40.0)], 1)
+
+
+class _Grid:
+    resolution_m = 1.0
+
+    def cell_centres(self):
+        return np.meshgrid(np.arange(6) + 0.5, [0.5])
+
+
+def test_the_zone_band_metric_counts_unknown_free_cells_within_the_band_of_a_zone_border():
+    from sfw_gym import metrics
+
+    truth = np.full((1, 6), 255, np.uint8)  # one row of free cells, zones 0 0 0 | 1 1 1
+    belief = np.full((1, 6), 127, np.uint8)
+    belief[0, 1] = 255  # mapped free: not unknown
+    m = metrics.zone_band_unknown(truth, belief, _Grid(), _Radio(), band_m=1.0)
+    # border cells 2 and 3; the band: cells within 1 m of them, 1 to 4; cell 1 is known
+    assert m == {"zone_band_cells": 4, "zone_band_unknown": 3, "zone_band_unknown_frac": 0.75}
+    one = type("OneRouter", (), {"routers": [(0.5, 0.5)]})()
+    assert metrics.zone_band_unknown(truth, belief, _Grid(), one)["zone_band_cells"] == 0

@@ -35,6 +35,14 @@ def test_resuming_with_other_settings_is_refused(tmp_path):
     assert json.loads((tmp_path / "config.json").read_text())["agents"] == ["random", "frontier"]
 
 
+def test_the_checkpoint_key_of_an_episode_is_the_one_earlier_runs_wrote():
+    """Resume finds an earlier run's records by these keys: they must not change."""
+    spec = ev.EpisodeSpec(agent="random", episode=3, seed=8, env_id=SMALL)
+    assert spec.key == "random|3|8|SfW-ExploreSmall-v0|None"
+    seeded = ev.EpisodeSpec(agent="random", episode=0, seed=2, floorplan="p.json", agent_seed=9)
+    assert seeded.key == "random|0|2|SfW-Explore-v0|p.json|9"
+
+
 def test_temp_files_of_a_killed_write_are_removed(tmp_path):
     (tmp_path / "episodes").mkdir()
     stale = [tmp_path / ".episodes.abc123.tmp.jsonl", tmp_path / "episodes" / ".x_0000.q.tmp.npz"]
