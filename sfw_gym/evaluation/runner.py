@@ -46,9 +46,9 @@ __all__ = [
     "BACKENDS",
     "CHECKPOINT",
     "EpisodeSpec",
-    "episode_specs",
     "evaluate",
     "load_checkpoint",
+    "plan_files",
     "run_episode",
     "run_specs",
     "zone_band_unknown",
@@ -80,50 +80,18 @@ def run_specs(specs: Sequence[EpisodeSpec], out: Path, executor: Executor) -> li
     return [by_key[s.key] for s in specs]
 
 
-def episode_specs(
-    agents: Sequence[str],
-    episodes: int,
-    seed: int,
-    *,
-    out: Path,
-    env_id: str = "SfW-Explore-v0",
-    floorplans: str | Path | None = None,
-    env_kwargs: dict[str, Any] | None = None,
-    agent_params: dict[str, dict[str, Any]] | None = None,
-    gif_episodes: int = 0,
-    curve_every: int = 10,
-) -> list[EpisodeSpec]:
-    """The episodes of a run, episode-major (every agent's episode 0 first)."""
-    plans: list[str | None] = [None]
-    if floorplans is not None:
-        folder = Path(floorplans)
-        if folder.is_file():
-            plans = [str(folder)]
-        else:
-            files = sorted(folder.glob("*.json")) if folder.is_dir() else []
-            if not files:
-                raise ConfigError(f"--floorplans {floorplans}: no .json floorplan files there")
-            plans = [str(p) for p in files]
-    specs = []
-    for i in range(episodes):
-        for name in agents:
-            specs.append(
-                EpisodeSpec(
-                    agent=name,
-                    episode=i,
-                    seed=seed + i,
-                    env_id=env_id,
-                    floorplan=plans[i % len(plans)],
-                    env_kwargs=dict(env_kwargs or {}),
-                    agent_params=dict((agent_params or {}).get(name, {})),
-                    curve_every=curve_every,
-                    gif_path=str(out / "gifs" / f"{name}_{i:04d}.gif")
-                    if i < gif_episodes
-                    else None,
-                    npz_path=str(out / "episodes" / f"{name}_{i:04d}.npz"),
-                )
-            )
-    return specs
+def plan_files(floorplans: str | Path | None) -> list[str | None]:
+    """The plan files episodes cycle through: a folder's ``*.json`` files, one file, or
+    ``[None]`` (the env's procedural plans)."""
+    if floorplans is None:
+        return [None]
+    folder = Path(floorplans)
+    if folder.is_file():
+        return [str(folder)]
+    files = sorted(folder.glob("*.json")) if folder.is_dir() else []
+    if not files:
+        raise ConfigError(f"--floorplans {floorplans}: no .json floorplan files there")
+    return [str(p) for p in files]
 
 
 def evaluate(
@@ -199,18 +167,23 @@ def evaluate(
         raise ConfigError(f"--env-kwargs: {exc}") from None
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    specs = episode_specs(
-        agents,
-        episodes,
-        seed,
-        out=out,
-        env_id=env_id,
-        floorplans=floorplans,
-        env_kwargs=env_kwargs,
-        agent_params=agent_params,
-        gif_episodes=gif_episodes,
-        curve_every=curve_every,
-    )
+    plans = plan_files(floorplans)
+    specs = [  # episode-major: every agent's episode 0 first
+        EpisodeSpec(
+            agent=name,
+            episode=i,
+            seed=seed + i,
+            env_id=env_id,
+            floorplan=plans[i % len(plans)],
+            env_kwargs=dict(env_kwargs or {}),
+            agent_params=dict((agent_params or {}).get(name, {})),
+            curve_every=curve_every,
+            gif_path=str(out / "gifs" / f"{name}_{i:04d}.gif") if i < gif_episodes else None,
+            npz_path=str(out / "episodes" / f"{name}_{i:04d}.npz"),
+        )
+        for i in range(episodes)
+        for name in agents
+    ]
     records = load_checkpoint(out / CHECKPOINT)
     manifest = evaluation_manifest(
         out, records, agents, episodes, seed, env_id, floorplans, env_kwargs, agent_params
