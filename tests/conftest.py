@@ -12,6 +12,14 @@ from sfw_gym.world.floorplan import Floorplan, floorplan_from_polygon
 HOUSEEXPO_DIR = Path(__file__).resolve().parents[1].parent / "shared" / "floorplans" / "houseexpo"
 
 
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """``episode`` tests (whole episodes, training, worker pools, the heavy ids' repeats) are
+    ``slow`` too: ``pytest -m "not slow"`` is the quick loop, CI runs everything."""
+    for item in items:
+        if item.get_closest_marker("episode") is not None:
+            item.add_marker(pytest.mark.slow)
+
+
 def houseexpo_files() -> list[Path]:
     """The shared HouseExpo plans, or an empty list when ../shared is absent."""
     return sorted(HOUSEEXPO_DIR.glob("*.json")) if HOUSEEXPO_DIR.is_dir() else []

@@ -89,6 +89,7 @@ def coverage(name: str) -> np.ndarray:
     return episodes(name)[0]
 
 
+@pytest.mark.episode
 @pytest.mark.parametrize("name", GOAL_CHOOSERS)
 def test_goal_choosing_agents_reach_a_coverage_floor(name):
     cov = coverage(name)

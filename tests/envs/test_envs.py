@@ -15,6 +15,22 @@ import sfw_gym
 from sfw_gym.core.errors import ConfigError
 
 ENV_IDS = sorted(sfw_gym.ENV_IDS)
+#: Ids whose one action is many env steps (a goal, a region): shorter rollouts check the same.
+MACRO_ACTION_IDS = ("SfW-ExploreGoals-v0", "SfW-ExploreRegions-v0")
+#: Ids whose reset costs seconds (a survey and its GP gridmaps): the checkers, rendering and
+#: repeats of these run in CI's full suite, not the quick loop.
+SLOW_RESET_IDS = ("SfW-Localize-v0",)
+
+
+def env_ids(heavy: tuple[str, ...] = SLOW_RESET_IDS) -> list:
+    """Every id; those in ``heavy`` marked ``episode`` (run by CI's full suite)."""
+    return [pytest.param(i, marks=pytest.mark.episode) if i in heavy else i for i in ENV_IDS]
+
+
+def _rollout_steps(env_id: str) -> int:
+    return 20 if env_id in MACRO_ACTION_IDS else 100
+
+
 #: Warnings we accept from the checkers, with why.
 WARNING_WHITELIST = (
     # SB3's checker notes that image observations should be channel-last or -first of size ≥ 36;
@@ -64,13 +80,14 @@ def _assert_no_unlisted_warnings(check, env) -> None:
     assert not bad, bad
 
 
-@pytest.mark.parametrize("env_id", ENV_IDS)
 class TestEveryEnv:
+    @pytest.mark.parametrize("env_id", env_ids())
     def test_gymnasium_check_env(self, env_id):
         _assert_no_unlisted_warnings(
             lambda env: gym_check_env(env, skip_render_check=False), gym.make(env_id).unwrapped
         )
 
+    @pytest.mark.parametrize("env_id", env_ids())
     def test_sb3_check_env(self, env_id):
         from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
@@ -78,15 +95,19 @@ class TestEveryEnv:
             lambda env: sb3_check_env(env, warn=True), gym.make(env_id).unwrapped
         )
 
+    @pytest.mark.parametrize("env_id", env_ids(heavy=()))
     def test_same_seed_same_rollout(self, env_id):
-        _assert_same(_rollout(env_id, 3, 100), _rollout(env_id, 3, 100))
+        n = _rollout_steps(env_id)
+        _assert_same(_rollout(env_id, 3, n), _rollout(env_id, 3, n))
 
+    @pytest.mark.parametrize("env_id", env_ids())
     def test_different_seeds_differ(self, env_id):
         a, b = _rollout(env_id, 1, 5), _rollout(env_id, 2, 5)
         assert not np.array_equal(a[0]["map"], b[0]["map"]) or not np.array_equal(
             a[-1][4], b[-1][4]
         )
 
+    @pytest.mark.parametrize("env_id", env_ids())
     def test_pickle_round_trip_continues_identically(self, env_id):
         env = gym.make(env_id)
         env.reset(seed=5)
@@ -102,6 +123,7 @@ class TestEveryEnv:
             _assert_same(a[:4], b[:4])
             np.testing.assert_array_equal(a[4]["true_pose"], b[4]["true_pose"])
 
+    @pytest.mark.parametrize("env_id", env_ids())
     def test_observations_fit_multi_input_policy(self, env_id):
         env = gym.make(env_id)
         obs, _ = env.reset(seed=0)
@@ -110,7 +132,10 @@ class TestEveryEnv:
             img = obs[key]
             assert img.dtype == np.uint8 and img.shape[0] <= 3 and min(img.shape[1:]) >= 36
 
-    @pytest.mark.parametrize("mode", ["rgb_array", "human"])
+    @pytest.mark.parametrize("env_id", env_ids())
+    @pytest.mark.parametrize(
+        "mode", ["rgb_array", pytest.param("human", marks=pytest.mark.episode)]
+    )
     def test_render_modes_headless(self, env_id, mode, monkeypatch):
         monkeypatch.setenv("MPLBACKEND", "Agg")
         env = gym.make(env_id, render_mode=mode)
@@ -136,6 +161,7 @@ def test_gymnasium_async_vector_env():
     envs.close()
 
 
+@pytest.mark.episode
 def test_sb3_subproc_vec_env():
     from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.vec_env import SubprocVecEnv
