@@ -46,12 +46,11 @@ import numpy as np
 from scipy import ndimage
 
 from sfw_gym.agents.base import Agent, AgentSettings, RobotView
-from sfw_gym.core.config import setting
+from sfw_gym.core.config import setting, setting_of
 from sfw_gym.core.constants import U8_FREE_MIN, U8_WALL_MAX
 from sfw_gym.navigation.candidates import (
     GAIN_SCALE,
     POTENTIAL_SCALE,
-    TURN_COST_M_PER_RAD,
     CandidateSettings,
     GoalFinder,
     explore_lite_choice,  # noqa: F401  (re-exported: the teacher's choice, by its old home)
@@ -137,22 +136,22 @@ class FrontierSettings(AgentSettings):
 
     gain_scale: float = setting(GAIN_SCALE, ge=0.0)
     potential_scale: float = setting(POTENTIAL_SCALE, ge=0.0)
-    min_frontier_size_m: float = setting(0.3, ge=0.0)
+    min_frontier_size_m: float = setting_of(CandidateSettings, "min_frontier_size_m")
     progress_timeout_steps: int = setting(30, integer=True, ge=1)
     blacklist_radius_m: float = setting(0.3, ge=0.0)
     replan_every_steps: int = setting(5, integer=True, ge=1)
     search_radius_m: float = setting(4.0, gt=0.0)
-    unknown_cost: float = setting(1.5, ge=1.0)
-    bump_exclusion_m: float = setting(0.3, ge=0.0)
+    unknown_cost: float = setting_of(CandidateSettings, "unknown_cost")
+    bump_exclusion_m: float = setting_of(CandidateSettings, "bump_exclusion_m")
     lookahead_m: float = setting(0.4, ge=0.05)
     backoff_steps: int = setting(1, integer=True, ge=0)
-    turn_cost_m_per_rad: float = setting(TURN_COST_M_PER_RAD, ge=0.0)
+    turn_cost_m_per_rad: float = setting_of(CandidateSettings, "turn_cost_m_per_rad")
     max_bumps_per_goal: int = setting(2, integer=True, ge=1)
     blacklist_ttl_steps: int = setting(600, integer=True, ge=1)
     unreachable_ttl_steps: int = setting(200, integer=True, ge=1)
-    min_unknown_region_m2: float = setting(0.5, ge=0.0)
+    min_unknown_region_m2: float = setting_of(CandidateSettings, "min_unknown_region_m2")
     escape_wall_cost: float = setting(25.0, ge=1.0)
-    min_hidden_room_depth_m: float = setting(0.5, ge=0.0)
+    min_hidden_room_depth_m: float = setting_of(CandidateSettings, "min_hidden_room_depth_m")
     escape_blacklist_radius_m: float = setting(1.0, ge=0.0)
     stall_steps: int = setting(300, integer=True, ge=1)
     stall_gain_m2: float = setting(1.0, ge=0.0)

@@ -105,6 +105,13 @@ def setting(
     return field(default=default, metadata={"range": rng})
 
 
+def setting_of(cls: type, name: str) -> Any:
+    """Field ``name`` of the config class ``cls`` (its default and range) for another config
+    class that shares the setting: one place for its default and range."""
+    f = {f.name: f for f in fields(cls)}[name]
+    return field(default=f.default, metadata=f.metadata)
+
+
 def check(name: str, value: Any, **bounds: Any) -> Any:
     """``value`` checked against a range given as :func:`setting`'s keywords (for arguments that
     are not dataclass fields, such as an agent's constructor parameters); normalised."""

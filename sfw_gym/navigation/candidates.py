@@ -73,6 +73,11 @@ _F = {name: i for i, name in enumerate(FEATURES)}
 _LN2 = float(np.log(2.0))
 
 
+#: explore_lite's utility of a frontier cluster: GAIN_SCALE × size (m) − POTENTIAL_SCALE × cost
+#: (m), the cost being the path plus TURN_COST_M_PER_RAD × the heading change (rad).
+GAIN_SCALE, POTENTIAL_SCALE, TURN_COST_M_PER_RAD = 1.0, 3.0, 0.3
+
+
 @dataclass(frozen=True)
 class CandidateSettings(Config):
     """How candidates are found (the defaults are :class:`~sfw_gym.agents.FrontierAgent`'s)."""
@@ -82,7 +87,7 @@ class CandidateSettings(Config):
     min_frontier_size_m: float = setting(0.3, ge=0.0)
     bump_exclusion_m: float = setting(0.3, ge=0.0)
     min_unknown_region_m2: float = setting(0.5, ge=0.0)
-    turn_cost_m_per_rad: float = setting(0.3, ge=0.0)
+    turn_cost_m_per_rad: float = setting(TURN_COST_M_PER_RAD, ge=0.0)
     min_hidden_room_depth_m: float = setting(0.5, ge=0.0)
     info_gain_samples: int = setting(300, integer=True, ge=1)
     near_radius_m: float = setting(1.0, gt=0.0)
@@ -128,11 +133,6 @@ class CandidateGoals:
     def path(self, i: int) -> np.ndarray:
         """``(N, 2)`` cells from the robot to candidate ``i``'s goal cell (empty if invalid)."""
         return self.paths.path(tuple(self.goal_rc[i]))
-
-
-#: explore_lite's utility of a frontier cluster: GAIN_SCALE × size (m) − POTENTIAL_SCALE × cost
-#: (m), the cost being the path plus TURN_COST_M_PER_RAD × the heading change (rad).
-GAIN_SCALE, POTENTIAL_SCALE, TURN_COST_M_PER_RAD = 1.0, 3.0, 0.3
 
 
 def explore_lite_choice(
