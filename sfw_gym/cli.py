@@ -361,6 +361,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         progress=not args.no_progress,
         backend=args.backend,
         address=args.address,
+        vector_envs=args.vector_envs,
     )
     print((Path(args.out) / "results.md").read_text(encoding="utf-8"), end="")
     paired = Path(args.out) / "paired.md"
@@ -733,6 +734,14 @@ def build_parser() -> argparse.ArgumentParser:
         "--out", type=folder, default="evaluation", help="output folder (resumes from it)"
     )
     _add_episode_runner_options(ev)
+    ev.add_argument(
+        "--vector-envs",
+        type=positive_int,
+        default=1,
+        help="N > 1: run the episodes on a gymnasium vector env of N sub-envs (worker processes; "
+        "the agents act on each sub-env's info['robot_view']) instead of --workers; the same "
+        "records (no GIFs)",
+    )
     ev.add_argument("--gif", action="store_true", help="also write GIFs of the first episodes")
     ev.add_argument(
         "--gif-episodes", type=non_negative_int, default=1, help="episodes per agent with a GIF"

@@ -7,8 +7,9 @@ from __future__ import annotations
 
 import multiprocessing as mp
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Generator, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from contextlib import closing
 from dataclasses import dataclass
 from typing import Any
 
@@ -74,10 +75,53 @@ class Executor:
         finishes (in the order they finish). The bar counts ``done`` jobs finished before (a
         resumed run) plus these; ``postfix(result)`` describes the last one. On an error or an
         interrupt the jobs not started are dropped and the running ones cancelled."""
+
+        def run_all(finish: Callable[[int, Any], None]) -> None:
+            if self.backend == "ray":
+                self._run_on_ray(fn, jobs, finish)
+            elif self.workers == 1:
+                for i, job in enumerate(jobs):
+                    finish(i, fn(job))
+            else:
+                self._run_in_pool(fn, jobs, finish)
+
+        self._with_bar(run_all, len(jobs), on_result, desc, unit, done, postfix)
+
+    def consume(
+        self,
+        results: Generator[tuple[int, Any], None, None],
+        total: int,
+        on_result: Callable[[int, Any], None],
+        *,
+        desc: str,
+        unit: str = "job",
+        done: int = 0,
+        postfix: Callable[[Any], str] | None = None,
+    ) -> None:
+        """Results that run elsewhere (a vector env's episodes: ``(i, result)`` pairs, ``total``
+        of them) handed to ``on_result`` as they come, with :meth:`run`'s progress bar."""
+
+        def run_all(finish: Callable[[int, Any], None]) -> None:
+            with closing(results):  # stopped early: the producer cleans up at once
+                for i, result in results:
+                    finish(i, result)
+
+        self._with_bar(run_all, total, on_result, desc, unit, done, postfix)
+
+    def _with_bar(
+        self,
+        run_all: Callable[[Callable[[int, Any], None]], None],
+        total: int,
+        on_result: Callable[[int, Any], None],
+        desc: str,
+        unit: str,
+        done: int,
+        postfix: Callable[[Any], str] | None,
+    ) -> None:
         from tqdm.auto import tqdm
 
         bar = tqdm(
-            total=done + len(jobs), initial=done, desc=desc, unit=unit, disable=not self.progress
+            total=done + total, initial=done, desc=desc, unit=unit, disable=not self.progress
         )
 
         def finish(i: int, result: Any) -> None:
@@ -87,13 +131,7 @@ class Executor:
             bar.update(1)
 
         try:
-            if self.backend == "ray":
-                self._run_on_ray(fn, jobs, finish)
-            elif self.workers == 1:
-                for i, job in enumerate(jobs):
-                    finish(i, fn(job))
-            else:
-                self._run_in_pool(fn, jobs, finish)
+            run_all(finish)
         finally:
             bar.close()
 

@@ -8,9 +8,10 @@ routers and start pose; the record is the same whichever process runs it.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -18,6 +19,9 @@ from sfw_gym.agents.base import decision_arrays
 from sfw_gym.core.atomic import atomic_path
 from sfw_gym.envs.explore import unwrap_sfw
 from sfw_gym.metrics import zone_band_unknown as _zone_band_unknown
+
+if TYPE_CHECKING:
+    from sfw_gym.envs.episode import GroundTruth
 
 
 @dataclass(frozen=True)
@@ -54,6 +58,11 @@ class EpisodeSpec:
     agent_seed: int | None = None
 
     @property
+    def agent_reset_seed(self) -> int:
+        """The seed the agent is reset with (``agent_seed``, else the env seed)."""
+        return self.seed if self.agent_seed is None else self.agent_seed
+
+    @property
     def key(self) -> str:
         """Identity in the checkpoint (an episode with the same key is not run again)."""
         key = f"{self.agent}|{self.episode}|{self.seed}|{self.env_id}|{self.floorplan}"
@@ -69,10 +78,93 @@ def zone_band_unknown(env: Any, band_m: float = 0.8) -> dict[str, float]:
     return _zone_band_unknown(gt.truth_u8, sfw.robot_view().belief_u8, gt.grid, gt.radio, band_m)
 
 
-def run_episode(spec: EpisodeSpec) -> dict[str, Any]:
-    """Run one episode and return its JSON-serialisable record."""
-    import time
+class EpisodeRecord:
+    """One episode's record, built from what the env returns: the reset's info, each step's
+    info, and at the end the episode's ground truth and the robot's final belief. The single
+    env (:func:`run_episode`) and the vector env (:mod:`~sfw_gym.evaluation.vector`) both build
+    their records here, so that they are the same.
 
+    Args:
+        spec: The episode.
+        info: The reset's info.
+        start: ``time.perf_counter()`` when the episode's work began (its ``wall_s``).
+    """
+
+    def __init__(self, spec: EpisodeSpec, info: dict[str, Any], start: float) -> None:
+        self.spec = spec
+        self.start = start
+        self.entropy_at_start = info["entropy_bits"]
+        self.curve: list[tuple[int, float, float, float]] = [
+            (0, info["coverage"], info["map_iou"], 0.0)
+        ]
+        self.steps = 0
+
+    def step(self, info: dict[str, Any], done: bool) -> None:
+        """Count a step and sample the curve (every ``curve_every`` steps and the last)."""
+        self.steps += 1
+        if self.steps % self.spec.curve_every == 0 or done:
+            self.curve.append(
+                (self.steps, info["coverage"], info["map_iou"], info["path_length_m"])
+            )
+
+    def finish(
+        self,
+        info: dict[str, Any],
+        terminated: bool,
+        agent: Any,
+        truth: GroundTruth,
+        belief_u8: np.ndarray,
+    ) -> dict[str, Any]:
+        """The JSON-serialisable record (and the ``.npz``, if the spec asks for one), from the
+        last step's info, whether the episode terminated, the agent, the ground truth and the
+        robot's final belief map."""
+        spec = self.spec
+        summary = dict(info.get("summary", {}))
+        summary.update(
+            _zone_band_unknown(truth.truth_u8, belief_u8, truth.grid, truth.radio, spec.band_m)
+        )
+        # The map's information gain per metre driven: what the reward pays for, per unit of
+        # effort.
+        summary["info_gain_total_bits"] = self.entropy_at_start - info["entropy_bits"]
+        path_m = info["path_length_m"]
+        summary["info_gain_per_m"] = (
+            summary["info_gain_total_bits"] / path_m if path_m > 0 else None
+        )
+        reason = agent.stop_reason or ("coverage_target" if terminated else "max_steps")
+        record = {
+            "key": spec.key,
+            "agent": spec.agent,
+            "episode": spec.episode,
+            "seed": spec.seed,
+            "env_id": spec.env_id,
+            "floorplan": truth.floorplan.name,
+            "floorplan_file": spec.floorplan,
+            "area_m2": float(truth.floorplan.area_m2),
+            "steps": self.steps,
+            "terminated": bool(terminated),
+            "stop_reason": reason,
+            "wall_s": time.perf_counter() - self.start,
+            "agent_params": agent.params(),
+            "decisions": len(agent.decisions),
+            "curve": [list(map(_py, c)) for c in self.curve],
+            **{k: _py(v) for k, v in summary.items()},
+        }
+        if spec.npz_path:
+            _write_npz(
+                Path(spec.npz_path),
+                truth=truth.truth_u8,
+                belief=belief_u8,
+                trajectory=truth.trajectory.astype(np.float32),
+                routers=np.asarray(truth.radio.routers),
+                origin=np.asarray(truth.grid.origin_xy),
+                resolution=np.asarray(truth.grid.resolution_m),
+                **decision_arrays(agent.decisions),
+            )
+        return record
+
+
+def run_episode(spec: EpisodeSpec) -> dict[str, Any]:
+    """Run one episode on its own env and return its JSON-serialisable record."""
     import gymnasium as gym
 
     import sfw_gym  # noqa: F401  (registers the envs in a fresh worker)
@@ -83,56 +175,18 @@ def run_episode(spec: EpisodeSpec) -> dict[str, Any]:
     env = gym.make(spec.env_id, render_mode=render, **spec.env_kwargs)
     options = {"floorplan": spec.floorplan} if spec.floorplan else None
     obs, info = env.reset(seed=spec.seed, options=options)
-    entropy_at_start = info["entropy_bits"]
+    episode = EpisodeRecord(spec, info, start)
     agent = make_agent(spec.agent, **spec.agent_params)
-    agent.reset(env, seed=spec.seed if spec.agent_seed is None else spec.agent_seed)
+    agent.reset(env, seed=spec.agent_reset_seed)
     frames: list[Any] = [env.render()] if render else []
-    curve: list[tuple[int, float, float, float]] = [(0, info["coverage"], info["map_iou"], 0.0)]
-    steps, terminated, truncated = 0, False, False
+    terminated = truncated = False
     while not (terminated or truncated):
         obs, _, terminated, truncated, info = env.step(agent.act(obs))
-        steps += 1
-        if steps % spec.curve_every == 0 or terminated or truncated:
-            curve.append((steps, info["coverage"], info["map_iou"], info["path_length_m"]))
-        if render and (steps % 10 == 0 or terminated or truncated):
+        episode.step(info, terminated or truncated)
+        if render and (episode.steps % 10 == 0 or terminated or truncated):
             frames.append(env.render())
-    summary = dict(info.get("summary", {}))
-    summary.update(zone_band_unknown(env, spec.band_m))
-    # The map's information gain per metre driven: what the reward pays for, per unit of effort.
-    summary["info_gain_total_bits"] = entropy_at_start - info["entropy_bits"]
-    path_m = info["path_length_m"]
-    summary["info_gain_per_m"] = summary["info_gain_total_bits"] / path_m if path_m > 0 else None
-    gt = unwrap_sfw(env).ground_truth()
-    reason = agent.stop_reason or ("coverage_target" if terminated else "max_steps")
-    record = {
-        "key": spec.key,
-        "agent": spec.agent,
-        "episode": spec.episode,
-        "seed": spec.seed,
-        "env_id": spec.env_id,
-        "floorplan": gt.floorplan.name,
-        "floorplan_file": spec.floorplan,
-        "area_m2": float(gt.floorplan.area_m2),
-        "steps": steps,
-        "terminated": bool(terminated),
-        "stop_reason": reason,
-        "wall_s": time.perf_counter() - start,
-        "agent_params": agent.params(),
-        "decisions": len(agent.decisions),
-        "curve": [list(map(_py, c)) for c in curve],
-        **{k: _py(v) for k, v in summary.items()},
-    }
-    if spec.npz_path:
-        _write_npz(
-            Path(spec.npz_path),
-            truth=gt.truth_u8,
-            belief=unwrap_sfw(env).robot_view().belief_u8,
-            trajectory=gt.trajectory.astype(np.float32),
-            routers=np.asarray(gt.radio.routers),
-            origin=np.asarray(gt.grid.origin_xy),
-            resolution=np.asarray(gt.grid.resolution_m),
-            **decision_arrays(agent.decisions),
-        )
+    sfw = unwrap_sfw(env)
+    record = episode.finish(info, terminated, agent, sfw.ground_truth(), sfw.robot_view().belief_u8)
     if spec.gif_path:
         _write_gif(Path(spec.gif_path), frames, fps=env.metadata.get("render_fps", 10))
     env.close()

@@ -41,6 +41,7 @@ from sfw_gym.evaluation.plots import plot_curves, plot_trajectories
 from sfw_gym.evaluation.report import paired_markdown, results_csv, results_markdown
 from sfw_gym.evaluation.rollout import EpisodeSpec, run_episode, zone_band_unknown
 from sfw_gym.evaluation.stats import paired_differences, summarize
+from sfw_gym.evaluation.vector import run_vector
 
 __all__ = [
     "BACKENDS",
@@ -55,9 +56,12 @@ __all__ = [
 ]
 
 
-def run_specs(specs: Sequence[EpisodeSpec], out: Path, executor: Executor) -> list[dict[str, Any]]:
-    """Run the episodes not yet in ``OUT/episodes.jsonl`` (the checkpoint) on ``executor`` and
-    return every spec's record, in the order of ``specs``."""
+def run_specs(
+    specs: Sequence[EpisodeSpec], out: Path, executor: Executor, vector_envs: int = 1
+) -> list[dict[str, Any]]:
+    """Run the episodes not yet in ``OUT/episodes.jsonl`` (the checkpoint) on ``executor`` (or,
+    with ``vector_envs`` > 1, on a vector env of that many sub-envs, through the executor's
+    progress bar) and return every spec's record, in the order of ``specs``."""
     records = open_checkpoint(out)
     done = {r["key"] for r in records}
     todo = [s for s in specs if s.key not in done]
@@ -67,15 +71,16 @@ def run_specs(specs: Sequence[EpisodeSpec], out: Path, executor: Executor) -> li
         records.append(record)
         append_record(ckpt, record)
 
-    executor.run(
-        run_episode,
-        todo,
-        keep,
-        desc="episodes",
-        unit="ep",
-        done=len(specs) - len(todo),
-        postfix=lambda r: f"{r['agent']} #{r['episode']} cov {r['coverage']:.2f}",
-    )
+    bar: dict[str, Any] = {
+        "desc": "episodes",
+        "unit": "ep",
+        "done": len(specs) - len(todo),
+        "postfix": lambda r: f"{r['agent']} #{r['episode']} cov {r['coverage']:.2f}",
+    }
+    if vector_envs > 1:
+        executor.consume(run_vector(todo, vector_envs), len(todo), keep, **bar)
+    else:
+        executor.run(run_episode, todo, keep, **bar)
     by_key = {r["key"]: r for r in records}
     return [by_key[s.key] for s in specs]
 
@@ -110,6 +115,7 @@ def evaluate(
     progress: bool = True,
     backend: str = "local",
     address: str | None = None,
+    vector_envs: int = 1,
 ) -> dict[str, Any]:
     """Run (or resume) an evaluation and write its table, curves and trajectory figures.
 
@@ -130,6 +136,10 @@ def evaluate(
         backend: ``"local"`` (worker processes) or ``"ray"`` (episodes as Ray tasks, at most
             ``workers`` at a time; a task whose worker dies runs again); the same records.
         address: Ray's address (``"auto"``: a running cluster); None starts a local Ray.
+        vector_envs: More than 1: run the episodes on a ``gymnasium.vector`` env of this many
+            sub-envs in worker processes instead (the agents act in this process on each
+            sub-env's ``info["robot_view"]``; :mod:`~sfw_gym.evaluation.vector`), with the
+            same records; ``workers`` and ``backend`` are then not used, and no GIFs.
 
     Returns:
         ``{"rows": summary rows, "records": episode records, "files": written paths}``; with
@@ -154,6 +164,10 @@ def evaluate(
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ConfigError(f"--episodes must be an int >= 1, got {episodes!r}")
     executor = Executor(workers=workers, backend=backend, address=address, progress=progress)
+    if isinstance(vector_envs, bool) or not isinstance(vector_envs, int) or vector_envs < 1:
+        raise ConfigError(f"--vector-envs must be an int >= 1, got {vector_envs!r}")
+    if vector_envs > 1 and (backend != "local" or gif_episodes):
+        raise ConfigError("--vector-envs runs the episodes here: not with --backend ray or --gif")
     for name, params in (agent_params or {}).items():  # fail early on bad parameters
         if not isinstance(params, dict):
             raise ConfigError(f"--agent-params: {name!r}: expected a JSON object, got {params!r}")
@@ -189,7 +203,7 @@ def evaluate(
         out, records, agents, episodes, seed, env_id, floorplans, env_kwargs, agent_params
     )
     write_text_atomic(out / "config.json", json.dumps(manifest, indent=2) + "\n")
-    mine = run_specs(specs, out, executor)
+    mine = run_specs(specs, out, executor, vector_envs)
     rows = summarize(mine, agents)
     files = [
         write_text_atomic(out / "results.csv", results_csv(rows)),

@@ -58,6 +58,29 @@ def test_run_hands_each_result_with_its_index_and_the_bar_counts_jobs_done_befor
     assert "quiet" not in capsys.readouterr().err
 
 
+def test_consume_hands_on_results_made_elsewhere_and_stops_their_producer_on_an_error(capsys):
+    closed: list[bool] = []
+
+    def produce():  # as a vector env yields its episodes' records
+        try:
+            yield from [(1, "b"), (0, "a"), (2, "c")]
+        finally:
+            closed.append(True)
+
+    seen: list[tuple[int, str]] = []
+    Executor().consume(produce(), 3, lambda i, r: seen.append((i, r)), desc="vector", done=1)
+    assert seen == [(1, "b"), (0, "a"), (2, "c")] and closed == [True]
+    bar = capsys.readouterr().err  # the same bar, counting the one done before
+    assert "vector" in bar and "4/4" in bar
+
+    def interrupted(i, result):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        Executor(progress=False).consume(produce(), 3, interrupted, desc="x")
+    assert closed == [True, True]  # the producer (a vector env's processes) shut at once
+
+
 def test_bad_settings_are_one_line_errors():
     with pytest.raises(ConfigError, match="--workers must be an int >= 1, got 0"):
         Executor(workers=0)
