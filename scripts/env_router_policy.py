@@ -59,8 +59,7 @@ def main() -> None:
         a, b = (np.array([r[m] for r in by[p]], float) for p in POLICIES)
         d = compare_paired(a, b)
         print(
-            f"| {m} | {np.nanmean(a):.3f} | {np.nanmean(b):.3f} | "
-            f"{d.mean:+.3f} [{d.low:+.3f}, {d.high:+.3f}] (n={d.n}) |"
+            f"| {m} | {np.nanmean(a):.3f} | {np.nanmean(b):.3f} | {d.text('{:+.3f}')} (n={d.n}) |"
         )
 
 

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial import cKDTree
 
+from sfw_gym.evaluation.stats import compare_paired
 from sfw_gym.evaluation.stats import mean_ci95_text as ci
 from sfw_gym.slam.radio_slam import travelled_m
 
@@ -143,7 +144,8 @@ def tables(records: list[dict[str, Any]], plans: int) -> list[str]:
             + " | ".join(ci([r[f"ate_{m}"] for r in rs]) for m in METHODS)
             + " |"
         )
-    lines += ["", "Paired differences, Radio+LiDAR − other [m] (negative: Radio+LiDAR better):", ""]
+    lines += ["", "Paired differences, Radio+LiDAR − other [m] (negative: Radio+LiDAR better; mean"]
+    lines += ["[95 % seeded bootstrap interval]):", ""]
     lines += [
         "| drift | runs | vs odometry | vs LiDAR-only | vs Radio SLAM |",
         "|---|---|---:|---:|---:|",
@@ -159,7 +161,9 @@ def tables(records: list[dict[str, Any]], plans: int) -> list[str]:
             lines.append(
                 f"| {d} | {label}, {len(sub)} | "
                 + " | ".join(
-                    ci([r["ate_radio_lidar"] - r[f"ate_{o}"] for r in sub])
+                    compare_paired(
+                        [r[f"ate_{o}"] for r in sub], [r["ate_radio_lidar"] for r in sub]
+                    ).text("{:.2f}")
                     for o in ("odometry", "lidar_only", "radio_slam")
                 )
                 + " |"

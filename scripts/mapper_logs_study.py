@@ -114,7 +114,7 @@ def main() -> None:
                 cell = f"{np.nanmean(vals):.3f}"
                 if label != REFERENCE and REFERENCE in methods:
                     d = compare_paired(ref, vals)
-                    cell += f" ({d.mean:+.3f} [{d.low:+.3f}, {d.high:+.3f}], n={d.n})"
+                    cell += f" ({d.text('{:+.3f}')}, n={d.n})"
                 cells.append(cell)
             us = np.mean([table[p, label]["us_mean"] for p in plans])
             print(f"| {label} | " + " | ".join(cells) + f" | {us:.1f} |")

@@ -70,7 +70,7 @@ def main() -> None:
         f"{args.episodes} held-out seeds, episode return: PPO {np.mean(learned):.2f} (sampled "
         f"actions), random actions {np.mean(random):.2f}"
     )
-    print(f"  PPO − random, paired: {d.mean:+.2f} [{d.low:+.2f}, {d.high:+.2f}]")
+    print(f"  PPO − random, paired: {d.text()}")
 
 
 if __name__ == "__main__":

@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from sfw_gym.evaluation.stats import compare_paired
 from sfw_gym.evaluation.stats import mean_ci95_text as ci
 
 DRIFT = {  # translation std (fraction of a step's travel), heading std per step (rad)
@@ -215,7 +216,8 @@ def main() -> None:
                 f"{ci([r['wall_precision'] for r in rs], '{:.3f}')} | "
                 f"{np.mean([r['env_ms'] for r in rs]):.2f} |"
             )
-    lines += ["", "Paired radio_slam − true (mapping metrics), radio_slam − odometry (ATE):", ""]
+    lines += ["", "Paired radio_slam − true (mapping metrics), radio_slam − odometry (ATE); mean"]
+    lines += ["[95 % seeded bootstrap interval] over seeds:", ""]
     lines += ["| drift | Δ ATE vs odometry [m] | Δ free-IoU vs true | Δ wall precision vs true |"]
     lines += ["|---|---:|---:|---:|"]
     for d in DRIFT:
@@ -223,8 +225,8 @@ def main() -> None:
         odo = {r["seed"]: r for r in rows(drift=d, source="odometry", aps=16)}
         true = {r["seed"]: r for r in rows(drift=d, source="true", aps=16)}
 
-        def diff(key: str, a: dict, b: dict, fmt: str) -> str:
-            return ci([a[k][key] - b[k][key] for k in seeds], fmt)
+        def diff(key: str, a: dict, b: dict, fmt: str) -> str:  # a − b, paired by seed
+            return compare_paired([b[k][key] for k in seeds], [a[k][key] for k in seeds]).text(fmt)
 
         lines.append(
             f"| {d} | {diff('ate_m', slam, odo, '{:.2f}')} | "

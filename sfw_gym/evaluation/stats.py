@@ -121,6 +121,10 @@ class PairedDifference:
     low: float
     high: float
 
+    def text(self, fmt: str = "{:+.2f}") -> str:
+        """``mean [low, high]``, each number in ``fmt``."""
+        return f"{fmt.format(self.mean)} [{fmt.format(self.low)}, {fmt.format(self.high)}]"
+
     def resolved(self, direction: int) -> str:
         """Where the interval leaves out zero (n ≥ 2): ``"better"``/``"worse"`` for b, by the
         metric's direction (:mod:`~sfw_gym.evaluation.metric_table`), or ``"higher"``/

@@ -276,6 +276,7 @@ def test_the_paired_comparison_is_a_seeded_bootstrap_of_the_mean_difference():
     assert ev.compare_paired(a, b) == ev.compare_paired(a, b)  # the same numbers every run
     assert d.low > 0 and d.resolved(+1) == "better" and d.resolved(-1) == "worse"
     assert d.resolved(0) == "higher"
+    assert d.text("{:+.3f}") == f"{d.mean:+.3f} [{d.low:+.3f}, {d.high:+.3f}]"
     assert ev.compare_paired([1.0, 2.0], [2.0, 1.0]).resolved(+1) == ""  # holds zero
     assert ev.compare_paired([None], [1.0]).n == 0
     with pytest.raises(ValueError, match="2 values against 1"):
