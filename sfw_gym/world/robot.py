@@ -373,15 +373,22 @@ class Robot:
         if self._open_space_shortcut and not self._may_touch_wall(
             x0, y0, abs(v) * cfg.control_period_s
         ):
-            # No wall within reach this step, hence no contact: setting the velocity before each
-            # substep gives bit for bit what the velocity callback would, without its cost.
+            # No wall within reach this step, hence no contact, and the substeps are chipmunk's
+            # position update alone (cpBodyUpdatePosition: p += (v + v_bias)·dt, a += (w +
+            # w_bias)·dt, no bias without contacts; its velocity update keeps v and w exactly
+            # without gravity, damping or force), done here in the same IEEE operations: bit for
+            # bit what pymunk's substeps give, without their cost (tests/world/test_robot.py).
             self._drive_by_callback(False)
-            space_step(dt)
-            for _ in range(substeps - 1):
-                if w != 0.0:
-                    a = body.angle
-                    body.velocity = (v * math.cos(a), v * math.sin(a))
-                space_step(dt)
+            x, y, a = x0, y0, a0
+            for i in range(substeps):
+                if i and w != 0.0:
+                    vx, vy = v * math.cos(a), v * math.sin(a)
+                x += (vx + 0.0) * dt
+                y += (vy + 0.0) * dt
+                a += (w + 0.0) * dt
+            body.position = (x, y)
+            body.angle = a
+            body.velocity = (vx, vy)
         else:
             # Re-insert the disc: pymunk keeps, between steps, cached contact impulses (it
             # warm-starts the next contact solve from them) and the disc's collision pairs in the
@@ -435,7 +442,8 @@ class Robot:
 
     # ------------------------------------------------------------------ helpers
 
-    #: Skip the velocity callback when no wall is within reach (same result, faster).
+    #: Far from walls, integrate the substeps as chipmunk does instead of stepping pymunk (same
+    #: result bit for bit, faster).
     _open_space_shortcut = True
 
     def _refresh_active_walls(self, x: float, y: float) -> None:
