@@ -40,5 +40,5 @@ PY
 "$work/venv/bin/sfw-gym" demo --episodes 1 --workers 1 --out "$work/report" --no-progress | tail -3
 "$work/venv/bin/sfw-gym" train ppo --env SfW-ExploreSmall-v0 --timesteps 256 --out "$work/run" \
     --no-progress | tail -2
-test -f "$work/run/model.zip"
+test -f "$work/run/SfW-ExploreSmall-v0.zip"  # rl-zoo's name for the model
 echo "wheel check passed"

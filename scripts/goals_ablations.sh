@@ -16,15 +16,22 @@ for name in $names; do
 import sys, yaml
 from sfw_gym.core.data import data_path
 name, path = sys.argv[1], sys.argv[2]
-block = yaml.safe_load(open(data_path("agents", "hyperparams", "ppo_mask.yml")))["SfW-ExploreGoals-v0"]
-block.update({"nomask": {"use_masking": False},
-              "shared": {"policy_kwargs": "dict(shared_trunk=True)"},
-              "shipped": {}}[name])
-yaml.safe_dump({"SfW-ExploreGoals-v0": block}, open(path, "w"), sort_keys=False)
+env_id = "SfW-ExploreGoals-v0"
+table = yaml.safe_load(open(data_path("agents", "hyperparams", "ppo_mask.yml")))
+# the rl-zoo block, and sfw-gym's own keys (cloning, use_masking) in the sfw_gym block
+block, own = table[env_id], (table.get("sfw_gym") or {}).get(env_id) or {}
+if name == "nomask":
+    own["use_masking"] = False
+elif name == "shared":
+    block["policy_kwargs"] = "dict(shared_trunk=True)"
+elif name != "shipped":
+    raise SystemExit(f"unknown ablation {name!r}")
+yaml.safe_dump({env_id: block, "sfw_gym": {env_id: own}}, open(path, "w"), sort_keys=False)
 PY
   sfw-gym train ppo_mask --env SfW-ExploreGoals-v0 --timesteps 10000 --checkpoint-every 10000 \
     --eval-every 25000 --eval-episodes 3 --hyperparams "$out/$name.yml" --out "$out/$name" \
     --resume --no-progress
-  sfw-gym evaluate --agents frontier,ppo --agent-params "{\"ppo\": {\"path\": \"$out/$name\"}}" \
+  sfw-gym evaluate --agents frontier,goals-ppo \
+    --agent-params "{\"goals-ppo\": {\"path\": \"$out/$name\"}}" \
     --episodes 50 --seed 2000000 --out "$out/$name-eval"
 done

@@ -24,18 +24,20 @@ import sys, yaml
 from sfw_gym.core.data import data_path
 name, path, full, base = sys.argv[1:5]
 env_id = "SfW-ExploreRegions-v0"
-block = yaml.safe_load(open(base or data_path("agents", "hyperparams", "ppo_mask.yml")))[env_id]
+table = yaml.safe_load(open(base or data_path("agents", "hyperparams", "ppo_mask.yml")))
+# the rl-zoo block, and sfw-gym's own keys (cloning, fine-tuning) in the sfw_gym block
+block, own = table[env_id], (table.get("sfw_gym") or {}).get(env_id) or {}
 if name == "nomap":
     block["policy_kwargs"] = "dict(map_context=False)"
 else:
-    block["behaviour_cloning"] = {"from_model": full}
+    own["behaviour_cloning"] = {"from_model": full}
     if name == "nofinetune":
-        del block["fine_tuning"]
+        del own["fine_tuning"]
     elif name == "noprivileged":
         block["env_kwargs"] = {"privileged": False}
     else:
         raise SystemExit(f"unknown ablation {name!r}")
-yaml.safe_dump({env_id: block}, open(path, "w"), sort_keys=False)
+yaml.safe_dump({env_id: block, "sfw_gym": {env_id: own}}, open(path, "w"), sort_keys=False)
 PY
   sfw-gym train ppo_mask --env SfW-ExploreRegions-v0 --timesteps "$steps" \
     --checkpoint-every "$steps" --eval-every 100000 --eval-episodes 1 \

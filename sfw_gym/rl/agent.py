@@ -26,6 +26,7 @@ from sfw_gym.envs.goals import GoalsConfig, action_masks, menu_observation
 from sfw_gym.envs.regions import candidate_pixels
 from sfw_gym.navigation.candidates import CandidateGoals, GoalFinder
 from sfw_gym.navigation.goal_driver import GoalDriver
+from sfw_gym.rl.runs import find_model
 
 
 class PPOAgent(Agent):
@@ -33,8 +34,9 @@ class PPOAgent(Agent):
     before the region one, which is now ``regions-ppo``).
 
     Args:
-        path: A ``sfw-gym train ppo_mask`` output folder (``model.zip``, ``config.yml``) or a
-            ``.zip`` in it or in its ``checkpoints``; by default the shipped model.
+        path: A ``sfw-gym train ppo_mask`` output folder (``<env-id>.zip`` or an older run's
+            ``model.zip``, ``config.yml``) or a ``.zip`` in it or in its ``checkpoints``; by
+            default the shipped model.
         deterministic: Take the policy's most likely candidate (the default); else sample it
             with the agent's seeded generator.
         device: Torch device of the policy.
@@ -117,8 +119,9 @@ def load_model(
     path: str | Path, device: str = "cpu", num_threads: int | None = 1
 ) -> tuple[Any, dict[str, Any]]:
     """A MaskablePPO model (fine-tuned ones load the same way) and its run's ``config.yml``
-    (empty if none) from a ``sfw-gym train ppo_mask`` output folder, or a ``.zip`` in it or in
-    its ``checkpoints``; ``num_threads``: PyTorch's CPU threads, set for the process."""
+    (empty if none) from a ``sfw-gym train ppo_mask`` output folder (its model found as
+    :mod:`sfw_gym.rl.runs` says), or a ``.zip`` in it or in its ``checkpoints``;
+    ``num_threads``: PyTorch's CPU threads, set for the process."""
     import torch
     from sb3_contrib import MaskablePPO
 
@@ -126,16 +129,20 @@ def load_model(
         torch.set_num_threads(num_threads)
     given = Path(path)
     folder = given.parent if given.suffix == ".zip" else given
-    model_path = given if given.suffix == ".zip" else folder / "model.zip"
+    hint = (
+        f"train one with `sfw-gym train ppo_mask --env SfW-ExploreRegions-v0 --out {folder}` "
+        "(or SfW-ExploreGoals-v0)"
+    )
+    try:
+        model_path = given if given.suffix == ".zip" else find_model(folder)
+    except ConfigError as exc:
+        raise ConfigError(f"{exc}; {hint}") from None
     # a checkpoint (OUT/checkpoints/ppo_mask_<steps>_steps.zip): the run's config is above it
     config_path = next(
         (p for p in (folder / "config.yml", folder.parent / "config.yml") if p.is_file()), None
     )
     if not model_path.is_file():
-        raise ConfigError(
-            f"{model_path} not found; train one with `sfw-gym train ppo_mask --env "
-            f"SfW-ExploreRegions-v0 --out {folder}` (or SfW-ExploreGoals-v0)"
-        )
+        raise ConfigError(f"{model_path} not found; {hint}")
     config: dict[str, Any] = {}
     if config_path is not None:
         config = yaml.safe_load(config_path.read_text(encoding="utf-8")) or {}

@@ -1,14 +1,15 @@
 """PPO training (stable-baselines3; sb3-contrib's MaskablePPO as ``ppo_mask``, optionally
 started by behaviour cloning) with checkpoints, resume, held-out evaluation and a curve.
 
-Layout of an output folder::
+Layout of an output folder (rl-baselines3-zoo's, :mod:`sfw_gym.rl.runs`, plus sfw-gym's own)::
 
     OUT/checkpoints/<algo>_<steps>_steps.zip   every ``checkpoint_every`` env steps, each with
     OUT/checkpoints/<algo>_<steps>_steps.state.pkl   what an exact resume needs (rl.resume)
     OUT/tb/                                 TensorBoard logs
     OUT/train_<start>.monitor.csv           episode return, length, floorplan (one per run segment)
     OUT/eval/evaluations.npz                held-out evaluation (EvalCallback)
-    OUT/model.zip                           the final model (written atomically)
+    OUT/<env-id>.zip                        the final model (written atomically)
+    OUT/<env-id>/config.yml, args.yml       rl-zoo's record: the hyperparameters, the arguments
     OUT/config.yml                          hyperparameters, env, seeds, command, wall time
     OUT/behaviour_cloning.yml               per cloning fit: decisions, loss, teacher agreement
     OUT/training_curve.png                  episode return and held-out return vs env steps
@@ -40,18 +41,23 @@ from sfw_gym.rl.resume import (
     save_checkpoint,
     state_path,
 )
+from sfw_gym.rl.runs import find_model, model_path, write_zoo_params
 
-#: Classes that moved, by their old dotted path: configs and models saved before still load.
 logger = logging.getLogger(__name__)
 
-MOVED_CLASSES = {
-    "sfw_gym.agents.waypoint_policy.WaypointPolicy": "sfw_gym.rl.policy.WaypointPolicy",
-    "sfw_gym.agents.waypoint_policy.BlockScores": "sfw_gym.rl.policy.BlockScores",
-}
 #: Evaluation episodes draw their floorplans from seeds this far from the training seeds.
 HELD_OUT_SEED_OFFSET = 1_000_000
 #: The algorithms, by rl-zoo's names.
 ALGOS = ("ppo", "ppo_mask")
+#: The top-level block of a hyperparameter file that holds, per env id, what ``sfw-gym train``
+#: does beyond plain (Maskable)PPO: rl-zoo reads only the env id's own block, and hands every key
+#: there that it does not know to the model's constructor.
+PROJECT_BLOCK = "sfw_gym"
+#: The keys of the project block: behaviour cloning before PPO, AnchoredMaskablePPO's
+#: fine-tuning, the no-mask ablation.
+PROJECT_KEYS = frozenset({"behaviour_cloning", "fine_tuning", "use_masking"})
+#: The keys rl-zoo reads from an env id's block (the rest of :data:`_PPO_KEYS` go to PPO).
+_ZOO_KEYS = frozenset({"policy", "n_timesteps", "n_envs", "env_wrapper", "env_kwargs"})
 _PPO_KEYS = {
     "target_kl",
     "n_steps",
@@ -68,39 +74,72 @@ _PPO_KEYS = {
 }
 
 
-def load_hyperparams(env_id: str, path: str | Path = DEFAULT_HYPERPARAMS) -> dict[str, Any]:
-    """The rl-zoo YAML block for ``env_id`` (``policy_kwargs`` parsed safely)."""
+def zoo_hyperparams(env_id: str, path: str | Path = DEFAULT_HYPERPARAMS) -> dict[str, Any]:
+    """The block of ``env_id`` in an rl-zoo hyperparameter file, as written there (what
+    ``rl_zoo3.train`` reads); the ``sfw_gym`` block's keys are not in it."""
     path = Path(path)
     try:
         table = yaml.safe_load(path.read_text(encoding="utf-8"))
     except (OSError, yaml.YAMLError) as exc:
         raise ConfigError(f"{path}: cannot read hyperparameters: {exc}") from exc
-    if not isinstance(table, dict) or env_id not in table:
-        known = sorted(table) if isinstance(table, dict) else []
-        raise ConfigError(f"{path}: no hyperparameters for {env_id!r}; blocks: {known}")
-    params = dict(table[env_id])
+    blocks = sorted(k for k in table if k != PROJECT_BLOCK) if isinstance(table, dict) else []
+    if env_id not in blocks:
+        raise ConfigError(f"{path}: no hyperparameters for {env_id!r}; blocks: {blocks}")
+    if not isinstance(table[env_id], dict):
+        raise ConfigError(f"{path}: the block of {env_id!r} must be a mapping")
+    return dict(table[env_id])
+
+
+def project_hyperparams(env_id: str, path: str | Path = DEFAULT_HYPERPARAMS) -> dict[str, Any]:
+    """``env_id``'s entry in the ``sfw_gym`` block of a hyperparameter file (``{}`` if none):
+    the keys that ``sfw-gym train`` reads and rl-zoo never sees."""
+    path = Path(path)
+    try:
+        table = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, yaml.YAMLError) as exc:
+        raise ConfigError(f"{path}: cannot read hyperparameters: {exc}") from exc
+    project = table.get(PROJECT_BLOCK) if isinstance(table, dict) else None
+    if project is None:
+        return {}
+    if not isinstance(project, dict) or not isinstance(project.get(env_id) or {}, dict):
+        raise ConfigError(
+            f"{path}: {PROJECT_BLOCK} must map env ids to mappings of "
+            f"{sorted(PROJECT_KEYS)}, got {project!r}"
+        )
+    keys = dict(project.get(env_id) or {})
+    unknown = set(keys) - PROJECT_KEYS
+    if unknown:
+        raise ConfigError(
+            f"{path}: unknown keys in {PROJECT_BLOCK}.{env_id}: {sorted(unknown)}; "
+            f"known: {sorted(PROJECT_KEYS)}"
+        )
+    return keys
+
+
+def load_hyperparams(env_id: str, path: str | Path = DEFAULT_HYPERPARAMS) -> dict[str, Any]:
+    """What ``sfw-gym train`` trains ``env_id`` with: the env id's rl-zoo block
+    (``policy_kwargs`` parsed safely) and its entry in the ``sfw_gym`` block
+    (:data:`PROJECT_KEYS`)."""
+    path = Path(path)
+    params = zoo_hyperparams(env_id, path)
+    misplaced = sorted(PROJECT_KEYS & set(params))
+    if misplaced:
+        raise ConfigError(
+            f"{path}: {misplaced} of {env_id!r} belong in the {PROJECT_BLOCK!r} block "
+            f"({PROJECT_BLOCK}: {{{env_id}: {{...}}}}): rl-zoo would hand them to the model"
+        )
     if isinstance(params.get("policy_kwargs"), str):
         params["policy_kwargs"] = parse_policy_kwargs(params["policy_kwargs"])
     wrapper_specs(params.get("env_wrapper"))  # fail early on a malformed entry
     if not isinstance(params.get("env_kwargs") or {}, dict):
         raise ConfigError(f"{path}: env_kwargs must be a mapping, got {params['env_kwargs']!r}")
-    unknown = (
-        set(params)
-        - _PPO_KEYS
-        - {
-            "policy",
-            "n_timesteps",
-            "n_envs",
-            "env_wrapper",
-            "env_kwargs",
-            "behaviour_cloning",
-            "fine_tuning",
-            "use_masking",
-        }
-    )
+    unknown = set(params) - _PPO_KEYS - _ZOO_KEYS
     if unknown:
-        raise ConfigError(f"{path}: unknown keys for {env_id!r}: {sorted(unknown)}")
-    return params
+        raise ConfigError(
+            f"{path}: unknown keys for {env_id!r}: {sorted(unknown)} (sfw-gym's own go in the "
+            f"{PROJECT_BLOCK!r} block)"
+        )
+    return {**params, **project_hyperparams(env_id, path)}
 
 
 def resolve_timesteps(timesteps: int | None, params: dict[str, Any], env_id: str) -> int:
@@ -177,11 +216,11 @@ def wrapper_specs(value: Any) -> list[tuple[str, dict[str, Any]]]:
 
 
 def import_dotted(name: str) -> Any:
-    """The object at dotted path ``pkg.mod.Name`` (old paths in :data:`MOVED_CLASSES` resolve to
-    their new home)."""
+    """The object at dotted path ``pkg.mod.Name`` (as rl-zoo imports ``policy`` and
+    ``env_wrapper`` entries)."""
     import importlib
 
-    module, _, attr = MOVED_CLASSES.get(name, name).rpartition(".")
+    module, _, attr = name.rpartition(".")
     try:
         return getattr(importlib.import_module(module), attr)
     except (ImportError, AttributeError, ValueError) as exc:
@@ -325,7 +364,7 @@ def train_ppo(
     start_steps = previous[1] if previous else 0
     exact = previous is not None and state_path(previous[0]).is_file()
     if previous is not None and start_steps >= timesteps:  # already there (killed after its last
-        with atomic_path(out / "model.zip") as tmp:  # checkpoint)
+        with atomic_path(model_path(out, env_id)) as tmp:  # checkpoint)
             shutil.copyfile(previous[0], tmp)
         steps, wall = start_steps, 0.0
     else:
@@ -407,7 +446,7 @@ def train_ppo(
                 **masking,
             )
             wall = time.perf_counter() - start
-            _save_atomic(model, out / "model.zip")
+            _save_atomic(model, model_path(out, env_id))
             # A final checkpoint, so that a later resume starts from the end of this run.
             final = out / "checkpoints" / f"{algo}_{model.num_timesteps}_steps.zip"
             save_checkpoint(model, venv, eval_env, final)
@@ -427,8 +466,25 @@ def train_ppo(
         "hyperparameters": params,
         "env_kwargs": env_kwargs,
         "command": " ".join(sys.argv),
-        "model": str(out / "model.zip"),
+        "model": str(model_path(out, env_id)),
     }
+    # rl-zoo's record, for rl_zoo3.enjoy: the env id's block as written, and the arguments
+    write_zoo_params(
+        out,
+        env_id,
+        zoo_hyperparams(env_id, hyperparams_path),
+        {
+            "algo": algo,
+            "env": env_id,
+            "conf_file": str(hyperparams_path),
+            "env_kwargs": env_kwargs or None,
+            "hyperparams": {"n_envs": n_envs} if n_envs != params.get("n_envs", 1) else None,
+            "n_timesteps": timesteps,
+            "seed": seed,
+            "device": device,
+            "num_threads": num_threads,
+        },
+    )
     write_text_atomic(out / "config.yml", yaml.safe_dump(summary, sort_keys=False))
     plot_training_curve(out)
     return summary
@@ -501,7 +557,7 @@ def _copy_clone(model: Any, path: Path) -> None:
 
     from sfw_gym.rl.finetune import AnchoredMaskablePPO
 
-    source = AnchoredMaskablePPO.load(path / "model.zip" if path.is_dir() else path)
+    source = AnchoredMaskablePPO.load(find_model(path) if path.is_dir() else path)
     clone: Any = source.anchor if source.anchor is not None else source.policy
     mine, theirs = model.policy.parameter_groups()["actor"], clone.parameter_groups()["actor"]
     if [p.shape for p in mine] != [p.shape for p in theirs]:

@@ -9,12 +9,7 @@ directly.
 
 from __future__ import annotations
 
-import base64
 import functools
-import io
-import json
-import pickle
-import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -25,7 +20,8 @@ from sfw_gym.agents.base import Agent, RobotView
 from sfw_gym.core.data import DEFAULT_WAYPOINT_MODEL_DIR
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.navigation.waypoints import WaypointDriver, block_features
-from sfw_gym.rl.training import MOVED_CLASSES, import_dotted, wrapper_specs
+from sfw_gym.rl.runs import find_model
+from sfw_gym.rl.training import wrapper_specs
 
 WAYPOINT_WRAPPER = "sfw_gym.envs.waypoint.WaypointWrapper"
 
@@ -37,29 +33,7 @@ def _load_model(path: str, device: str) -> Any:
 
     # One env's forward pass is tiny: threads only fight the evaluation's other workers.
     torch.set_num_threads(1)
-    return PPO.load(path, device=device, custom_objects=_moved_objects(path))
-
-
-def _moved_objects(model_zip: str) -> dict[str, Any]:
-    """SB3 ``custom_objects`` for the values a model pickled by a class path that has since
-    moved (:data:`~sfw_gym.rl.training.MOVED_CLASSES`), so that older models keep loading."""
-    with zipfile.ZipFile(model_zip) as archive:
-        data = json.loads(archive.read("data"))
-    out = {}
-    for key, value in data.items():
-        if isinstance(value, dict) and ":serialized:" in value:
-            raw = base64.b64decode(value[":serialized:"])
-            try:
-                pickle.loads(raw)
-            except (ImportError, AttributeError):
-                out[key] = _RenamingUnpickler(io.BytesIO(raw)).load()
-    return out
-
-
-class _RenamingUnpickler(pickle.Unpickler):
-    def find_class(self, module: str, name: str) -> Any:
-        moved = MOVED_CLASSES.get(f"{module}.{name}")
-        return import_dotted(moved) if moved else super().find_class(module, name)
+    return PPO.load(path, device=device)
 
 
 def waypoint_settings(config: dict[str, Any]) -> dict[str, int] | None:
@@ -75,8 +49,9 @@ class WaypointPPOAgent(Agent):
     """Acts with a PPO model trained by ``sfw-gym train ppo`` (by default the shipped one).
 
     Args:
-        path: A training output folder holding ``model.zip`` and ``config.yml`` (or that
-            ``model.zip``); by default the shipped policy.
+        path: A training output folder holding the model (``<env-id>.zip``, or ``model.zip``
+            of an older run) and ``config.yml``, or that ``.zip``; by default the shipped
+            policy.
         deterministic: Take the policy's most likely waypoint (or mean action), the default, so
             that an episode is a function of the env seed alone; else sample it from the policy
             as in training, with the agent's generator seeded in :meth:`reset` (never torch's
@@ -102,14 +77,16 @@ class WaypointPPOAgent(Agent):
         self.path = str(path)
         self.deterministic = bool(deterministic)
         self.device = device
-        model_path = folder / "model.zip"
         config_path = folder / "config.yml"
-        for file in (model_path, config_path):
-            if not file.is_file():
-                raise ConfigError(
-                    f"WaypointPPOAgent: {file} not found; train one with `sfw-gym train ppo --out "
-                    f"{folder}` or pass path="
-                )
+        hint = f"train one with `sfw-gym train ppo --out {folder}` or pass path="
+        if not config_path.is_file():
+            raise ConfigError(f"WaypointPPOAgent: {config_path} not found; {hint}")
+        try:
+            model_path = Path(path) if Path(path).suffix == ".zip" else find_model(folder)
+        except ConfigError as exc:
+            raise ConfigError(f"WaypointPPOAgent: {exc}; {hint}") from None
+        if not model_path.is_file():
+            raise ConfigError(f"WaypointPPOAgent: {model_path} not found; {hint}")
         try:
             config = yaml.safe_load(config_path.read_text(encoding="utf-8")) or {}
         except yaml.YAMLError as exc:

@@ -214,7 +214,13 @@ CASES = [
         [*EVALUATE, "--out", "{tmp}/afile"], r"argument --out: .*afile", id="evaluate-out-is-a-file"
     ),
     # -- train
-    ok(TRAIN, "run/model.zip", "run/config.yml", id="train"),
+    ok(
+        TRAIN,
+        "run/SfW-ExploreSmall-v0.zip",
+        "run/SfW-ExploreSmall-v0/args.yml",
+        "run/config.yml",
+        id="train",
+    ),
     bad([*TRAIN, "--timesteps", "0"], r"argument --timesteps: .*'0'", id="train-timesteps-0"),
     bad([*TRAIN, "--n-envs", "0"], r"argument --n-envs: .*'0'", id="train-n-envs-0"),
     bad([*TRAIN, "--n-envs", "-1"], r"argument --n-envs: .*'-1'", id="train-n-envs-negative"),

@@ -52,8 +52,10 @@ def test_the_agent_drives_the_explore_env_as_the_goals_env_does(model_dir):
 
 
 def test_a_missing_model_is_named(tmp_path):
-    with pytest.raises(ConfigError, match=r"model\.zip not found; train one with `sfw-gym train"):
+    with pytest.raises(ConfigError, match=r"no model found .*; train one with `sfw-gym train"):
         PPOAgent(tmp_path)
+    with pytest.raises(ConfigError, match=r"other\.zip not found; train one with `sfw-gym train"):
+        PPOAgent(tmp_path / "other.zip")
 
 
 def test_the_agent_runs_torch_on_one_thread_unless_told_otherwise(model_dir):

@@ -25,17 +25,19 @@ SfW-ExploreRegions-v0:
   n_envs: 1
   env_kwargs:
     privileged: true
-  behaviour_cloning:
-    episodes: 3
-    epochs: 20
-  fine_tuning:
-    critic_warmup_updates: 1
-    actor_warmup_updates: 2
-    kl_coef: 0.5
-    kl_half_life_updates: 2
   n_steps: 16
   batch_size: 16
   n_epochs: 2
+sfw_gym:
+  SfW-ExploreRegions-v0:
+    behaviour_cloning:
+      episodes: 3
+      epochs: 20
+    fine_tuning:
+      critic_warmup_updates: 1
+      actor_warmup_updates: 2
+      kl_coef: 0.5
+      kl_half_life_updates: 2
 """
 
 
@@ -106,7 +108,7 @@ def test_cloning_then_anchored_fine_tuning_keeps_the_teacher_and_resumes(tmp_pat
 
     summary = train_ppo("SfW-ExploreRegions-v0", 48, out, resume=True, **kwargs)
     assert summary["steps"] == 48
-    resumed = AnchoredMaskablePPO.load(out / "model.zip")
+    resumed = AnchoredMaskablePPO.load(out / "SfW-ExploreRegions-v0.zip")
     assert resumed.n_train_calls == 3
     for a, b in zip(resumed.anchor.parameters(), model.anchor.parameters(), strict=True):
         torch.testing.assert_close(a, b)  # the anchor stays the clone

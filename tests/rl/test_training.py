@@ -24,6 +24,7 @@ from sfw_gym.rl.training import (
 )
 
 TINY = {"max_steps": 40}
+SMALL_ID = "SfW-ExploreSmall-v0"
 
 
 def test_hyperparams_load_for_every_block():
@@ -152,7 +153,8 @@ def test_a_run_killed_five_times_ends_with_the_uninterrupted_runs_model(tmp_path
     train_ppo("SfW-ExploreSmall-v0", target, tmp_path / "whole", progress_bar=False, **run)
     for name in ("policy.pth", "policy.optimizer.pth"):
         killed, whole = (
-            _zip_tensors(tmp_path / d / "model.zip", name) for d in ("killed", "whole")
+            _zip_tensors(tmp_path / d / "SfW-ExploreSmall-v0.zip", name)
+            for d in ("killed", "whole")
         )
         assert killed.keys() == whole.keys()
         assert all(torch_equal(killed[k], whole[k]) for k in killed), name
@@ -216,9 +218,9 @@ def test_maskable_ppo_on_candidate_goals_starts_from_the_frontier_agents_choices
     yml.write_text(
         "SfW-ExploreGoals-v0:\n"
         "  policy: 'sfw_gym.rl.goal_policy.GoalsPolicy'\n"
-        "  behaviour_cloning: {episodes: 3, epochs: 30}\n"
         "  env_kwargs: {goals: {cost_per_m_bits: 20.0}, max_steps: 999}\n"
         "  n_steps: 32\n  batch_size: 32\n  n_epochs: 1\n  learning_rate: !!float 1e-5\n"
+        "sfw_gym:\n  SfW-ExploreGoals-v0:\n    behaviour_cloning: {episodes: 3, epochs: 30}\n"
     )
     out = tmp_path / "run"
     kwargs = dict(n_envs=1, env_kwargs=SMALL, hyperparams_path=yml, algo="ppo_mask")
@@ -244,7 +246,7 @@ def test_maskable_ppo_on_candidate_goals_starts_from_the_frontier_agents_choices
     from sfw_gym.rl.agent import PPOAgent
 
     assert PPOAgent(out).config.cost_per_m_bits == 20.0
-    model = MaskablePPO.load(out / "model.zip")
+    model = MaskablePPO.load(out / "SfW-ExploreGoals-v0.zip")
     env = gym.make("SfW-ExploreGoals-v0", **SMALL)
     agree = []
     for seed in (20, 21):
@@ -268,7 +270,60 @@ def test_shipped_maskable_hyperparameters_load():
 
     params = load_hyperparams("SfW-ExploreGoals-v0", default_hyperparams("ppo_mask"))
     assert params["policy"] == "sfw_gym.rl.goal_policy.GoalsPolicy"
-    assert params["behaviour_cloning"]["episodes"] > 0
+    assert params["behaviour_cloning"]["episodes"] > 0  # from the sfw_gym block
+    regions = load_hyperparams("SfW-ExploreRegions-v0", default_hyperparams("ppo_mask"))
+    assert regions["fine_tuning"]["kl_coef"] > 0 and regions["env_kwargs"] == {"privileged": True}
+
+
+@pytest.mark.parametrize("algo", ["ppo", "ppo_mask", "rllib_ppo"])
+def test_rl_zoo_reads_only_keys_it_knows_in_every_shipped_block(algo):
+    """rl-zoo hands every key of an env id's block that it does not pop to the model's
+    constructor: sfw-gym's own keys live in the sfw_gym block, which it never reads."""
+    import inspect
+
+    import yaml
+    from stable_baselines3 import PPO
+
+    from sfw_gym.core.data import default_hyperparams
+    from sfw_gym.rl.training import PROJECT_BLOCK, PROJECT_KEYS, zoo_hyperparams
+
+    path = default_hyperparams(algo)
+    table = yaml.safe_load(path.read_text(encoding="utf-8"))
+    ppo_args = set(inspect.signature(PPO.__init__).parameters)
+    popped_by_rl_zoo = {"n_timesteps", "n_envs", "env_wrapper", "env_kwargs"}
+    for env_id in set(table) - {PROJECT_BLOCK}:
+        block = zoo_hyperparams(env_id, path)
+        assert set(block) <= ppo_args | popped_by_rl_zoo, (env_id, set(block) - ppo_args)
+        assert not PROJECT_KEYS & set(block)
+    for env_id, keys in (table.get(PROJECT_BLOCK) or {}).items():
+        assert env_id in table and set(keys) <= PROJECT_KEYS
+
+
+def test_sfw_gym_keys_outside_their_block_or_unknown_in_it_are_named(tmp_path):
+    yml = tmp_path / "ppo_mask.yml"
+    yml.write_text(
+        f"{SMALL_ID}:\n  policy: MultiInputPolicy\n  behaviour_cloning: {{episodes: 1}}\n"
+    )
+    with pytest.raises(ConfigError, match=r"\['behaviour_cloning'\] of .* belong in the 'sfw_gym'"):
+        load_hyperparams(SMALL_ID, yml)
+    yml.write_text(
+        f"{SMALL_ID}:\n  policy: MultiInputPolicy\nsfw_gym:\n  {SMALL_ID}:\n    cloning: 1\n"
+    )
+    with pytest.raises(
+        ConfigError, match=r"unknown keys in sfw_gym\.SfW-ExploreSmall-v0: \['cloning'\]"
+    ):
+        load_hyperparams(SMALL_ID, yml)
+    yml.write_text(f"{SMALL_ID}:\n  policy: MultiInputPolicy\nsfw_gym: [1]\n")
+    with pytest.raises(ConfigError, match="sfw_gym must map env ids"):
+        load_hyperparams(SMALL_ID, yml)
+    yml.write_text(f"{SMALL_ID}:\n  policy: MultiInputPolicy\n  n_step: 8\n")
+    with pytest.raises(ConfigError, match=r"unknown keys for .*\['n_step'\]"):
+        load_hyperparams(SMALL_ID, yml)
+    with pytest.raises(ConfigError, match=r"no hyperparameters for 'sfw_gym'"):
+        load_hyperparams("sfw_gym", yml)  # the project block is no env's block
+    project = f"sfw_gym:\n  {SMALL_ID}:\n    use_masking: false\n"
+    yml.write_text(f"{SMALL_ID}:\n  policy: MultiInputPolicy\n{project}")
+    assert load_hyperparams(SMALL_ID, yml) == {"policy": "MultiInputPolicy", "use_masking": False}
 
 
 def test_the_training_curve_draws_other_policies_levels(tmp_path, monkeypatch):
@@ -366,3 +421,63 @@ def test_the_budget_is_the_yamls_n_timesteps_unless_given(tmp_path):
         checkpoint_every=64, eval_every=64, eval_episodes=1,
     )  # fmt: skip
     assert summary["steps"] == 64
+
+
+def test_a_run_is_saved_in_rl_zoos_layout(tmp_path):
+    """OUT/<env-id>.zip, OUT/<env-id>/config.yml (the block as written, without the sfw_gym
+    block) and args.yml (the env_kwargs rl_zoo3.enjoy uses), beside sfw-gym's config.yml."""
+    import yaml
+
+    from sfw_gym.rl.runs import find_model
+
+    yml = tmp_path / "ppo.yml"
+    block = (
+        f"{SMALL_ID}:\n  policy: MultiInputPolicy\n  n_timesteps: 32\n  n_envs: 1\n"
+        "  n_steps: 32\n  batch_size: 32\n  n_epochs: 1\n  env_kwargs: {max_steps: 40}\n"
+        '  policy_kwargs: "dict(net_arch=[8])"\n'
+    )
+    yml.write_text(block + f"sfw_gym:\n  {SMALL_ID}:\n    use_masking: false\n")
+    out = tmp_path / "ppo" / f"{SMALL_ID}_1"
+    summary = train_ppo(
+        SMALL_ID, None, out, hyperparams_path=yml, env_kwargs={"max_steps": 30}, seed=5,
+        progress_bar=False, eval_every=10**6,
+    )  # fmt: skip
+    assert summary["model"] == str(out / f"{SMALL_ID}.zip") == str(find_model(out))
+    assert not (out / "model.zip").exists()
+    zoo = yaml.safe_load((out / SMALL_ID / "config.yml").read_text())
+    assert zoo == yaml.safe_load(block)[SMALL_ID]  # policy_kwargs stays rl-zoo's string
+    args = yaml.safe_load((out / SMALL_ID / "args.yml").read_text())
+    assert args["algo"] == "ppo" and args["env"] == SMALL_ID and args["seed"] == 5
+    assert args["env_kwargs"] == {"max_steps": 30}  # the caller's win over the block's
+    assert args["n_timesteps"] == 32 and args["hyperparams"] is None
+    record = yaml.safe_load((out / "config.yml").read_text())
+    assert record["hyperparameters"]["use_masking"] is False  # the project block, recorded
+
+
+def test_the_model_of_a_run_folder_is_found_by_its_env_id_or_the_old_name(tmp_path):
+    from sfw_gym.rl.runs import env_name, find_model, model_path
+
+    assert env_name("sfw_gym:SfW-Explore-v0") == "SfW-Explore-v0"
+    assert env_name("ns/Env-v1") == "ns-Env-v1"
+    assert model_path(tmp_path, "sfw_gym:SfW-Explore-v0") == tmp_path / "SfW-Explore-v0.zip"
+    with pytest.raises(ConfigError, match="names no env"):
+        env_name("sfw_gym:")
+    zoo = tmp_path / "SfW-ExploreGoals-v0_3"  # rl-zoo's run folder: named by the env id
+    zoo.mkdir()
+    with pytest.raises(ConfigError, match=r"no model found \(looked for SfW-ExploreGoals-v0\.zip"):
+        find_model(zoo)
+    (zoo / "model.zip").write_bytes(b"old")  # a run saved before the rl-zoo names
+    assert find_model(zoo) == zoo / "model.zip"
+    (zoo / "SfW-ExploreGoals-v0.zip").write_bytes(b"new")
+    assert find_model(zoo) == zoo / "SfW-ExploreGoals-v0.zip"
+    run = tmp_path / "runs-goals"  # sfw-gym's --out, any name: its config.yml names the env
+    run.mkdir()
+    (run / "SfW-ExploreRegions-v0.zip").write_bytes(b"m")
+    with pytest.raises(ConfigError, match=r"looked for model\.zip\)"):
+        find_model(run)
+    (run / "config.yml").write_text("env_id: SfW-ExploreRegions-v0\n")
+    assert find_model(run) == run / "SfW-ExploreRegions-v0.zip"
+    (run / "config.yml").unlink()  # or rl-zoo's <env-id>/config.yml beside the model
+    (run / "SfW-ExploreRegions-v0").mkdir()
+    (run / "SfW-ExploreRegions-v0" / "config.yml").write_text("{}")
+    assert find_model(run) == run / "SfW-ExploreRegions-v0.zip"

@@ -180,8 +180,13 @@ def test_an_env_with_other_observations_is_refused(waypoint_model):
 
 
 def test_missing_model_is_a_clear_error(tmp_path):
-    with pytest.raises(ConfigError, match=r"model\.zip not found"):
+    with pytest.raises(ConfigError, match=r"config\.yml not found; train one"):
         WaypointPPOAgent(path=tmp_path)
+    (tmp_path / "config.yml").write_text("env_id: SfW-Explore-v0\n")
+    with pytest.raises(ConfigError, match=r"no model found \(looked for SfW-Explore-v0\.zip"):
+        WaypointPPOAgent(path=tmp_path)
+    with pytest.raises(ConfigError, match=r"other\.zip not found; train one"):
+        WaypointPPOAgent(path=tmp_path / "other.zip")
 
 
 def test_env_wrapper_entries_in_rl_zoo_forms():
