@@ -33,6 +33,23 @@ def require_ray() -> Any:
 
 
 @dataclass(frozen=True)
+class Bar:
+    """What the progress bar shows.
+
+    Attributes:
+        desc: Its label.
+        unit: What it counts.
+        done: Jobs finished before (a resumed run), counted from the start.
+        postfix: Describes the last result beside the bar.
+    """
+
+    desc: str
+    unit: str = "job"
+    done: int = 0
+    postfix: Callable[[Any], str] | None = None
+
+
+@dataclass(frozen=True)
 class Executor:
     """Runs jobs at most ``workers`` at a time.
 
@@ -65,15 +82,10 @@ class Executor:
         fn: Callable[[Any], Any],
         jobs: Sequence[Any],
         on_result: Callable[[int, Any], None],
-        *,
-        desc: str,
-        unit: str = "job",
-        done: int = 0,
-        postfix: Callable[[Any], str] | None = None,
+        bar: Bar,
     ) -> None:
         """``fn(job)`` for every job; ``on_result(i, result)`` in this process as job ``i``
-        finishes (in the order they finish). The bar counts ``done`` jobs finished before (a
-        resumed run) plus these; ``postfix(result)`` describes the last one. On an error or an
+        finishes (in the order they finish), counted on the progress ``bar``. On an error or an
         interrupt the jobs not started are dropped and the running ones cancelled."""
 
         def run_all(finish: Callable[[int, Any], None]) -> None:
@@ -85,67 +97,62 @@ class Executor:
             else:
                 self._run_in_pool(fn, jobs, finish)
 
-        self._with_bar(run_all, len(jobs), on_result, desc, unit, done, postfix)
+        self._with_bar(run_all, len(jobs), on_result, bar)
 
     def consume(
         self,
         results: Generator[tuple[int, Any], None, None],
         total: int,
         on_result: Callable[[int, Any], None],
-        *,
-        desc: str,
-        unit: str = "job",
-        done: int = 0,
-        postfix: Callable[[Any], str] | None = None,
+        bar: Bar,
     ) -> None:
         """Results that run elsewhere (a vector env's episodes: ``(i, result)`` pairs, ``total``
-        of them) handed to ``on_result`` as they come, with :meth:`run`'s progress bar."""
+        of them) handed to ``on_result`` as they come, on :meth:`run`'s progress bar."""
 
         def run_all(finish: Callable[[int, Any], None]) -> None:
             with closing(results):  # stopped early: the producer cleans up at once
                 for i, result in results:
                     finish(i, result)
 
-        self._with_bar(run_all, total, on_result, desc, unit, done, postfix)
+        self._with_bar(run_all, total, on_result, bar)
 
-    def _with_bar(
-        self,
-        run_all: Callable[[Callable[[int, Any], None]], None],
-        total: int,
-        on_result: Callable[[int, Any], None],
-        desc: str,
-        unit: str,
-        done: int,
-        postfix: Callable[[Any], str] | None,
-    ) -> None:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(
-            total=done + total, initial=done, desc=desc, unit=unit, disable=not self.progress
-        )
-
-        def finish(i: int, result: Any) -> None:
-            on_result(i, result)
-            if postfix is not None:
-                bar.set_postfix_str(postfix(result))
-            bar.update(1)
-
-        try:
-            run_all(finish)
-        finally:
-            bar.close()
-
-    def map(
-        self, fn: Callable[[Any], Any], jobs: Sequence[Any], *, desc: str, unit: str = "job"
-    ) -> list[Any]:
+    def map(self, fn: Callable[[Any], Any], jobs: Sequence[Any], bar: Bar) -> list[Any]:
         """``[fn(job) for job in jobs]``, run as :meth:`run` runs them."""
         results: list[Any] = [None] * len(jobs)
 
         def keep(i: int, result: Any) -> None:
             results[i] = result
 
-        self.run(fn, jobs, keep, desc=desc, unit=unit)
+        self.run(fn, jobs, keep, bar)
         return results
+
+    def _with_bar(
+        self,
+        run_all: Callable[[Callable[[int, Any], None]], None],
+        total: int,
+        on_result: Callable[[int, Any], None],
+        bar: Bar,
+    ) -> None:
+        from tqdm.auto import tqdm
+
+        shown = tqdm(
+            total=bar.done + total,
+            initial=bar.done,
+            desc=bar.desc,
+            unit=bar.unit,
+            disable=not self.progress,
+        )
+
+        def finish(i: int, result: Any) -> None:
+            on_result(i, result)
+            if bar.postfix is not None:
+                shown.set_postfix_str(bar.postfix(result))
+            shown.update(1)
+
+        try:
+            run_all(finish)
+        finally:
+            shown.close()
 
     def _run_in_pool(
         self, fn: Callable[[Any], Any], jobs: Sequence[Any], finish: Callable[[int, Any], None]

@@ -22,7 +22,7 @@ import numpy as np
 
 from sfw_gym.core.atomic import atomic_path, write_text_atomic
 from sfw_gym.evaluation.drives import record_frontier_drive
-from sfw_gym.evaluation.executor import Executor
+from sfw_gym.evaluation.executor import Bar, Executor
 from sfw_gym.evaluation.stats import mean_ci95
 from sfw_gym.localization import GaussianGridmaps, MclConfig, SignalModel, Survey, WifiMCL
 from sfw_gym.slam import relative_pose
@@ -205,7 +205,7 @@ def run_localization_study(
         for i in range(plans)
     ]
     start = time.perf_counter()
-    results = executor.map(study_plan, jobs, desc="localisation study", unit="plan")
+    results = executor.map(study_plan, jobs, Bar("localisation study", "plan"))
     wall = time.perf_counter() - start
     summary = summarise(results, plans, runs, particles, test_steps, wall)
     figure = results[0]

@@ -36,7 +36,7 @@ from sfw_gym.evaluation.checkpoint import (
     load_checkpoint,
     open_checkpoint,
 )
-from sfw_gym.evaluation.executor import BACKENDS, Executor
+from sfw_gym.evaluation.executor import BACKENDS, Bar, Executor
 from sfw_gym.evaluation.plots import plot_curves, plot_trajectories
 from sfw_gym.evaluation.report import paired_markdown, results_csv, results_markdown
 from sfw_gym.evaluation.rollout import EpisodeSpec, run_episode, zone_band_unknown
@@ -71,16 +71,16 @@ def run_specs(
         records.append(record)
         append_record(ckpt, record)
 
-    bar: dict[str, Any] = {
-        "desc": "episodes",
-        "unit": "ep",
-        "done": len(specs) - len(todo),
-        "postfix": lambda r: f"{r['agent']} #{r['episode']} cov {r['coverage']:.2f}",
-    }
+    bar = Bar(
+        "episodes",
+        "ep",
+        done=len(specs) - len(todo),
+        postfix=lambda r: f"{r['agent']} #{r['episode']} cov {r['coverage']:.2f}",
+    )
     if vector_envs > 1:
-        executor.consume(run_vector(todo, vector_envs), len(todo), keep, **bar)
+        executor.consume(run_vector(todo, vector_envs), len(todo), keep, bar)
     else:
-        executor.run(run_episode, todo, keep, **bar)
+        executor.run(run_episode, todo, keep, bar)
     by_key = {r["key"]: r for r in records}
     return [by_key[s.key] for s in specs]
 

@@ -12,7 +12,7 @@ import pytest
 from sfw_gym.cli import main
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.evaluation import localization
-from sfw_gym.evaluation.executor import Executor
+from sfw_gym.evaluation.executor import Bar, Executor
 
 
 def square(x: int) -> int:
@@ -29,7 +29,7 @@ def fail_on_three(x: int) -> int:
 @pytest.mark.parametrize("workers", [1, 2])
 def test_map_gives_every_result_in_the_order_of_the_jobs(workers):
     jobs = list(range(7))
-    assert Executor(workers=workers, progress=False).map(square, jobs, desc="t") == [
+    assert Executor(workers=workers, progress=False).map(square, jobs, Bar("t")) == [
         j * j for j in jobs
     ]
 
@@ -37,7 +37,7 @@ def test_map_gives_every_result_in_the_order_of_the_jobs(workers):
 @pytest.mark.parametrize("workers", [1, 2])
 def test_a_failing_job_raises_in_the_caller(workers):
     with pytest.raises(ValueError, match="job 3 failed"):
-        Executor(workers=workers, progress=False).map(fail_on_three, list(range(6)), desc="t")
+        Executor(workers=workers, progress=False).map(fail_on_three, list(range(6)), Bar("t"))
 
 
 def test_run_hands_each_result_with_its_index_and_the_bar_counts_jobs_done_before(capsys):
@@ -46,15 +46,12 @@ def test_run_hands_each_result_with_its_index_and_the_bar_counts_jobs_done_befor
         square,
         [2, 3],
         lambda i, result: seen.append((i, result)),
-        desc="episodes",
-        unit="ep",
-        done=5,
-        postfix=lambda result: f"last {result}",
+        Bar("episodes", "ep", done=5, postfix=lambda result: f"last {result}"),
     )
     assert seen == [(0, 4), (1, 9)]
     bar = capsys.readouterr().err
     assert "episodes" in bar and "7/7" in bar and "last 9" in bar
-    Executor(workers=1, progress=False).map(square, [1], desc="quiet")
+    Executor(workers=1, progress=False).map(square, [1], Bar("quiet"))
     assert "quiet" not in capsys.readouterr().err
 
 
@@ -68,7 +65,7 @@ def test_consume_hands_on_results_made_elsewhere_and_stops_their_producer_on_an_
             closed.append(True)
 
     seen: list[tuple[int, str]] = []
-    Executor().consume(produce(), 3, lambda i, r: seen.append((i, r)), desc="vector", done=1)
+    Executor().consume(produce(), 3, lambda i, r: seen.append((i, r)), Bar("vector", done=1))
     assert seen == [(1, "b"), (0, "a"), (2, "c")] and closed == [True]
     bar = capsys.readouterr().err  # the same bar, counting the one done before
     assert "vector" in bar and "4/4" in bar
@@ -77,7 +74,7 @@ def test_consume_hands_on_results_made_elsewhere_and_stops_their_producer_on_an_
         raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        Executor(progress=False).consume(produce(), 3, interrupted, desc="x")
+        Executor(progress=False).consume(produce(), 3, interrupted, Bar("x"))
     assert closed == [True, True]  # the producer (a vector env's processes) shut at once
 
 
@@ -98,8 +95,8 @@ class _Stop(Exception):
 def test_the_localisation_study_runs_its_plans_on_the_executor(tmp_path, monkeypatch):
     seen = {}
 
-    def record_and_stop(self, fn, jobs, *, desc, unit="job"):
-        seen.update(executor=self, fn=fn, seeds=[job["seed"] for job in jobs], unit=unit)
+    def record_and_stop(self, fn, jobs, bar):
+        seen.update(executor=self, fn=fn, seeds=[job["seed"] for job in jobs], unit=bar.unit)
         raise _Stop
 
     monkeypatch.setattr(Executor, "map", record_and_stop)
