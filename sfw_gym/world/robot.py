@@ -282,8 +282,8 @@ class Robot:
     @property
     def pose(self) -> Pose:
         """True pose ``(x, y, theta)``; theta wrapped to [-π, π]."""
-        x, y = self._body.position
-        return Pose(x, y, _wrap(self._body.angle))
+        x, y, a = self._xya
+        return Pose(x, y, _wrap(a))
 
     @property
     def odometry_pose(self) -> Pose:
@@ -318,6 +318,8 @@ class Robot:
         body.linear_m_s = 0.0
         body.angular_rad_s = 0.0
         self._space.reindex_shapes_for_body(body)
+        x, y = body.position
+        self._xya = (x, y, body.angle)  # the body's state, read back once per step
         self._refresh_active_walls(x, y)
         self._odometry = (x, y, theta)
         self._bumped = False
@@ -354,20 +356,13 @@ class Robot:
         w = _command("angular_rad_s", angular_rad_s, cfg.max_angular_speed_rad_s)
         body = self._body
         space = self._space
-        x0, y0 = body.position
-        a0 = body.angle
+        x0, y0, a0 = self._xya
         self._refresh_active_walls(x0, y0)
-        body.linear_m_s = v
-        body.angular_rad_s = w
         # The velocity callback runs after each substep's position update, so the first substep's
         # velocity is set here, with the part into walls that the robot touches removed.
         vx, vy = v * math.cos(a0), v * math.sin(a0)
         if self._bumped:
             vx, vy = self._slide_along_contacts(vx, vy)
-        body.velocity = (vx, vy)
-        body.angular_velocity = w
-        space.robot_touched = False
-        space_step = space.step
         dt = cfg.substep_s
         substeps = cfg.physics_substeps
         if self._open_space_shortcut and not self._may_touch_wall(
@@ -389,6 +384,9 @@ class Robot:
             body.position = (x, y)
             body.angle = a
             body.velocity = (vx, vy)
+            body.angular_velocity = w
+            bumped = False
+            x1, y1, a1 = x, y, a  # what the body now holds, exactly
         else:
             # Re-insert the disc: pymunk keeps, between steps, cached contact impulses (it
             # warm-starts the next contact solve from them) and the disc's collision pairs in the
@@ -396,6 +394,12 @@ class Robot:
             # what a fresh copy has, so a copy continues exactly.
             space.remove(self._disc)
             space.add(self._disc)
+            body.linear_m_s = v
+            body.angular_rad_s = w
+            body.velocity = (vx, vy)
+            body.angular_velocity = w
+            space.robot_touched = False
+            space_step = space.step
             self._drive_by_callback(True)
             space.collision_bias = self._collision_bias
             for _ in range(substeps - 1):
@@ -405,10 +409,11 @@ class Robot:
             # step with none makes the state between steps complete, so a copy continues exactly.
             space.collision_bias = 1.0
             space_step(dt)
-        bumped = space.robot_touched
+            bumped = space.robot_touched
+            x1, y1 = body.position
+            a1 = body.angle
         self._bumped = bumped
-        x1, y1 = body.position
-        a1 = body.angle
+        self._xya = (x1, y1, a1)
 
         # Odometry: the true displacement in the robot's frame at the start of the step, plus noise.
         dx, dy = x1 - x0, y1 - y0
