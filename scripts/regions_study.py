@@ -2,7 +2,8 @@
 
 Runs ``sfw-gym evaluate`` (resuming what is done) with every agent of the comparison on the same
 plans and seeds, then prints each agent's bits per metre and coverage as ratios to default
-frontier's (ratio of the means, 95 % interval by a paired bootstrap over episodes), the decisions
+frontier's (ratio of the means, 95 % interval by a paired bootstrap over episodes: the package's
+paired comparison, ``compare_paired(..., ratio=True)``), the decisions
 per episode and the wall time per step relative to frontier's.
 
     python scripts/regions_study.py --episodes 50 --seed 2000000 --out runs/study_test
@@ -21,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from sfw_gym.evaluation.runner import evaluate
+from sfw_gym.evaluation.stats import compare_paired
 
 #: The tuned heuristics of DESIGN.md's sweep: name → (table label, entry point, parameters).
 TUNED = {
@@ -38,17 +40,6 @@ TUNED = {
 DEFAULT_AGENTS = (
     "frontier,regions-ppo,region-teacher,greedy-tuned,frontier-tuned,cross-pass,goals-ppo"
 )
-
-
-def paired_ratio(
-    ref: np.ndarray, other: np.ndarray, resamples: int = 10_000, seed: int = 0
-) -> tuple[float, float, float]:
-    """mean(other) / mean(ref) with a 95 % percentile interval from resampling the pairs."""
-    rng = np.random.default_rng(seed)
-    idx = rng.integers(0, len(ref), (resamples, len(ref)))
-    ratios = other[idx].mean(1) / ref[idx].mean(1)
-    low, high = np.percentile(ratios, [2.5, 97.5])
-    return float(other.mean() / ref.mean()), float(low), float(high)
 
 
 def main() -> None:
@@ -111,13 +102,14 @@ def main() -> None:
     ref_ms = per_step_ms(ref_name)
     for agent in agents:
         bits, cov = column(agent, "info_gain_per_m"), column(agent, "coverage")
-        rb, rc = paired_ratio(ref_bits, bits), paired_ratio(ref_cov, cov)
+        rb = compare_paired(ref_bits, bits, ratio=True)
+        rc = compare_paired(ref_cov, cov, ratio=True)
         decisions = np.mean([records[agent][i]["decisions"] for i in episodes])
         steps = np.mean([records[agent][i]["steps"] for i in episodes])
         ms = per_step_ms(agent)
         lines.append(
-            f"| {label[agent]} | {rb[0]:.3f} [{rb[1]:.3f}, {rb[2]:.3f}] | "
-            f"{rc[0]:.3f} [{rc[1]:.3f}, {rc[2]:.3f}] | {bits.mean():.1f} | {cov.mean():.3f} | "
+            f"| {label[agent]} | {rb.text('{:.3f}')} | "
+            f"{rc.text('{:.3f}')} | {bits.mean():.1f} | {cov.mean():.3f} | "
             f"{decisions:.0f} ({steps / max(decisions, 1):.1f}) | {ms:.2f} ({ms / ref_ms:.2f}×) |"
         )
     text = "\n".join(lines)

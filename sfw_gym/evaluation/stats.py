@@ -5,7 +5,7 @@ episodes with a seeded bootstrap interval) that evaluate, the benchmark and the 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -83,15 +83,32 @@ def bootstrap_ci(
 ) -> tuple[float, float]:
     """The percentile-bootstrap interval of the mean of ``values`` (scipy.stats.bootstrap,
     seeded: the same interval every time); fewer than two values or equal values: the mean."""
-    from scipy import stats
-
     v = np.asarray(values, np.float64)
     if len(v) < 2 or np.ptp(v) == 0:
         mean = float(np.mean(v)) if len(v) else math.nan
         return mean, mean
+    return _bootstrap((v,), np.mean, confidence, resamples, random_state)
+
+
+def _ratio_of_means(a: np.ndarray, b: np.ndarray, axis: int = -1) -> np.ndarray:
+    return np.mean(b, axis=axis) / np.mean(a, axis=axis)
+
+
+def _bootstrap(
+    samples: tuple[np.ndarray, ...],
+    statistic: Callable[..., Any],
+    confidence: float,
+    resamples: int,
+    random_state: int,
+) -> tuple[float, float]:
+    """scipy's seeded percentile bootstrap of ``statistic``; two samples are resampled as
+    pairs (the same indices on both sides)."""
+    from scipy import stats
+
     res = stats.bootstrap(
-        (v,),
-        np.mean,
+        samples,
+        statistic,
+        paired=len(samples) > 1,
         confidence_level=float(confidence),
         n_resamples=int(resamples),
         method="percentile",
@@ -103,14 +120,16 @@ def bootstrap_ci(
 # ---------------------------------------------------------------------------------- pairing
 @dataclass(frozen=True)
 class PairedDifference:
-    """One metric compared over paired episodes: ``b − a``.
+    """One metric compared over paired episodes: ``b − a`` (or ``b ÷ a``).
 
     Attributes:
         metric: The record key.
         n: Pairs where both values are finite.
         mean_a, mean_b: The two sides' means over those pairs.
-        mean: Mean of the differences ``b − a``.
-        low, high: Its bootstrap interval (:func:`bootstrap_ci`).
+        mean: Mean of the differences ``b − a``; with ``ratio``, the ratio of the means
+            ``mean_b / mean_a``.
+        low, high: Its seeded bootstrap interval (resampling the pairs).
+        ratio: Whether ``mean`` is a ratio (no difference: 1) or a difference (no difference: 0).
     """
 
     metric: str
@@ -120,18 +139,21 @@ class PairedDifference:
     mean: float
     low: float
     high: float
+    ratio: bool = False
 
     def text(self, fmt: str = "{:+.2f}") -> str:
         """``mean [low, high]``, each number in ``fmt``."""
         return f"{fmt.format(self.mean)} [{fmt.format(self.low)}, {fmt.format(self.high)}]"
 
     def resolved(self, direction: int) -> str:
-        """Where the interval leaves out zero (n ≥ 2): ``"better"``/``"worse"`` for b, by the
-        metric's direction (:mod:`~sfw_gym.evaluation.metric_table`), or ``"higher"``/
-        ``"lower"`` where neither way is better; ``""`` where it holds zero."""
-        if self.n < 2 or self.low <= 0.0 <= self.high:
+        """Where the interval leaves out "no difference" (0, or 1 for a ratio; n ≥ 2):
+        ``"better"``/``"worse"`` for b, by the metric's direction
+        (:mod:`~sfw_gym.evaluation.metric_table`), or ``"higher"``/``"lower"`` where neither
+        way is better; ``""`` where it holds it."""
+        same = 1.0 if self.ratio else 0.0
+        if self.n < 2 or self.low <= same <= self.high:
             return ""
-        up = self.low > 0.0
+        up = self.low > same
         if direction in (HIGHER, LOWER):
             return "better" if up == (direction == HIGHER) else "worse"
         return "higher" if up else "lower"
@@ -146,28 +168,39 @@ def compare_paired(
     b: Sequence[float | None] | np.ndarray,
     *,
     metric: str = "",
+    ratio: bool = False,
     **intervals: Any,
 ) -> PairedDifference:
     """The paired comparison: ``a[i]`` and ``b[i]`` are one episode's values on either side
     (the same plan and seed); pairs with a missing or non-finite value are left out. The mean of
-    ``b − a`` with its bootstrap interval (``intervals``: :func:`bootstrap_ci`'s keywords)."""
+    ``b − a`` with its bootstrap interval (``intervals``: :func:`bootstrap_ci`'s keywords), or
+    with ``ratio`` the ratio of the means ``mean(b) / mean(a)`` with a paired bootstrap interval
+    (the pairs resampled together)."""
     if len(a) != len(b):
         raise ValueError(f"compare_paired: {len(a)} values against {len(b)}")
     both = np.array(
         [(x, y) for x, y in zip(a, b, strict=True) if _finite(x) and _finite(y)], np.float64
     )
     if not len(both):
-        return PairedDifference(metric, 0, *(math.nan,) * 5)
-    diff = both[:, 1] - both[:, 0]
-    low, high = bootstrap_ci(diff, **intervals)
+        return PairedDifference(metric, 0, *(math.nan,) * 5, ratio=ratio)
+    x, y = both[:, 0], both[:, 1]
+    if not ratio:
+        low, high = bootstrap_ci(y - x, **intervals)
+        stat = float((y - x).mean())
+    else:
+        stat = float(y.mean() / x.mean())
+        low = high = stat
+        if len(x) >= 2 and np.ptp(y * x.mean() - x * y.mean()) > 0:  # not every pair alike
+            settings = {**BOOTSTRAP, **intervals}
+            low, high = _bootstrap(
+                (x, y),
+                _ratio_of_means,
+                settings["confidence"],
+                settings["resamples"],
+                settings["random_state"],
+            )
     return PairedDifference(
-        metric,
-        len(diff),
-        float(both[:, 0].mean()),
-        float(both[:, 1].mean()),
-        float(diff.mean()),
-        low,
-        high,
+        metric, len(x), float(x.mean()), float(y.mean()), stat, low, high, ratio=ratio
     )
 
 

@@ -283,6 +283,22 @@ def test_the_paired_comparison_is_a_seeded_bootstrap_of_the_mean_difference():
         ev.compare_paired([1.0, 2.0], [1.0])
 
 
+def test_the_paired_ratio_of_means_resamples_the_pairs_together():
+    rng = np.random.default_rng(5)
+    a = rng.uniform(20.0, 30.0, 40)
+    b = 1.1 * a * rng.normal(1.0, 0.02, 40)  # 10 % more, pair by pair
+    d = ev.compare_paired(a, b, ratio=True)
+    assert d.ratio and d.n == 40 and d.mean == pytest.approx(b.mean() / a.mean())
+    # the pairs resampled together: about as tight as the pair-by-pair spread (a resampling of
+    # the two sides apart would be some ten times wider, from the spread of a itself)
+    idx = np.random.default_rng(1).integers(0, 40, (4000, 40))
+    lo, hi = np.percentile(b[idx].mean(1) / a[idx].mean(1), [2.5, 97.5])
+    assert d.low == pytest.approx(lo, abs=2e-3) and d.high == pytest.approx(hi, abs=2e-3)
+    assert d.low > 1.0 and d.resolved(+1) == "better" and d.text("{:.3f}").startswith("1.1")
+    same = ev.compare_paired(a, a, ratio=True)
+    assert (same.mean, same.low, same.high, same.resolved(+1)) == (1.0, 1.0, 1.0, "")
+
+
 def test_one_metric_table_formats_every_table():
     from sfw_gym.evaluation import benchmark as bm
     from sfw_gym.evaluation.metric_table import METRICS
