@@ -69,8 +69,9 @@ def _index_markdown(
         "# sfw_gym demo: WiFi-only exploration",
         "",
         f"`{DEMO_ENV}` (default radio, two routers, 3,000-step budget): frontier exploration, "
-        "frontier with cross-connecting passes and the learned explorer (`ppo`: MaskablePPO "
-        f"choosing among the navigation menu's candidate goals, `{policy}`) on the same "
+        "frontier with cross-connecting passes and the learned explorer (`regions-ppo`: "
+        "MaskablePPO choosing a region of the navigation menu's candidates every 20 steps, "
+        f"`{policy}`) on the same "
         "procedural floorplans, start poses and "
         f"seeds ({seed}–{seed + len(episodes) - 1}; never used in training). "
         f"Report written in {wall_s:.0f} s.",
