@@ -215,7 +215,7 @@ def _cmd_localize(args: argparse.Namespace) -> int:
     from sfw_gym.evaluation.localization import run_localization_study
 
     summary = run_localization_study(
-        args.json,
+        args.out,
         plans=args.plans,
         runs=args.runs,
         survey_steps=args.survey_steps,
@@ -228,7 +228,7 @@ def _cmd_localize(args: argparse.Namespace) -> int:
         progress=not args.no_progress,
     )
     print(summary["markdown"])
-    print(f"wrote {args.json}/results.json, tables.md, gridmaps.png, error_over_time.png")
+    print(f"wrote {args.out}/results.json, tables.md, gridmaps.png, error_over_time.png")
     return 0
 
 
@@ -400,7 +400,7 @@ EXAMPLES = {
     "map": 'sfw-gym map LOG.csv --routers "60,60;220,220" --scale 0.05 --out map.png',
     "record": "sfw-gym record walk.csv --seed 3 --routers 2",
     "slam": "sfw-gym slam drift.csv --record 7",
-    "localize": "sfw-gym localize --plans 10 --json localize",
+    "localize": "sfw-gym localize --plans 10 --out localize",
     "speed": "sfw-gym speed --steps 5000 --resets 50",
     "train": "sfw-gym train ppo_mask --env SfW-ExploreRegions-v0 --out runs/regions --resume",
     "evaluate": "sfw-gym evaluate --agents frontier,ppo,greedy --episodes 10 --seed 2000000",
@@ -626,7 +626,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _add_episode_runner_options(loc)
     loc.add_argument(
-        "--json", type=folder, default="localize", help="output folder (default localize/)"
+        "--out",
+        "--json",  # its name before issue 32, kept as an alias
+        dest="out",
+        type=folder,
+        default="localize",
+        help="output folder (default localize/; --json is the old name)",
     )
     loc.set_defaults(func=_cmd_localize)
 

@@ -115,8 +115,8 @@ def test_localize_takes_the_executors_options(tmp_path, monkeypatch, capsys):
         return {"markdown": "tables\n"}
 
     monkeypatch.setattr(localization, "run_localization_study", fake_study)
-    argv = ["localize", "--json", str(tmp_path), "--workers", "3", "--no-progress"]
+    argv = ["localize", "--out", str(tmp_path), "--workers", "3", "--no-progress"]
     assert main(argv) == 0
     assert (given["workers"], given["backend"], given["progress"]) == (3, "local", False)
-    assert main(["localize", "--json", str(tmp_path)]) == 0
+    assert main(["localize", "--out", str(tmp_path)]) == 0
     assert given["progress"] is True and given["address"] is None

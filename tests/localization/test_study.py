@@ -13,7 +13,7 @@ from sfw_gym.cli import main
 def test_the_localization_study_writes_every_table_and_figure(tmp_path, capsys):
     out = tmp_path / "loc"
     argv = ["localize", "--plans", "1", "--runs", "1", "--survey-steps", "300"]
-    argv += ["--test-steps", "60", "--particles", "100", "--workers", "1", "--json", str(out)]
+    argv += ["--test-steps", "60", "--particles", "100", "--workers", "1", "--out", str(out)]
     assert main(argv) == 0
     tables = (out / "tables.md").read_text()
     assert capsys.readouterr().out.startswith(tables.splitlines()[0])
@@ -29,6 +29,8 @@ def test_the_localization_study_writes_every_table_and_figure(tmp_path, capsys):
 
 def test_an_output_path_that_is_a_file_is_refused(tmp_path, capsys):
     (tmp_path / "f").write_text("x")
-    with pytest.raises(SystemExit) as exc:
-        main(["localize", "--json", str(tmp_path / "f")])
-    assert exc.value.code == 2
+    for option in ("--out", "--json"):  # --json: the old name, an alias
+        with pytest.raises(SystemExit) as exc:
+            main(["localize", option, str(tmp_path / "f")])
+        assert exc.value.code == 2
+        assert "f" in capsys.readouterr().err
