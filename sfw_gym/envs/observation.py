@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 from gymnasium import spaces
+from numba import njit
 
 from sfw_gym.core.constants import U8_UNKNOWN
 from sfw_gym.mapping import GridSpec
@@ -83,14 +84,18 @@ class ObservationBuilder:
         self.crop_px = crop_px
         self.n_router_slots = n_router_slots
         rows, cols = grid.shape
+        # the grid's geometry as plain floats (read every step)
+        (self._ox, self._oy), self._res = grid.origin_xy, grid.resolution_m
+        self._rows, self._cols = rows, cols
+        self._width_m, self._height_m = cols * grid.resolution_m, rows * grid.resolution_m
         self.cells_per_px = max(rows, cols) / map_px
         pad_r = (map_px - rows / self.cells_per_px) / 2
         pad_c = (map_px - cols / self.cells_per_px) / 2
         src_r = np.floor((np.arange(map_px) - pad_r + 0.5) * self.cells_per_px).astype(np.int64)
         src_c = np.floor((np.arange(map_px) - pad_c + 0.5) * self.cells_per_px).astype(np.int64)
         valid = ((src_r >= 0) & (src_r < rows))[:, None] & ((src_c >= 0) & (src_c < cols))[None, :]
-        flat = np.clip(src_r, 0, rows - 1)[:, None] * cols + np.clip(src_c, 0, cols - 1)[None, :]
-        self._flat_index = flat
+        self._src_r, self._src_c = np.clip(src_r, 0, rows - 1), np.clip(src_c, 0, cols - 1)
+        self._flat_index = self._src_r[:, None] * cols + self._src_c[None, :]
         self._pad = ~valid
         self._pad_r, self._pad_c = pad_r, pad_c
         self._trajectory = np.zeros((map_px, map_px), np.uint8)
@@ -98,15 +103,12 @@ class ObservationBuilder:
         for x, y in routers_xy:
             r, c = self.pixel_of(x, y)
             self._routers[max(r - 1, 0) : r + 2, max(c - 1, 0) : c + 2] = 255
-        self._padded = np.full((rows + crop_px, cols + crop_px), U8_UNKNOWN, np.uint8)
         self._routers_xy = np.asarray(routers_xy, np.float64)
 
     def pixel_of(self, x: float, y: float) -> tuple[int, int]:
         """Map-image pixel (row, col) of a world point, clamped to the image."""
-        ox, oy = self.grid.origin_xy
-        res = self.grid.resolution_m
-        r = math.floor((y - oy) / res / self.cells_per_px + self._pad_r)
-        c = math.floor((x - ox) / res / self.cells_per_px + self._pad_c)
+        r = math.floor((y - self._oy) / self._res / self.cells_per_px + self._pad_r)
+        c = math.floor((x - self._ox) / self._res / self.cells_per_px + self._pad_c)
         return min(max(r, 0), self.map_px - 1), min(max(c, 0), self.map_px - 1)
 
     def image_of(self, grid_u8: np.ndarray) -> np.ndarray:
@@ -134,38 +136,65 @@ class ObservationBuilder:
     ) -> dict[str, np.ndarray]:
         """The observation dict for the current belief and readings."""
         x, y, theta = odometry_pose
-        belief = self.image_of(belief_u8)
-        robot = self._trajectory.copy()
         r, c = self.pixel_of(x, y)
-        robot[max(r - 1, 0) : r + 2, max(c - 1, 0) : c + 2] = ROBOT_U8
-        image = np.empty((3, self.map_px, self.map_px), np.uint8)
-        image[0], image[1], image[2] = belief, robot, self._routers
+        cr = min(max(int((y - self._oy) / self._res), 0), self._rows - 1)
+        cc = min(max(int((x - self._ox) / self._res), 0), self._cols - 1)
+        image, local = _draw(
+            belief_u8, self._src_r, self._src_c, self._pad, self._trajectory, self._routers,
+            r, c, cr, cc, self.crop_px,
+        )  # fmt: skip
 
-        half = self.crop_px // 2
-        rows, cols = self.grid.shape
-        self._padded[half : half + rows, half : half + cols] = belief_u8
-        ox, oy = self.grid.origin_xy
-        cr = min(max(int((y - oy) / self.grid.resolution_m), 0), rows - 1)
-        cc = min(max(int((x - ox) / self.grid.resolution_m), 0), cols - 1)
-        local = self._padded[None, cr : cr + self.crop_px, cc : cc + self.crop_px].copy()
-
-        n = len(rssi_dbm)
-        state = np.zeros(state_size(self.n_router_slots), np.float32)
-        heard = rssi_dbm > RSSI_FLOOR_DBM
-        state[:n] = np.clip((rssi_dbm - RSSI_FLOOR_DBM) / RSSI_SPAN_DB, 0.0, 1.0) * heard
-        state[self.n_router_slots : self.n_router_slots + n] = heard
-        k = 2 * self.n_router_slots
-        (x0, y0), (w, h) = self.grid.origin_xy, self._extent()
-        state[k : k + 6] = (
+        slots = self.n_router_slots
+        state = [0.0] * state_size(slots)  # a few numbers: plain floats, one conversion
+        for i, dbm in enumerate(rssi_dbm.tolist()):
+            if dbm > RSSI_FLOOR_DBM:
+                state[i] = min(max((dbm - RSSI_FLOOR_DBM) / RSSI_SPAN_DB, 0.0), 1.0)
+                state[slots + i] = 1.0
+        state[2 * slots :] = (
             float(bumped),
-            min(max((x - x0) / w, 0.0), 1.0),
-            min(max((y - y0) / h, 0.0), 1.0),
+            min(max((x - self._ox) / self._width_m, 0.0), 1.0),
+            min(max((y - self._oy) / self._height_m, 0.0), 1.0),
             math.sin(theta),
             math.cos(theta),
             known_fraction,
         )
-        return {"map": image, "local": local, "state": state}
+        return {"map": image, "local": local, "state": np.array(state, np.float32)}
 
-    def _extent(self) -> tuple[float, float]:
-        rows, cols = self.grid.shape
-        return cols * self.grid.resolution_m, rows * self.grid.resolution_m
+
+@njit(cache=True)
+def _draw(
+    belief: np.ndarray,
+    src_r: np.ndarray,
+    src_c: np.ndarray,
+    pad: np.ndarray,
+    trajectory: np.ndarray,
+    routers: np.ndarray,
+    r: int,
+    c: int,
+    cr: int,
+    cc: int,
+    crop: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The ``map`` image (the belief sampled at ``src_r × src_c``, unknown on ``pad``; the
+    trajectory with the robot's 3 × 3 square at pixel (r, c); the routers) and the ``local`` crop
+    of the belief centred on cell (cr, cc) (unknown outside the grid), in one pass."""
+    m = src_r.shape[0]
+    image = np.empty((3, m, m), np.uint8)
+    for i in range(m):
+        for j in range(m):
+            image[0, i, j] = U8_UNKNOWN if pad[i, j] else belief[src_r[i], src_c[j]]
+            image[1, i, j] = trajectory[i, j]
+            image[2, i, j] = routers[i, j]
+    for i in range(max(r - 1, 0), min(r + 2, m)):
+        for j in range(max(c - 1, 0), min(c + 2, m)):
+            image[1, i, j] = ROBOT_U8
+    rows, cols = belief.shape
+    half = crop // 2
+    local = np.empty((1, crop, crop), np.uint8)
+    for i in range(crop):
+        br = cr + i - half
+        for j in range(crop):
+            bc = cc + j - half
+            inside = 0 <= br < rows and 0 <= bc < cols
+            local[0, i, j] = belief[br, bc] if inside else U8_UNKNOWN
+    return image, local
