@@ -12,28 +12,70 @@ frontier,regions-ppo``; a model of one's own with ``--agent-params '{"regions-pp
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import yaml
 
-from sfw_gym.agents.base import Agent, RobotView
+from sfw_gym.agents.base import Agent, AgentSettings, RobotView
 from sfw_gym.agents.regions import RegionAgent
+from sfw_gym.core.config import setting
 from sfw_gym.core.data import DEFAULT_MODEL_DIR, DEFAULT_REGIONS_MODEL_DIR
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.goals import GoalsConfig, action_masks, menu_observation
-from sfw_gym.envs.regions import candidate_pixels
+from sfw_gym.envs.regions import RegionsConfig, candidate_pixels
 from sfw_gym.navigation.candidates import CandidateGoals, GoalFinder
 from sfw_gym.navigation.goal_driver import GoalDriver
 from sfw_gym.rl.runs import find_model
+
+
+@dataclass(frozen=True)
+class LearnedAgentSettings(AgentSettings):
+    """The parameters of an agent that acts with a trained model.
+
+    Attributes:
+        path: A training output folder holding the model, or the ``.zip`` (a ``Path`` works too).
+        deterministic: Take the policy's most likely action (the default); else sample it with
+            the agent's seeded generator.
+        device: Torch device of the policy.
+    """
+
+    path: str = ""
+    deterministic: bool = setting(True, choices=(True, False))
+    device: str = "cpu"
+
+    def validate(self) -> None:
+        object.__setattr__(self, "path", str(self.path))
+
+
+@dataclass(frozen=True)
+class MaskedPPOSettings(LearnedAgentSettings):
+    """A MaskablePPO agent's parameters (:class:`PPOAgent`, :class:`RegionsPPOAgent`).
+
+    Attributes:
+        num_threads: PyTorch's CPU threads, set for the process (None: leave them): one is
+            fastest for this small network, several contend for the cores with the envs (a
+            decision took 5× longer with two threads on a busy 2-core machine).
+    """
+
+    path: str = str(DEFAULT_MODEL_DIR)
+    num_threads: int | None = setting(1, integer=True, ge=1, optional=True)
+
+
+@dataclass(frozen=True)
+class RegionsPPOSettings(MaskedPPOSettings):
+    """:class:`RegionsPPOAgent`'s parameters: by default the shipped region model."""
+
+    path: str = str(DEFAULT_REGIONS_MODEL_DIR)
 
 
 class PPOAgent(Agent):
     """Acts with a MaskablePPO model over candidate goals (``goals-ppo``: the learned explorer
     before the region one, which is now ``regions-ppo``).
 
-    Args:
+    Parameters (keyword arguments, :class:`MaskedPPOSettings`):
         path: A ``sfw-gym train ppo_mask`` output folder (``<env-id>.zip`` or an older run's
             ``model.zip``, ``config.yml``) or a ``.zip`` in it or in its ``checkpoints``; by
             default the shipped model.
@@ -47,19 +89,15 @@ class PPOAgent(Agent):
     """
 
     name = "goals-ppo"
+    settings_class = MaskedPPOSettings
+    settings: MaskedPPOSettings
 
-    def __init__(
-        self,
-        path: str | Path = DEFAULT_MODEL_DIR,
-        deterministic: bool = True,
-        device: str = "cpu",
-        num_threads: int | None = 1,
-        max_steps: int | None = None,
-    ) -> None:
-        super().__init__(max_steps=max_steps)
-        self.path, self.deterministic, self.device = str(path), bool(deterministic), device
-        self.num_threads = num_threads
-        self.model, config = load_model(path, device, num_threads)
+    def __init__(self, path: str | Path | None = None, **params: Any) -> None:
+        if path is not None:  # the model, positionally: PPOAgent("runs/mine")
+            params["path"] = path
+        super().__init__(**params)
+        s = self.settings
+        self.model, config = load_model(s.path, s.device, s.num_threads)
         goals = (config.get("env_kwargs") or {}).get("goals")
         self.config = GoalsConfig.from_dict(goals, "goals")
         # a policy trained without masks (an ablation) chooses among all candidates
@@ -95,7 +133,7 @@ class PPOAgent(Agent):
         from sfw_gym.rl.goal_policy import GoalsInputs, GoalsPolicy
 
         policy = self.model.policy
-        if self.deterministic and isinstance(policy, GoalsPolicy):
+        if self.settings.deterministic and isinstance(policy, GoalsPolicy):
             # the most likely valid candidate: the actor's logits straight, without SB3's
             # predict() (its tensors, checks and distribution cost 1.2 ms a decision)
             with torch.no_grad():
@@ -105,7 +143,7 @@ class PPOAgent(Agent):
                 features = policy.extract_features(x)
                 logits = policy.heads.forward_actor(features)[0].numpy()  # type: ignore[arg-type]
             return int(np.argmax(np.where(mask, logits, -np.inf)))
-        if self.deterministic:
+        if self.settings.deterministic:
             action, _ = self.model.predict(obs, action_masks=mask, deterministic=True)
             return int(action)
         with torch.no_grad():
@@ -155,7 +193,7 @@ class RegionsPPOAgent(RegionAgent):
     candidate menu from the whole map (its actor reads no ground truth), and the classical
     steering drives towards it, exactly as in the env.
 
-    Args:
+    Parameters (keyword arguments, :class:`RegionsPPOSettings`):
         path: A training output folder or a ``.zip`` in it or in its ``checkpoints``; by
             default the shipped region model.
         deterministic: Take the most likely region (the default); else sample it with the
@@ -166,20 +204,17 @@ class RegionsPPOAgent(RegionAgent):
     """
 
     name = "regions-ppo"
+    settings_class = RegionsPPOSettings  # type: ignore[assignment]  # the regions: the model's
+    settings: RegionsPPOSettings  # type: ignore[assignment]
 
-    def __init__(
-        self,
-        path: str | Path = DEFAULT_REGIONS_MODEL_DIR,
-        deterministic: bool = True,
-        device: str = "cpu",
-        num_threads: int | None = 1,
-        max_steps: int | None = None,
-    ) -> None:
-        self.model, config = load_model(path, device, num_threads)
+    def __init__(self, path: str | Path | None = None, **params: Any) -> None:
+        if path is not None:  # the model, positionally: PPOAgent("runs/mine")
+            params["path"] = path
+        Agent.__init__(self, **params)
+        s = self.settings
+        self.model, config = load_model(s.path, s.device, s.num_threads)
         regions = (config.get("env_kwargs") or {}).get("regions")
-        super().__init__(regions=regions, max_steps=max_steps)
-        self.path, self.deterministic, self.device = str(path), bool(deterministic), device
-        self.num_threads = num_threads
+        self.config = RegionsConfig.from_dict(regions, "regions")
 
     def choose(
         self, view: RobotView, obs: Any, menu: CandidateGoals, extra: dict[str, np.ndarray]
@@ -196,7 +231,7 @@ class RegionsPPOAgent(RegionAgent):
             x = {key: torch.as_tensor(full[key])[None] for key in policy.actor_keys}
             logits = policy.actor_logits(x)[0].numpy().astype(np.float64)
         logits = np.where(action_masks(menu, k), logits, -np.inf)
-        if self.deterministic:
+        if self.settings.deterministic:
             return int(np.argmax(logits))
         probs = np.exp(logits - logits.max())
         return int(self.rng.choice(k, p=probs / probs.sum()))

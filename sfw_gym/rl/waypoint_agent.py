@@ -10,6 +10,7 @@ directly.
 from __future__ import annotations
 
 import functools
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +21,7 @@ from sfw_gym.agents.base import Agent, RobotView
 from sfw_gym.core.data import DEFAULT_WAYPOINT_MODEL_DIR
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.navigation.waypoints import WaypointDriver, block_features
+from sfw_gym.rl.agent import LearnedAgentSettings
 from sfw_gym.rl.runs import find_model
 from sfw_gym.rl.training import wrapper_specs
 
@@ -45,10 +47,17 @@ def waypoint_settings(config: dict[str, Any]) -> dict[str, int] | None:
     return None
 
 
+@dataclass(frozen=True)
+class WaypointPPOSettings(LearnedAgentSettings):
+    """:class:`WaypointPPOAgent`'s parameters: by default the shipped waypoint policy."""
+
+    path: str = str(DEFAULT_WAYPOINT_MODEL_DIR)
+
+
 class WaypointPPOAgent(Agent):
     """Acts with a PPO model trained by ``sfw-gym train ppo`` (by default the shipped one).
 
-    Args:
+    Parameters (keyword arguments, :class:`WaypointPPOSettings`):
         path: A training output folder holding the model (``<env-id>.zip``, or ``model.zip``
             of an older run) and ``config.yml``, or that ``.zip``; by default the shipped
             policy.
@@ -65,18 +74,15 @@ class WaypointPPOAgent(Agent):
 
     name = "waypoint-ppo"
 
-    def __init__(
-        self,
-        path: str | Path = DEFAULT_WAYPOINT_MODEL_DIR,
-        deterministic: bool = True,
-        device: str = "cpu",
-        max_steps: int | None = None,
-    ) -> None:
-        super().__init__(max_steps=max_steps)
+    settings_class = WaypointPPOSettings
+    settings: WaypointPPOSettings
+
+    def __init__(self, path: str | Path | None = None, **params: Any) -> None:
+        if path is not None:  # the model, positionally: PPOAgent("runs/mine")
+            params["path"] = path
+        super().__init__(**params)
+        path, device = self.settings.path, self.settings.device
         folder = Path(path).parent if Path(path).suffix == ".zip" else Path(path)
-        self.path = str(path)
-        self.deterministic = bool(deterministic)
-        self.device = device
         config_path = folder / "config.yml"
         hint = f"train one with `sfw-gym train ppo --out {folder}` or pass path="
         if not config_path.is_file():
@@ -108,7 +114,7 @@ class WaypointPPOAgent(Agent):
     def _choose(self, obs: dict[str, np.ndarray]) -> int:
         """The policy's waypoint for ``obs``: its mode, or a sample drawn with ``self.rng``."""
         probs = self._distribution(obs).probs[0].cpu().numpy()
-        if self.deterministic:
+        if self.settings.deterministic:
             return int(np.argmax(probs))
         probs = probs.astype(np.float64)
         return int(self.rng.choice(len(probs), p=probs / probs.sum()))
@@ -123,7 +129,7 @@ class WaypointPPOAgent(Agent):
         if not isinstance(dist, torch.distributions.Normal):
             raise ConfigError(
                 f"WaypointPPOAgent: cannot sample the {type(dist).__name__} actions of "
-                f"{self.path} with the agent's generator; use deterministic=True"
+                f"{self.settings.path} with the agent's generator; use deterministic=True"
             )
         mean = dist.loc[0].cpu().numpy().astype(np.float64)
         std = dist.scale[0].cpu().numpy().astype(np.float64)
@@ -147,7 +153,7 @@ class WaypointPPOAgent(Agent):
         if differ:
             got = {k: np.shape(obs.get(k)) for k in differ}
             raise ConfigError(
-                f"WaypointPPOAgent: the policy in {self.path} was trained on observations "
+                f"WaypointPPOAgent: the policy in {self.settings.path} was trained on observations "
                 f"{differ}; this env gives {got} (map_px, crop_px and n_routers must match)"
             )
         self._obs_checked = True
@@ -162,7 +168,7 @@ class WaypointPPOAgent(Agent):
         if self.waypoints is None:
             action = (  # the Gaussian's mean, or a draw from it with self.rng
                 self.model.predict(obs, deterministic=True)[0]
-                if self.deterministic
+                if self.settings.deterministic
                 else self._sample_action(obs)
             )
             linear, angular = np.clip(np.asarray(action, np.float64).ravel()[:2], -1.0, 1.0)

@@ -174,7 +174,7 @@ def test_an_env_with_other_observations_is_refused(waypoint_model):
     message = str(error.value)
     assert str(waypoint_model) in message  # which policy
     assert "'map': (3, 36, 36)" in message and "'map': (3, 64, 64)" in message  # trained vs got
-    assert agent.path == str(waypoint_model)
+    assert agent.settings.path == str(waypoint_model)
     with pytest.raises(ConfigError, match=r"WaypointPPOAgent\.act\(obs\) needs the env's \(Dict\)"):
         agent.act(None)
 
