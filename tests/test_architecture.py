@@ -64,6 +64,7 @@ def test_type_checker_is_clean():
     assert status == 0, stdout + stderr
 
 
+@pytest.mark.episode
 def test_making_and_stepping_an_env_imports_no_torch():
     code = (
         "import sfw_gym, gymnasium as gym, sys; e = gym.make('SfW-Explore-v0'); e.reset(seed=0); "

@@ -51,8 +51,8 @@ TRAIN += ["--hyperparams", "{tmp}/ppo.yml", "--out", "{tmp}/run", "--eval-every"
 DEMO = ["demo", "--out", "{tmp}/demo", "--episodes", "1", "--workers", "1", "--no-progress"]
 
 
-def ok(argv: list[str], *outputs: str, id: str):
-    return pytest.param(argv, 0, None, outputs, id=id)
+def ok(argv: list[str], *outputs: str, id: str, marks=()):
+    return pytest.param(argv, 0, None, outputs, id=id, marks=marks)
 
 
 def bad(argv: list[str], error: str, id: str):
@@ -220,6 +220,7 @@ CASES = [
         "run/SfW-ExploreSmall-v0/args.yml",
         "run/config.yml",
         id="train",
+        marks=pytest.mark.episode,
     ),
     bad([*TRAIN, "--timesteps", "0"], r"argument --timesteps: .*'0'", id="train-timesteps-0"),
     bad([*TRAIN, "--n-envs", "0"], r"argument --n-envs: .*'0'", id="train-n-envs-0"),
@@ -301,6 +302,7 @@ def test_cli(argv, code, error, outputs, inputs, capsys):
         assert_one_error_line(captured.err, argv[0], error)
 
 
+@pytest.mark.episode
 def test_console_script_reports_bad_input_in_one_line(tmp_path):
     """The installed ``sfw-gym`` executable (catches a broken entry point)."""
     exe = shutil.which("sfw-gym", path=str(Path(sys.executable).parent)) or shutil.which("sfw-gym")
@@ -324,6 +326,7 @@ def run_cli(argv: list[str], capsys: pytest.CaptureFixture) -> str:
     return capsys.readouterr().out
 
 
+@pytest.mark.episode
 def test_world_is_reproducible_from_its_seed(inputs, capsys):
     """The same --seed draws the same plan and routers (printed with their positions)."""
     argv = ["world", "--seed", "5", "--out", "w.png", "--resolution", "0.5", "--routers", "3"]

@@ -20,15 +20,23 @@ MACRO_ACTION_IDS = ("SfW-ExploreGoals-v0", "SfW-ExploreRegions-v0")
 #: Ids whose reset costs seconds (a survey and its GP gridmaps): the checkers, rendering and
 #: repeats of these run in CI's full suite, not the quick loop.
 SLOW_RESET_IDS = ("SfW-Localize-v0",)
+#: Ids that are SfW-Explore-v0 with other radio, budget or odometry settings: the quick loop
+#: checks them by their rollout determinism, the full suite by everything.
+KWARG_VARIANT_IDS = (
+    "SfW-ExploreThick-v0",
+    "SfW-ExploreResidential-v0",
+    "SfW-ExploreFull-v0",
+    "SfW-ExploreDrift-v0",
+)
 
 
-def env_ids(heavy: tuple[str, ...] = SLOW_RESET_IDS) -> list:
+def env_ids(heavy: tuple[str, ...] = SLOW_RESET_IDS + KWARG_VARIANT_IDS) -> list:
     """Every id; those in ``heavy`` marked ``episode`` (run by CI's full suite)."""
     return [pytest.param(i, marks=pytest.mark.episode) if i in heavy else i for i in ENV_IDS]
 
 
 def _rollout_steps(env_id: str) -> int:
-    return 20 if env_id in MACRO_ACTION_IDS else 100
+    return 10 if env_id in MACRO_ACTION_IDS else 60
 
 
 #: Warnings we accept from the checkers, with why.

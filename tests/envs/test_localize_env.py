@@ -33,6 +33,7 @@ def test_the_robot_finds_itself_from_an_unknown_start():
     assert sum(rewards) == pytest.approx(infos[0]["loc_spread_m"] - infos[-1]["loc_spread_m"])
 
 
+@pytest.mark.episode
 def test_a_kidnapped_robot_is_lost_then_found_and_its_odometry_saw_nothing():
     env = gym.make("SfW-Localize-v0", localize={"kidnap_step": 60})
     _, infos, _ = drive(env, 2_000_000, 100)

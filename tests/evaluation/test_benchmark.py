@@ -45,6 +45,7 @@ def test_the_shipped_protocol_has_disjoint_seed_and_plan_splits():
         bm.load_protocol("benchmark-v9")
 
 
+@pytest.mark.episode
 def test_running_the_benchmark_twice_gives_the_same_results_files(tmp_path):
     options = ["--agent", "random", "--split", "validation", "--episodes", "1"]
     # `benchmark run`, and the bare form kept from before the subcommands
@@ -175,6 +176,7 @@ def test_unreached_90_percent_counts_as_the_budget_and_all_zero_metrics_are_left
     assert "ate_m" not in summary and summary["coverage"]["n"] == 2
 
 
+@pytest.mark.episode
 def test_another_agent_seed_runs_its_own_episodes(tmp_path):
     argv = ["benchmark", "--agent", "random", "--split", "validation", "--episodes", "1"]
     common = ["--workers", "1", "--no-progress"]

@@ -101,6 +101,7 @@ class StraightAgent(Agent):
         return 1.0, 0.0
 
 
+@pytest.mark.episode
 def test_an_agent_of_ones_own_runs_in_the_workers_by_its_entry_point(tmp_path):
     entry = f"{__name__}:StraightAgent"
     result = ev.evaluate(["random", entry], 2, seed=5, out=tmp_path, **{**TINY, "workers": 2})
@@ -152,6 +153,7 @@ def test_interrupted_run_resumes_without_redoing_episodes(tmp_path, monkeypatch)
     assert len(rerun) == 2 and all("|2|" in k for k in rerun)
 
 
+@pytest.mark.episode
 def test_parallel_workers_match_the_serial_run(tmp_path):
     serial = ev.evaluate(["random"], 2, seed=1, out=tmp_path / "a", **TINY)
     parallel = ev.evaluate(["random"], 2, seed=1, out=tmp_path / "b", **{**TINY, "workers": 2})

@@ -26,7 +26,7 @@ def fail_on_three(x: int) -> int:
     return x
 
 
-@pytest.mark.parametrize("workers", [1, 2])
+@pytest.mark.parametrize("workers", [1, pytest.param(2, marks=pytest.mark.episode)])
 def test_map_gives_every_result_in_the_order_of_the_jobs(workers):
     jobs = list(range(7))
     assert Executor(workers=workers, progress=False).map(square, jobs, Bar("t")) == [
@@ -34,7 +34,7 @@ def test_map_gives_every_result_in_the_order_of_the_jobs(workers):
     ]
 
 
-@pytest.mark.parametrize("workers", [1, 2])
+@pytest.mark.parametrize("workers", [1, pytest.param(2, marks=pytest.mark.episode)])
 def test_a_failing_job_raises_in_the_caller(workers):
     with pytest.raises(ValueError, match="job 3 failed"):
         Executor(workers=workers, progress=False).map(fail_on_three, list(range(6)), Bar("t"))

@@ -22,6 +22,7 @@ def _records(folder):
     return {r["key"]: {k: v for k, v in r.items() if k != "wall_s"} for r in map(json.loads, lines)}
 
 
+@pytest.mark.episode
 def test_frontier_on_two_vector_envs_gives_the_sequential_records(tmp_path, capsys):
     # 3 episodes on 2 sub-envs: one sub-env runs two episodes in a row, the other idles at the end
     argv = ["evaluate", "--agents", "frontier", "--episodes", "3", "--seed", "4", "--env", SMALL]

@@ -70,6 +70,7 @@ def models(survey):
     return SignalModel(survey, per_ap=True), SignalModel(survey, per_ap=False)
 
 
+@pytest.mark.episode
 def test_gp_models_learn_the_signal_field(models):
     test = np.random.default_rng(1).uniform(1, 9, (200, 2))
     truth = field(test)
@@ -84,6 +85,7 @@ def test_gp_models_learn_the_signal_field(models):
     assert mgp < gp
 
 
+@pytest.mark.episode
 def test_gridmaps_store_the_direct_prediction_at_cell_centres(models):
     mgp = models[0]
     maps = GaussianGridmaps.from_model(mgp, (0, 0, 10, 10), 0.5)
@@ -107,6 +109,7 @@ def test_gridmaps_store_the_direct_prediction_at_cell_centres(models):
     np.testing.assert_allclose(v, direct_var)
 
 
+@pytest.mark.episode
 def test_gridmaps_round_trip_through_npz(tmp_path, models):
     maps = GaussianGridmaps.from_model(models[1], (0, 0, 10, 10), 1.0, "float16")
     loaded = GaussianGridmaps.load(maps.save(tmp_path / "maps.npz"))
@@ -190,6 +193,7 @@ def test_a_kidnapped_robot_is_found_again():
     assert errors[-20:].mean() < 0.7  # found again
 
 
+@pytest.mark.episode
 def test_mcl_on_direct_gp_prediction_tracks_like_on_its_gridmaps(models):
     mgp = models[0]
     maps = GaussianGridmaps.from_model(mgp, (0, 0, 10, 10), 0.25)
@@ -201,6 +205,7 @@ def test_mcl_on_direct_gp_prediction_tracks_like_on_its_gridmaps(models):
         assert drive(mcl, path, rng)[10:].mean() < 0.6
 
 
+@pytest.mark.episode
 def test_a_path_loss_mean_extrapolates_where_the_zero_mean_falls_to_zero():
     """Our option: surveyed on the left half only, predicted on the right half of a log-distance
     field; the zero mean decays toward 0 away from the data, the fitted curves follow it."""

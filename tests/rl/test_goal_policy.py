@@ -68,6 +68,7 @@ def test_each_heads_gradient_norm_is_logged_after_every_update():
         assert set(norms) == {"actor", "critic"} and min(norms.values()) > 0
 
 
+@pytest.mark.episode
 def test_behaviour_cloning_learns_the_teachers_choices():
     observations, actions, masks = teacher_decisions(range(4))
     held_out, actions_out, masks_out = teacher_decisions([10])

@@ -202,6 +202,7 @@ def torch_equal(a, b) -> bool:
     return a == b
 
 
+@pytest.mark.episode
 def test_maskable_ppo_on_candidate_goals_starts_from_the_frontier_agents_choices(
     tmp_path, monkeypatch
 ):
@@ -339,6 +340,7 @@ def test_the_training_curve_draws_other_policies_levels(tmp_path, monkeypatch):
     assert drawn == [(12.3, "frontier"), (7.9, "greedy")]
 
 
+@pytest.mark.episode
 def test_a_resumed_run_keeps_its_evaluations_and_survives_a_cut_monitor_line(tmp_path):
     from sfw_gym.rl.training import _monitored_seconds
 
@@ -360,6 +362,7 @@ def test_a_resumed_run_keeps_its_evaluations_and_survives_a_cut_monitor_line(tmp
         train_ppo("SfW-ExploreSmall-v0", 8, tmp_path / "x", **{**run, "checkpoint_every": 0})
 
 
+@pytest.mark.episode
 def test_a_resume_from_before_the_first_evaluation_evaluates_on_the_same_episodes(tmp_path):
     """The evaluation env has not been reset yet at the first checkpoint: its seed still waits
     for that reset, and a resume must keep it (not draw fresh entropy)."""

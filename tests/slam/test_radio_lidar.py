@@ -34,12 +34,14 @@ def ate(poses, drive):
     return absolute_trajectory_error(poses, drive["truth"], align=False)
 
 
+@pytest.mark.episode
 def test_lidar_only_slam_removes_most_of_the_odometrys_drift(drive):
     result = lidar_slam(drive["odometry"], drive["keyframe_scans"], radio=drive["slam_config"])
     assert result.consecutive_registered > 0.8  # walls in view nearly everywhere indoors
     assert ate(result.poses, drive) < 0.3 * ate(drive["odometry"], drive)
 
 
+@pytest.mark.episode
 def test_radio_lidar_slam_beats_radio_slam_and_closes_lidar_loops(drive):
     radio = ate(
         radio_slam(drive["odometry"], drive["fingerprints"], drive["slam_config"]).poses, drive
@@ -60,6 +62,7 @@ def test_radio_lidar_slam_beats_radio_slam_and_closes_lidar_loops(drive):
     assert ate(both.poses, drive) < 0.5 * radio
 
 
+@pytest.mark.episode
 def test_without_scan_matching_the_pipeline_is_no_better_than_its_first_stage(drive):
     """Flip side of the tests above: with ICP never accepting (fitness bound ~0) nothing of the
     LiDAR stage is used and Radio+LiDAR returns Radio SLAM's trajectory."""
@@ -78,6 +81,7 @@ def test_without_scan_matching_the_pipeline_is_no_better_than_its_first_stage(dr
     assert ate(both.poses, drive) == pytest.approx(ate(radio, drive), abs=0.05)
 
 
+@pytest.mark.episode
 def test_a_missing_keyframe_scan_is_one_clear_error(drive):
     scans = dict(drive["keyframe_scans"])
     del scans[5]
@@ -96,6 +100,7 @@ def test_the_online_solver_keeps_scans_only_at_keyframes_and_the_latest_pose():
         slam.add((0.0, 0.0, 0.0), np.full(4, -50.0))
 
 
+@pytest.mark.episode
 def test_the_lidar_env_maps_along_a_trajectory_far_better_than_its_odometry():
     env = gym.make("SfW-ExploreLidar-v0", max_steps=400)
     drift = gym.make("SfW-ExploreDrift-v0", max_steps=400)
@@ -134,6 +139,7 @@ def test_a_weakly_constrained_registration_far_from_the_odometry_is_not_used(
     assert poses[-1, 0] == pytest.approx(expected, abs=1e-6)
 
 
+@pytest.mark.episode
 def test_the_recorded_keyframe_scans_lie_on_the_walls_seen_from_their_true_poses(drive):
     import shapely
 

@@ -26,6 +26,7 @@ def serrated(n: int, tmp_path) -> str:
     return str(path)
 
 
+@pytest.mark.episode
 def test_a_many_vertex_plan_keeps_its_shape_and_places_routers_clear_of_walls(tmp_path):
     path = serrated(6000, tmp_path)
     plan = load_floorplan(path)

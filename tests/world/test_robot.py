@@ -203,6 +203,7 @@ def test_full_speed_into_wall_head_on_stays_in_free_space_and_bumps():
     assert robot.pose.theta == pytest.approx(0.0, abs=1e-12)
 
 
+@pytest.mark.episode
 def test_full_speed_at_random_headings_into_box_walls():
     rng = np.random.default_rng(7)
     for theta in rng.uniform(-math.pi, math.pi, 20):
@@ -225,7 +226,7 @@ def test_random_driving_in_a_room_never_leaves_free_space():
     assert bumps > 0
 
 
-@pytest.mark.parametrize("thickness", [0.1, 0.05])
+@pytest.mark.parametrize("thickness", [0.1, pytest.param(0.05, marks=pytest.mark.episode)])
 def test_thin_wall_is_never_crossed(thickness):
     walls = thin_wall_room(thickness=thickness)
     rng = np.random.default_rng(11)
