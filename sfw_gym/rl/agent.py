@@ -50,6 +50,12 @@ class LearnedAgentSettings(AgentSettings):
         object.__setattr__(self, "path", str(self.path))
 
 
+def with_model_path(path: str | Path | None, params: dict[str, Any]) -> dict[str, Any]:
+    """A learned agent's parameters with the model ``path`` given positionally
+    (``PPOAgent("runs/mine")``) folded in."""
+    return params if path is None else {**params, "path": path}
+
+
 @dataclass(frozen=True)
 class MaskedPPOSettings(LearnedAgentSettings):
     """A MaskablePPO agent's parameters (:class:`PPOAgent`, :class:`RegionsPPOAgent`).
@@ -93,9 +99,7 @@ class PPOAgent(Agent):
     settings: MaskedPPOSettings
 
     def __init__(self, path: str | Path | None = None, **params: Any) -> None:
-        if path is not None:  # the model, positionally: PPOAgent("runs/mine")
-            params["path"] = path
-        super().__init__(**params)
+        super().__init__(**with_model_path(path, params))
         s = self.settings
         self.model, config = load_model(s.path, s.device, s.num_threads)
         goals = (config.get("env_kwargs") or {}).get("goals")
@@ -208,9 +212,7 @@ class RegionsPPOAgent(RegionAgent):
     settings: RegionsPPOSettings  # type: ignore[assignment]
 
     def __init__(self, path: str | Path | None = None, **params: Any) -> None:
-        if path is not None:  # the model, positionally: PPOAgent("runs/mine")
-            params["path"] = path
-        Agent.__init__(self, **params)
+        Agent.__init__(self, **with_model_path(path, params))
         s = self.settings
         self.model, config = load_model(s.path, s.device, s.num_threads)
         regions = (config.get("env_kwargs") or {}).get("regions")

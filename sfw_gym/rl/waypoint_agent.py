@@ -21,7 +21,7 @@ from sfw_gym.agents.base import Agent, RobotView
 from sfw_gym.core.data import DEFAULT_WAYPOINT_MODEL_DIR
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.navigation.waypoints import WaypointDriver, block_features
-from sfw_gym.rl.agent import LearnedAgentSettings
+from sfw_gym.rl.agent import LearnedAgentSettings, with_model_path
 from sfw_gym.rl.runs import find_model
 from sfw_gym.rl.training import wrapper_specs
 
@@ -78,9 +78,7 @@ class WaypointPPOAgent(Agent):
     settings: WaypointPPOSettings
 
     def __init__(self, path: str | Path | None = None, **params: Any) -> None:
-        if path is not None:  # the model, positionally: PPOAgent("runs/mine")
-            params["path"] = path
-        super().__init__(**params)
+        super().__init__(**with_model_path(path, params))
         path, device = self.settings.path, self.settings.device
         folder = Path(path).parent if Path(path).suffix == ".zip" else Path(path)
         config_path = folder / "config.yml"
