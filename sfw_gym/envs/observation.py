@@ -180,21 +180,22 @@ def _draw(
     of the belief centred on cell (cr, cc) (unknown outside the grid), in one pass."""
     m = src_r.shape[0]
     image = np.empty((3, m, m), np.uint8)
+    image[1] = trajectory
+    image[2] = routers
     for i in range(m):
+        row = belief[src_r[i]]
+        out = image[0, i]
+        padded = pad[i]
         for j in range(m):
-            image[0, i, j] = U8_UNKNOWN if pad[i, j] else belief[src_r[i], src_c[j]]
-            image[1, i, j] = trajectory[i, j]
-            image[2, i, j] = routers[i, j]
-    for i in range(max(r - 1, 0), min(r + 2, m)):
-        for j in range(max(c - 1, 0), min(c + 2, m)):
-            image[1, i, j] = ROBOT_U8
+            out[j] = U8_UNKNOWN if padded[j] else row[src_c[j]]
+    image[1, max(r - 1, 0) : r + 2, max(c - 1, 0) : c + 2] = ROBOT_U8
     rows, cols = belief.shape
     half = crop // 2
-    local = np.empty((1, crop, crop), np.uint8)
+    local = np.full((1, crop, crop), U8_UNKNOWN, np.uint8)
+    c0 = cc - half  # belief column of the crop's first column
+    j0, j1 = max(0, -c0), min(crop, cols - c0)  # the crop's columns inside the grid
     for i in range(crop):
         br = cr + i - half
-        for j in range(crop):
-            bc = cc + j - half
-            inside = 0 <= br < rows and 0 <= bc < cols
-            local[0, i, j] = belief[br, bc] if inside else U8_UNKNOWN
+        if 0 <= br < rows and j0 < j1:
+            local[0, i, j0:j1] = belief[br, c0 + j0 : c0 + j1]
     return image, local
