@@ -315,9 +315,10 @@ class SfWExploreEnv(gym.Env):
         s = self.scene
         assert s is not None
         true_pose = s.robot.pose
-        rssi, true_k = s.radio.measure_with_k(np.array(true_pose[:2]))
+        rssi, true_k = s.radio.measure_at(true_pose.x, true_pose.y)
         if s.background is not None:  # the fingerprint of the access points beyond the routers
-            self.fingerprint = s.background.measure(np.array(true_pose[:2])).astype(np.float64)
+            reading, _ = s.background.measure_at(true_pose.x, true_pose.y)
+            self.fingerprint = reading.astype(np.float64)
         if self.lidar is not None:
             self.lidar_ranges = self.lidar.scan(true_pose, self.np_random)
         entropy_before = self.mapper.entropy_bits

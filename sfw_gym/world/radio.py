@@ -343,12 +343,28 @@ class RadioModel:
     def measure_with_k(self, point: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """One reading at ``point`` and the true k of each router there (one wall traversal)."""
         rssi, k = self._model(self._points(point)[:1])
-        rssi = rssi[0]
+        return self._reading(rssi[0]), k[0]
+
+    def measure_at(self, x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`measure_with_k` at ``(x, y)`` (floats), without the array checks (the step's
+        call: the same reading, the same random draws)."""
+        if not (math.isfinite(x) and math.isfinite(y)):
+            raise ConfigError(f"points must be finite (got {x!r}, {y!r})")
+        pts = np.array(((x, y),))
+        rssi, k = _rssi(
+            self.floorplan.edges, self._edge_loss_db, self.routers, pts, self._params,
+            *self._shadow_args,
+        )  # fmt: skip
+        return self._reading(rssi[0]), k[0]
+
+    def _reading(self, rssi: np.ndarray) -> np.ndarray:
+        """Mean RSSI (R,) → one reading: temporal noise, rounded to whole dBm, ``NOT_HEARD_DBM``
+        below sensitivity."""
         if self.config.noise_sigma_db > 0:
             rssi += self.rng.normal(0.0, self.config.noise_sigma_db, rssi.shape)
         reading = np.rint(rssi).astype(np.int32)
         reading[reading < self.config.sensitivity_dbm] = NOT_HEARD_DBM
-        return reading, k[0]
+        return reading
 
 
 def validate_routers(floorplan: Floorplan, routers: np.ndarray) -> np.ndarray:

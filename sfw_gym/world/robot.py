@@ -60,6 +60,11 @@ _WALL_CATEGORY = 0b10  # walls carry every category (the default); the disc only
 _WALL_QUERY = pymunk.ShapeFilter(mask=_WALL_CATEGORY)
 # Extra distance at which a wall counts as within reach of the robot in the coming step.
 _REACH_MARGIN_M = 1e-3
+# How far beyond its reach the robot looks for walls, so that the clearance it finds answers the
+# next steps' "a wall within reach?" without asking pymunk again (see Robot._may_touch_wall).
+_CLEARANCE_LOOKAHEAD_M = 1.0
+# Rounding allowance of that answer: closer calls ask pymunk, so every answer is pymunk's own.
+_CLEARANCE_ROUNDING_M = 1e-9
 # The drive is kinematic and the walls static, so the mass only scales the solver's impulses.
 _ROBOT_MASS_KG = 5.0
 # Overlap that pymunk leaves uncorrected (its default, 0.1, assumes pixels, not metres).
@@ -320,6 +325,7 @@ class Robot:
         self._space.reindex_shapes_for_body(body)
         x, y = body.position
         self._xya = (x, y, body.angle)  # the body's state, read back once per step
+        self._clearance = (x, y, -math.inf)  # nothing known: the next step asks pymunk
         self._refresh_active_walls(x, y)
         self._odometry = (x, y, theta)
         self._bumped = False
@@ -477,11 +483,25 @@ class Robot:
         if active:
             self._space.add(*active.values())
         self._active_centre = (x, y)
+        self._clearance = (x, y, -math.inf)  # other walls now: ask pymunk again
 
     def _may_touch_wall(self, x: float, y: float, travel_m: float) -> bool:
-        """Whether a wall lies within ``travel_m`` (plus a margin) of the robot's disc."""
+        """Whether a wall lies within ``travel_m`` (plus a margin) of the robot's disc.
+
+        pymunk's answer, asked less often: a query reaches ``_CLEARANCE_LOOKAHEAD_M`` further and
+        keeps the nearest wall's distance (the clearance). A distance to a wall changes by at most
+        the distance moved, so while the clearance minus the distance moved since exceeds the
+        reach, no wall is within reach; closer calls ask pymunk again.
+        """
         reach = self._config.radius_m + travel_m + _REACH_MARGIN_M
-        return self._space.point_query_nearest((x, y), reach, _WALL_QUERY) is not None
+        qx, qy, clearance = self._clearance
+        if clearance - math.hypot(x - qx, y - qy) - _CLEARANCE_ROUNDING_M >= reach:
+            return False
+        look = reach + _CLEARANCE_LOOKAHEAD_M
+        nearest = self._space.point_query_nearest((x, y), look, _WALL_QUERY)
+        clearance = look if nearest is None else nearest.distance
+        self._clearance = (x, y, clearance)
+        return clearance < reach  # pymunk returns walls nearer than its maximum distance
 
     def _drive_by_callback(self, on: bool) -> None:
         """Switch the kinematic velocity callback on or off (off: pymunk keeps the velocity)."""

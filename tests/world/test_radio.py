@@ -116,6 +116,22 @@ def test_measure_is_integer_noisy_and_reports_not_heard(open_hall):
     assert far.measure(np.array([19.0, 5.0])).tolist() == [NOT_HEARD_DBM]
 
 
+def test_a_reading_at_floats_is_the_reading_at_a_point(two_rooms):
+    """``measure_at(x, y)`` (the env's step) = ``measure_with_k(point)``: the same readings,
+    walls and random draws, and the same error for a point that is no number."""
+    cfg = RadioConfig(noise_sigma_db=2.0)
+    routers = np.array([[1.0, 1.0], [8.0, 3.0]])
+    a = RadioModel(two_rooms, routers, cfg, np.random.default_rng(3))
+    b = RadioModel(two_rooms, routers, cfg, np.random.default_rng(3))
+    for x, y in np.random.default_rng(0).uniform((0.3, 0.3), (9.7, 4.7), (50, 2)).tolist():
+        reading, k = a.measure_at(x, y)
+        expected, expected_k = b.measure_with_k(np.array([x, y]))
+        np.testing.assert_array_equal(reading, expected)
+        np.testing.assert_array_equal(k, expected_k)
+    with pytest.raises(ConfigError, match="finite"):
+        a.measure_at(math.nan, 1.0)
+
+
 def test_routers_in_walls_or_outside_are_rejected(two_rooms):
     with pytest.raises(ConfigError, match=r"router 1 at \(5\.000, 2\.000\) is inside a wall"):
         RadioModel(two_rooms, [[1.0, 1.0], [5.0, 2.0]])
