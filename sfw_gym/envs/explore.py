@@ -263,13 +263,14 @@ class SfWExploreEnv(gym.Env):
         obs = self._sense_and_map(bumped=result.bumped)
         paid = self.config.reward
         reward = paid.reward_scale * self.last_gain_bits - paid.collision_penalty * result.bumped
-        coverage = self.tracker.coverage
+        metrics = self.tracker.metrics()
+        coverage = metrics["coverage"]
         for level in self.steps_to:
             if self.steps_to[level] < 0 and coverage >= level:
                 self.steps_to[level] = self.steps
         terminated = coverage >= paid.coverage_target
         truncated = not terminated and self.steps >= self.episode_max_steps
-        info = self._info(terminal=terminated or truncated)
+        info = self._info(terminal=terminated or truncated, metrics=metrics)
         if self.render_mode == "human":
             self.render()
         return obs, float(reward), terminated, truncated, info
@@ -407,16 +408,12 @@ class SfWExploreEnv(gym.Env):
         errors = self.pose_estimates.view[:, :2] - np.asarray(self.trajectory, np.float64)
         self._squared_pose_errors = float(np.sum(errors**2))
 
-    def _info(self, *, terminal: bool) -> dict[str, Any]:
+    def _info(self, *, terminal: bool, metrics: dict[str, float] | None = None) -> dict[str, Any]:
         s = self.scene
         assert s is not None
         t = self.tracker
         info: dict[str, Any] = {
-            "coverage": t.coverage,
-            "map_iou": t.map_iou,
-            "free_iou": t.free_iou,
-            "wall_precision": t.wall_precision,
-            "interior_wall_recall": t.interior_wall_recall,
+            **(metrics or t.metrics()),
             "k_accuracy": self.k_correct / self.k_total if self.k_total else 0.0,
             "path_length_m": self.path_length_m,
             "collisions": self.collisions,

@@ -126,6 +126,20 @@ class MapTracker:
                 self._counts,
             )
 
+    def metrics(self) -> dict[str, float]:
+        """``coverage``, ``map_iou``, ``free_iou``, ``wall_precision`` and
+        ``interior_wall_recall``: :mod:`sfw_gym.mapping.metrics`' figures of the current belief
+        (the paper's IoU for ``map_iou``), from the counts kept up to date."""
+        c, ratio = self._counts.tolist(), self._ratio
+        inter = c[_FREE_INTER]
+        return {
+            "coverage": ratio(c[_COVERED], self._n_truth_free),
+            "map_iou": ratio(c[_AGREE], c[_KNOWN_BOTH]),
+            "free_iou": ratio(inter, c[_N_EST_FREE] + self._n_truth_free - inter),
+            "wall_precision": ratio(c[_WALL_NEAR], c[_N_EST_WALL]),
+            "interior_wall_recall": ratio(c[_INTERIOR_FOUND], self._n_interior),
+        }
+
     @staticmethod
     def _ratio(num: int, den: int) -> float:
         # 0.0 while undefined (no wall estimated yet, …): info stays comparable and averageable;
@@ -136,32 +150,6 @@ class MapTracker:
     def known_fraction(self) -> float:
         """Fraction of the grid the belief classifies (free or wall): the robot's own view."""
         return self._counts[_N_KNOWN] / self._n_cells
-
-    @property
-    def coverage(self) -> float:
-        """`sfw_gym.mapping.metrics.coverage`."""
-        return self._ratio(self._counts[_COVERED], self._n_truth_free)
-
-    @property
-    def map_iou(self) -> float:
-        """`sfw_gym.mapping.metrics.map_iou` (the paper's)."""
-        return self._ratio(self._counts[_AGREE], self._counts[_KNOWN_BOTH])
-
-    @property
-    def free_iou(self) -> float:
-        """`sfw_gym.mapping.metrics.free_iou`."""
-        inter = self._counts[_FREE_INTER]
-        return self._ratio(inter, self._counts[_N_EST_FREE] + self._n_truth_free - inter)
-
-    @property
-    def wall_precision(self) -> float:
-        """`sfw_gym.mapping.metrics.wall_precision`."""
-        return self._ratio(self._counts[_WALL_NEAR], self._counts[_N_EST_WALL])
-
-    @property
-    def interior_wall_recall(self) -> float:
-        """`sfw_gym.mapping.metrics.interior_wall_recall`."""
-        return self._ratio(self._counts[_INTERIOR_FOUND], self._n_interior)
 
     def map_mse(self, est_u8: np.ndarray) -> float:
         """`sfw_gym.mapping.metrics.map_mse` (graded values: on the full map, at episode end)."""
