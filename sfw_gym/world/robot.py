@@ -315,6 +315,7 @@ class Robot:
         """
         x, y, theta = _parse_pose(pose, "pose")
         self._check_clearance(x, y)
+        self._unsynced: tuple[float, ...] | None = None  # the body is set here
         body = self._body
         body.position = (x, y)
         body.angle = theta
@@ -368,6 +369,7 @@ class Robot:
         # velocity is set here, with the part into walls that the robot touches removed.
         vx, vy = v * math.cos(a0), v * math.sin(a0)
         if self._bumped:
+            self._sync_body()
             vx, vy = self._slide_along_contacts(vx, vy)
         dt = cfg.substep_s
         substeps = cfg.physics_substeps
@@ -387,10 +389,9 @@ class Robot:
                 x += (vx + 0.0) * dt
                 y += (vy + 0.0) * dt
                 a += (w + 0.0) * dt
-            body.position = (x, y)
-            body.angle = a
-            body.velocity = (vx, vy)
-            body.angular_velocity = w
+            # pymunk's body is told only when it next matters (_sync_body): four attribute sets
+            # through pymunk's Python layer cost more than the substeps above
+            self._unsynced = (x, y, a, vx, vy, w)
             bumped = False
             x1, y1, a1 = x, y, a  # what the body now holds, exactly
         else:
@@ -398,6 +399,7 @@ class Robot:
             # warm-starts the next contact solve from them) and the disc's collision pairs in the
             # order they arose, and a pickle carries neither. Near walls every step starts from
             # what a fresh copy has, so a copy continues exactly.
+            self._sync_body()
             space.remove(self._disc)
             space.add(self._disc)
             body.linear_m_s = v
@@ -502,6 +504,22 @@ class Robot:
         clearance = look if nearest is None else nearest.distance
         self._clearance = (x, y, clearance)
         return clearance < reach  # pymunk returns walls nearer than its maximum distance
+
+    def _sync_body(self) -> None:
+        """Give pymunk's body the state the open-space shortcut left it (position, angle,
+        velocities): before anything reads the body or steps pymunk, and before a pickle."""
+        if self._unsynced is not None:
+            x, y, a, vx, vy, w = self._unsynced
+            body = self._body
+            body.position = (x, y)
+            body.angle = a
+            body.velocity = (vx, vy)
+            body.angular_velocity = w
+            self._unsynced = None
+
+    def __getstate__(self) -> dict[str, Any]:
+        self._sync_body()  # a copy carries the body as pymunk would hold it
+        return self.__dict__
 
     def _drive_by_callback(self, on: bool) -> None:
         """Switch the kinematic velocity callback on or off (off: pymunk keeps the velocity)."""
