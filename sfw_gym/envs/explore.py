@@ -345,8 +345,9 @@ class SfWExploreEnv(gym.Env):
         if self.slam is not None:  # a replay moved the entropy too: the gain is the difference
             self.last_gain_bits = entropy_before - self.mapper.entropy_bits
         self.obs_builder.mark_visited(pose[0], pose[1])
-        rssi_slots = np.full(self.config.explore.n_routers, float(NOT_HEARD_DBM))
-        rssi_slots[: len(rssi)] = rssi
+        # the observation has a slot per router of the env; an episode may use fewer
+        rssi_slots = rssi.tolist()
+        rssi_slots += [NOT_HEARD_DBM] * (self.config.explore.n_routers - len(rssi_slots))
         obs = self.obs_builder.build(
             self.mapper.occupancy_u8, rssi_slots, bumped, pose, self.tracker.known_fraction
         )

@@ -7,6 +7,7 @@ nothing is ground truth.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 
 import numpy as np
 from gymnasium import spaces
@@ -129,12 +130,13 @@ class ObservationBuilder:
     def build(
         self,
         belief_u8: np.ndarray,
-        rssi_dbm: np.ndarray,
+        rssi_dbm: Iterable[float],
         bumped: bool,
         odometry_pose: tuple[float, float, float],
         known_fraction: float,
     ) -> dict[str, np.ndarray]:
-        """The observation dict for the current belief and readings."""
+        """The observation dict for the current belief and readings (``rssi_dbm``: one per router
+        slot, dBm)."""
         x, y, theta = odometry_pose
         r, c = self.pixel_of(x, y)
         cr = min(max(int((y - self._oy) / self._res), 0), self._rows - 1)
@@ -146,7 +148,7 @@ class ObservationBuilder:
 
         slots = self.n_router_slots
         state = [0.0] * state_size(slots)  # a few numbers: plain floats, one conversion
-        for i, dbm in enumerate(rssi_dbm.tolist()):
+        for i, dbm in enumerate(rssi_dbm):
             if dbm > RSSI_FLOOR_DBM:
                 state[i] = min(max((dbm - RSSI_FLOOR_DBM) / RSSI_SPAN_DB, 0.0), 1.0)
                 state[slots + i] = 1.0
