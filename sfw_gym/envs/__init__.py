@@ -67,13 +67,24 @@ ENTRY_POINTS: dict[str, str] = {
 }
 
 
+#: The native vector env of each entry point (``gym.make_vec``'s default for every id).
+VECTOR_ENTRY_POINTS: dict[str, str] = {
+    ENTRY_POINT: "sfw_gym.envs.vector:explore_vector_env",
+    "sfw_gym.envs.goals:SfWGoalsEnv": "sfw_gym.envs.vector:goals_vector_env",
+    "sfw_gym.envs.regions:SfWRegionsEnv": "sfw_gym.envs.vector:regions_vector_env",
+    "sfw_gym.envs.localize:SfWLocalizeEnv": "sfw_gym.envs.vector:localize_vector_env",
+}
+
+
 def register_envs() -> None:
     """Register every id in ENV_IDS (idempotent)."""
     for env_id, kwargs in ENV_IDS.items():
         if env_id not in gym.registry:
+            entry_point = ENTRY_POINTS.get(env_id, ENTRY_POINT)
             gym.register(
                 id=env_id,
-                entry_point=ENTRY_POINTS.get(env_id, ENTRY_POINT),
+                entry_point=entry_point,
+                vector_entry_point=VECTOR_ENTRY_POINTS[entry_point],
                 kwargs=dict(kwargs),
                 max_episode_steps=None,
                 disable_env_checker=False,

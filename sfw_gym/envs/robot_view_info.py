@@ -16,10 +16,14 @@ class RobotViewInInfo(gym.Wrapper):
 
     Agents read it with ``agent.reset(info=info)`` and ``agent.act(obs, info)``::
 
-        envs = gym.make_vec("SfW-Explore-v0", num_envs=2, wrappers=[RobotViewInInfo])
+        envs = gym.make_vec(
+            "SfW-Explore-v0", num_envs=2, vectorization_mode="sync", wrappers=[RobotViewInInfo]
+        )
 
-    In the same process the view's arrays are read-only views of the env's state, valid until its
-    next ``step`` (copy what you keep); across processes they arrive as copies.
+    (Gymnasium applies ``wrappers`` to its ``sync`` and ``async`` vector envs only, not to a
+    ``vector_entry_point``.) In the same process the view's arrays are read-only views of the
+    env's state, valid until its next ``step`` (copy what you keep); across processes they
+    arrive as copies.
 
     Raises:
         ConfigError: If the env has no ``robot_view()`` (not an SfW env).

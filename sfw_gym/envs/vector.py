@@ -1,0 +1,209 @@
+"""A native vector env: N SfW envs stepped in this process, behind ``gym.make_vec``.
+
+``gym.make_vec("SfW-Explore-v0", num_envs=N)`` builds it (every id registers it as its
+``vector_entry_point``; ``vectorization_mode="sync"`` or ``"async"`` still give Gymnasium's).
+Each sub-env is the single env with its seed, bit for bit. Autoreset is Gymnasium 1.x's
+``NEXT_STEP``: the step after an episode ends resets that sub-env and returns its first
+observation with reward 0. There is no process boundary and no per-step deep copy, so N envs cost
+N single steps. The sub-envs are not batched into shared compiled calls yet.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space, create_empty_array, iterate
+from gymnasium.wrappers import TimeLimit
+
+from sfw_gym.core.errors import ConfigError, SfwGymError
+
+
+class SfWVectorEnv(VectorEnv):
+    """``num_envs`` envs of ``env_class`` (built with ``kwargs``), stepped in this process.
+
+    Args:
+        env_class: The single env's class, or its ``"module:Class"`` entry point.
+        num_envs: How many sub-envs.
+        max_episode_steps: Truncate each sub-env's episodes from outside (``TimeLimit``), as
+            ``gym.make`` does; None: the env's own step budget.
+        **kwargs: The single env's keyword arguments (``render_mode`` included).
+
+    Raises:
+        ConfigError: ``num_envs`` < 1, or a sub-env's bad action or option (naming the sub-env).
+    """
+
+    def __init__(
+        self,
+        env_class: type[gym.Env] | str,
+        num_envs: int = 1,
+        max_episode_steps: int | None = None,
+        **kwargs: Any,
+    ) -> None:
+        make: Any = env_class
+        if isinstance(env_class, str):
+            from gymnasium.envs.registration import load_env_creator
+
+            make = load_env_creator(env_class)
+        if not isinstance(num_envs, int | np.integer) or num_envs < 1:
+            raise ConfigError(f"num_envs must be an int >= 1, got {num_envs!r}")
+        self.num_envs = int(num_envs)
+        self.envs: list[gym.Env] = []
+        for _ in range(self.num_envs):
+            env = make(**kwargs)
+            self.envs.append(
+                env if max_episode_steps is None else TimeLimit(env, max_episode_steps)
+            )
+        first = self.envs[0]
+        self.metadata = {**first.metadata, "autoreset_mode": AutoresetMode.NEXT_STEP}
+        self.render_mode = first.render_mode
+        self.single_observation_space = first.observation_space
+        self.single_action_space = first.action_space
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self._observations: dict[str, np.ndarray] = self._empty_batch(np.zeros)
+        self._rewards = np.zeros(self.num_envs, np.float64)
+        self._terminations = np.zeros(self.num_envs, np.bool_)
+        self._truncations = np.zeros(self.num_envs, np.bool_)
+        self._autoreset = np.zeros(self.num_envs, np.bool_)
+
+    def reset(
+        self, *, seed: int | list[int | None] | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Any, dict[str, Any]]:
+        """Reset every sub-env (``options["reset_mask"]``: those marked), sub-env ``i`` with
+        ``seed + i`` (an int), ``seed[i]`` (a list) or its own generator (None)."""
+        if seed is None or isinstance(seed, int | np.integer):
+            seeds = [None if seed is None else int(seed) + i for i in range(self.num_envs)]
+        else:
+            seeds = list(seed)
+            if len(seeds) != self.num_envs:
+                raise ConfigError(f"seed must give {self.num_envs} seeds, got {len(seeds)}")
+        options = dict(options or {})
+        mask = np.asarray(options.pop("reset_mask", np.ones(self.num_envs, np.bool_)))
+        if mask.shape != (self.num_envs,) or mask.dtype != np.bool_:
+            raise ConfigError(f"reset_mask must be {self.num_envs} booleans, got {mask!r}")
+        # rows not reset keep their observation; a copy, so that a batch handed out stays as it was
+        self._observations = {key: rows.copy() for key, rows in self._observations.items()}
+        infos: list[dict[str, Any] | None] = [None] * self.num_envs
+        for i in np.flatnonzero(mask).tolist():
+            obs, infos[i] = self._sub(i, "reset", seed=seeds[i], options=options or None)
+            self._write(i, obs)
+        self._autoreset[mask] = False
+        return self._batch(), batch_infos(infos)
+
+    def step(self, actions: Any) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """Step every sub-env with its action; a sub-env whose episode ended last step is reset
+        instead (its action ignored, reward 0)."""
+        n = len(actions) if hasattr(actions, "__len__") else -1
+        if n != self.num_envs:
+            raise ConfigError(
+                f"actions must hold one action per sub-env ({self.num_envs}), got {n}"
+            )
+        self._observations = self._empty_batch()  # every row is written below
+        infos: list[dict[str, Any] | None] = [None] * self.num_envs
+        for i, action in enumerate(iterate(self.action_space, actions)):
+            if self._autoreset[i]:
+                obs, infos[i] = self._sub(i, "reset")
+                reward, terminated, truncated = 0.0, False, False
+            else:
+                obs, reward, terminated, truncated, infos[i] = self._sub(i, "step", action)
+            self._write(i, obs)
+            self._rewards[i] = reward
+            self._terminations[i] = terminated
+            self._truncations[i] = truncated
+        self._autoreset = self._terminations | self._truncations
+        return (
+            self._batch(),
+            self._rewards.copy(),
+            self._terminations.copy(),
+            self._truncations.copy(),
+            batch_infos(infos),
+        )
+
+    def render(self) -> tuple[Any, ...] | None:
+        """Each sub-env's frame (``render_mode="rgb_array"``)."""
+        return tuple(env.render() for env in self.envs)
+
+    def call(self, name: str, *args: Any, **kwargs: Any) -> tuple[Any, ...]:
+        """Each sub-env's ``name(*args, **kwargs)`` (or attribute ``name``)."""
+        out = []
+        for env in self.envs:
+            attr = env.get_wrapper_attr(name)
+            out.append(attr(*args, **kwargs) if callable(attr) else attr)
+        return tuple(out)
+
+    def get_attr(self, name: str) -> tuple[Any, ...]:
+        """Each sub-env's attribute ``name``."""
+        return tuple(env.get_wrapper_attr(name) for env in self.envs)
+
+    def set_attr(self, name: str, values: list[Any] | tuple[Any, ...] | Any) -> None:
+        """Set attribute ``name`` of each sub-env (one value each, or one for all)."""
+        if not isinstance(values, list | tuple):
+            values = [values] * self.num_envs
+        for env, value in zip(self.envs, values, strict=True):
+            env.set_wrapper_attr(name, value)
+
+    def close_extras(self, **kwargs: Any) -> None:
+        for env in self.envs:
+            env.close()
+
+    def _sub(self, i: int, method: str, *args: Any, **kwargs: Any) -> Any:
+        """Sub-env ``i``'s ``method``; its errors name the sub-env."""
+        try:
+            return getattr(self.envs[i], method)(*args, **kwargs)
+        except SfwGymError as exc:
+            raise type(exc)(f"sub-env {i}: {exc}") from None
+
+    def _empty_batch(self, fn: Any = np.empty) -> dict[str, np.ndarray]:
+        return create_empty_array(self.single_observation_space, self.num_envs, fn=fn)  # type: ignore[return-value]
+
+    def _write(self, i: int, obs: dict[str, np.ndarray]) -> None:
+        for key, value in obs.items():
+            self._observations[key][i] = value
+
+    def _batch(self) -> dict[str, np.ndarray]:
+        """The observations as the caller keeps them: never written again (a step writes a
+        new batch, a reset a copy)."""
+        return dict(self._observations)
+
+
+def batch_infos(infos: list[dict[str, Any] | None]) -> dict[str, Any]:
+    """The sub-envs' infos (None: that sub-env gave none) batched as Gymnasium's vector envs
+    batch them (``VectorEnv._add_info``, applied env by env): per key an array over the
+    sub-envs (typed by the first value; nested dicts recursively; anything else as objects)
+    and a ``_key`` mask of the sub-envs that have it. Key by key rather than env by env: the
+    same dict, without rebuilding a mask per key per sub-env."""
+    n = len(infos)
+    out: dict[str, Any] = {}
+    keys = dict.fromkeys(key for info in infos if info for key in info)
+    for key in keys:
+        have = [i for i, info in enumerate(infos) if info is not None and key in info]
+        first = infos[have[0]][key]  # type: ignore[index]
+        array: Any
+        if key != "final_obs" and isinstance(first, dict):
+            array = batch_infos([info[key] if i in have else None for i, info in enumerate(infos)])  # type: ignore[index]
+        else:
+            if key == "final_obs":
+                array = np.full(n, None, dtype=object)
+            elif type(first) in (int, float, bool) or isinstance(first, np.number):
+                array = np.zeros(n, dtype=type(first))
+            elif isinstance(first, np.ndarray):
+                array = np.zeros((n, *first.shape), dtype=first.dtype)
+            else:
+                array = np.full(n, None, dtype=object)
+            for i in have:
+                array[i] = infos[i][key]  # type: ignore[index]
+        mask = np.zeros(n, dtype=np.bool_)
+        mask[have] = True
+        out[key], out[f"_{key}"] = array, mask
+    return out
+
+
+#: ``vector_entry_point`` of each env class (see ``sfw_gym.envs.register_envs``).
+explore_vector_env = partial(SfWVectorEnv, "sfw_gym.envs.explore:SfWExploreEnv")
+goals_vector_env = partial(SfWVectorEnv, "sfw_gym.envs.goals:SfWGoalsEnv")
+regions_vector_env = partial(SfWVectorEnv, "sfw_gym.envs.regions:SfWRegionsEnv")
+localize_vector_env = partial(SfWVectorEnv, "sfw_gym.envs.localize:SfWLocalizeEnv")

@@ -1,0 +1,127 @@
+"""The native vector env (``gym.make_vec``'s default for every id): each sub-env is the single env
+with its seed, autoresets as Gymnasium 1.x's NEXT_STEP, and a bad action names its sub-env."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import sfw_gym  # noqa: F401  (registers the ids)
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.envs.vector import SfWVectorEnv
+
+SMALL = "SfW-ExploreSmall-v0"
+
+
+def single_run(env_id: str, seed: int, actions: list, **kwargs) -> list:
+    """The single env driven by ``actions`` with NEXT_STEP autoreset: per step (obs, reward,
+    terminated, truncated)."""
+    env = gym.make(env_id, **kwargs)
+    obs, _ = env.reset(seed=seed)
+    out, done = [], False
+    for action in actions:
+        if done:
+            obs, _ = env.reset()
+            reward, terminated, truncated = 0.0, False, False
+        else:
+            obs, reward, terminated, truncated, _ = env.step(action)
+        out.append((obs, reward, terminated, truncated))
+        done = terminated or truncated
+    return out
+
+
+@pytest.mark.parametrize(
+    ("env_id", "steps", "kwargs"),
+    [
+        (SMALL, 1000, {"max_steps": 120}),  # eight episodes a sub-env, wall contacts
+        pytest.param("SfW-ExploreGoals-v0", 30, {}, marks=pytest.mark.episode),
+    ],
+)
+def test_each_sub_env_is_the_single_env_with_its_seed_through_autoresets(env_id, steps, kwargs):
+    seeds = [4, 9, 13]
+    vec = gym.make_vec(env_id, num_envs=len(seeds), **kwargs)
+    assert isinstance(vec, SfWVectorEnv)
+    vec.action_space.seed(0)
+    actions = [vec.action_space.sample() for _ in range(steps)]
+    vec.reset(seed=seeds)
+    got = [vec.step(a) for a in actions]
+    ends = 0
+    for i, seed in enumerate(seeds):
+        expected = single_run(env_id, seed, [a[i] for a in actions], **kwargs)
+        for (obs, reward, terminated, truncated), step in zip(expected, got, strict=True):
+            for key in obs:
+                np.testing.assert_array_equal(step[0][key][i], obs[key])
+            assert (step[1][i], step[2][i], step[3][i]) == (reward, terminated, truncated)
+            ends += terminated or truncated
+    assert ends >= (len(seeds) if env_id == SMALL else 0)  # autoresets were compared
+    vec.close()
+
+
+def test_the_native_env_passes_the_vector_api_checks():
+    vec = gym.make_vec(SMALL, num_envs=2)
+    obs, info = vec.reset(seed=0)
+    assert vec.observation_space.contains(obs) and "coverage" in info
+    assert vec.metadata["autoreset_mode"] is gym.vector.AutoresetMode.NEXT_STEP
+    obs, rewards, terminated, truncated, info = vec.step(vec.action_space.sample())
+    assert vec.observation_space.contains(obs)
+    assert rewards.shape == terminated.shape == truncated.shape == (2,)
+    assert info["_coverage"].all()
+    again, _ = gym.make_vec(SMALL, num_envs=2).reset(seed=0)  # int seed: seed + i
+    first, _ = vec.reset(seed=0)
+    np.testing.assert_array_equal(again["map"], first["map"])
+    assert not np.array_equal(first["map"][0], first["map"][1])
+    assert gym.make_vec(SMALL, num_envs=2, vectorization_mode="sync").num_envs == 2
+
+
+def test_a_bad_action_or_option_names_its_sub_env():
+    vec = gym.make_vec(SMALL, num_envs=3)
+    vec.reset(seed=0)
+    actions = np.zeros((3, 2), np.float32)
+    actions[1, 0] = np.nan
+    with pytest.raises(ConfigError, match=r"^sub-env 1: action must be finite"):
+        vec.step(actions)
+    with pytest.raises(ConfigError, match=r"one action per sub-env \(3\), got 2"):
+        vec.step(actions[:2])
+    with pytest.raises(ConfigError, match=r"^sub-env 0: reset options: unknown key 'nope'"):
+        vec.reset(options={"nope": 1})
+    with pytest.raises(ConfigError, match="num_envs must be an int >= 1"):
+        gym.make_vec(SMALL, num_envs=0)
+
+
+def _same(a, b) -> None:
+    assert list(a) == list(b)  # keys and their order
+    for key in a:
+        if isinstance(a[key], dict):
+            _same(a[key], b[key])
+        else:
+            assert a[key].dtype == b[key].dtype and a[key].shape == b[key].shape, key
+            for x, y in zip(a[key], b[key], strict=True):
+                np.testing.assert_array_equal(x, y)
+
+
+def test_infos_are_batched_as_gymnasiums_vector_envs_batch_them():
+    from sfw_gym.envs.vector import batch_infos
+
+    env = gym.make(SMALL, max_steps=5)
+    _, first = env.reset(seed=0)
+    for _ in range(5):
+        *_, last = env.step(env.action_space.sample())
+    assert "summary" in last  # a nested dict, at the episode's end
+    infos = [first, None, last, {"other": "text", "final_obs": {"map": np.zeros(2)}}]
+    reference = gym.make_vec(SMALL, num_envs=len(infos))
+    expected: dict = {}
+    for i, info in enumerate(infos):
+        if info is not None:
+            expected = reference._add_info(expected, info, i)
+    _same(batch_infos(infos), expected)
+
+
+def test_a_batch_handed_out_is_never_written_again():
+    vec = gym.make_vec(SMALL, num_envs=2)
+    first, _ = vec.reset(seed=0)
+    kept = {key: rows.copy() for key, rows in first.items()}
+    vec.step(vec.action_space.sample())
+    vec.reset(seed=5, options={"reset_mask": np.array([True, False])})
+    for key in kept:
+        np.testing.assert_array_equal(first[key], kept[key])
