@@ -132,6 +132,22 @@ class TestEveryEnv:
             np.testing.assert_array_equal(a[4]["true_pose"], b[4]["true_pose"])
 
     @pytest.mark.parametrize("env_id", env_ids())
+    def test_the_native_vector_env_steps_each_sub_env_as_the_single_env(self, env_id):
+        vec = gym.make_vec(env_id, num_envs=2)
+        assert type(vec).__name__ == "SfWVectorEnv"
+        vec.action_space.seed(1)
+        actions = [vec.action_space.sample() for _ in range(3)]
+        vec.reset(seed=[3, 4])
+        batches = [vec.step(a)[0] for a in actions]
+        for i, seed in enumerate((3, 4)):
+            env = gym.make(env_id)
+            env.reset(seed=seed)
+            for action, batch in zip(actions, batches, strict=True):
+                obs = env.step(action[i])[0]
+                for key in obs:
+                    np.testing.assert_array_equal(batch[key][i], obs[key])
+
+    @pytest.mark.parametrize("env_id", env_ids())
     def test_observations_fit_multi_input_policy(self, env_id):
         env = gym.make(env_id)
         obs, _ = env.reset(seed=0)
