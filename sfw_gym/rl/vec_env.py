@@ -1,0 +1,99 @@
+"""stable-baselines3 on a Gymnasium vector env (by default the native SfW one): SB3's ``VecEnv``
+interface, with SB3's autoreset (a finished sub-env is reset at once, its last observation in
+``infos[i]["terminal_observation"]``)::
+
+    venv = SB3VecEnv(gym.make_vec("SfW-ExploreSmall-v0", num_envs=8))
+    PPO("MultiInputPolicy", venv).learn(10_000)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from stable_baselines3.common.vec_env.base_vec_env import VecEnv, VecEnvObs, VecEnvStepReturn
+
+
+def unbatch_infos(infos: dict[str, Any], n: int) -> list[dict[str, Any]]:
+    """A vector env's batched infos (arrays and ``_key`` masks) as one dict per sub-env."""
+    out: list[dict[str, Any]] = [{} for _ in range(n)]
+    for key, values in infos.items():
+        if key.startswith("_"):
+            continue
+        present = infos.get(f"_{key}", np.ones(n, np.bool_))
+        nested = unbatch_infos(values, n) if isinstance(values, dict) else None
+        for i in np.flatnonzero(present).tolist():
+            value = nested[i] if nested is not None else values[i]
+            out[i][key] = value.item() if isinstance(value, np.generic) else value
+    return out
+
+
+class SB3VecEnv(VecEnv):
+    """SB3's ``VecEnv`` over ``venv``, a Gymnasium vector env with ``NEXT_STEP`` autoreset
+    that takes ``options={"reset_mask": ...}`` (the native SfW env, ``gym.make_vec``'s default
+    for the SfW ids). With the same seed it gives what ``DummyVecEnv`` of single envs gives."""
+
+    def __init__(self, venv: gym.vector.VectorEnv) -> None:
+        self.venv: Any = venv  # its get_attr and envs: the native env's
+        super().__init__(venv.num_envs, venv.single_observation_space, venv.single_action_space)
+        self._actions: Any = None
+
+    def reset(self) -> VecEnvObs:
+        seeds = [None if s is None else int(s) for s in self._seeds]
+        options = self._options[0] if self._options and self._options[0] else None
+        obs, infos = self.venv.reset(seed=seeds, options=options)
+        self.reset_infos = unbatch_infos(infos, self.num_envs)
+        self._reset_seeds()
+        self._reset_options()
+        return obs
+
+    def step_async(self, actions: np.ndarray) -> None:
+        self._actions = actions
+
+    def step_wait(self) -> VecEnvStepReturn:
+        obs, rewards, terminated, truncated, batched = self.venv.step(self._actions)
+        dones = terminated | truncated
+        infos = unbatch_infos(batched, self.num_envs)
+        if dones.any():  # SB3 resets at once: the next observation is the new episode's first
+            for i in np.flatnonzero(dones).tolist():
+                infos[i]["terminal_observation"] = {key: rows[i] for key, rows in obs.items()}
+                infos[i]["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
+            first, reset_batched = self.venv.reset(options={"reset_mask": dones})
+            reset_infos = unbatch_infos(reset_batched, self.num_envs)
+            obs = {key: rows.copy() for key, rows in obs.items()}
+            for i in np.flatnonzero(dones).tolist():
+                for key in obs:
+                    obs[key][i] = first[key][i]
+                self.reset_infos[i] = reset_infos[i]
+        return obs, rewards.astype(np.float32), dones, infos
+
+    def close(self) -> None:
+        self.venv.close()
+
+    def get_attr(self, attr_name: str, indices: Any = None) -> list[Any]:
+        values = self.venv.get_attr(attr_name)
+        return [values[i] for i in self._get_indices(indices)]
+
+    def set_attr(self, attr_name: str, value: Any, indices: Any = None) -> None:
+        for i in self._get_indices(indices):
+            self.venv.envs[i].set_wrapper_attr(attr_name, value)
+
+    def env_method(
+        self, method_name: str, *method_args: Any, indices: Any = None, **method_kwargs: Any
+    ) -> list[Any]:
+        envs = self.venv.envs
+        return [
+            envs[i].get_wrapper_attr(method_name)(*method_args, **method_kwargs)
+            for i in self._get_indices(indices)
+        ]
+
+    def env_is_wrapped(self, wrapper_class: type, indices: Any = None) -> list[bool]:
+        from stable_baselines3.common import env_util
+
+        envs = self.venv.envs
+        return [env_util.is_wrapped(envs[i], wrapper_class) for i in self._get_indices(indices)]
+
+    def get_images(self) -> Sequence[np.ndarray | None]:
+        return list(self.venv.render() or ())
