@@ -5,6 +5,7 @@ included), and the figure is the median of the per-round ratios: a neighbour's l
 slows both sides of a round alike instead of skewing one whole measurement.
 
     python scripts/bench_env_ratio.py --env SfW-Explore-v0 --rounds 21 --steps 400
+    python scripts/bench_env_ratio.py --floorplan ../shared/floorplans/houseexpo/PLAN.json
 """
 
 from __future__ import annotations
@@ -33,8 +34,10 @@ def main() -> None:
     parser.add_argument("--env", default="SfW-Explore-v0")
     parser.add_argument("--rounds", type=int, default=21)
     parser.add_argument("--steps", type=int, default=400, help="env steps per round")
+    parser.add_argument("--floorplan", default=None, help="a plan file for every episode")
     args = parser.parse_args()
-    envs = {name: gym.make(name) for name in (args.env, "CartPole-v1")}
+    kwargs = {} if args.floorplan is None else {"floorplan": args.floorplan}
+    envs = {args.env: gym.make(args.env, **kwargs), "CartPole-v1": gym.make("CartPole-v1")}
     actions = {}
     for name, env in envs.items():
         env.reset(seed=0)
