@@ -15,14 +15,14 @@ CASES = [
     (
         "bug1.worst-goal",
         "sfw_gym/agents/frontier.py",
-        "if best is None or u > best[0]:",
-        "if best is None or u < best[0]:",
+        "best = int(ok[np.argmax(u)])",
+        "best = int(ok[np.argmin(u)])",
         "tests/agents/test_agent_behaviour.py",
     ),
     (
         "bug2a.ppo-waypoint-sample",
         "sfw_gym/rl/waypoint_agent.py",
-        "        if self.deterministic:",
+        "        if self.settings.deterministic:",
         "        if False:",
         "tests/rl/test_waypoint_agent.py",
     ),
@@ -43,8 +43,8 @@ CASES = [
     (
         "bug4.cli-floorplan",
         "sfw_gym/cli.py",
-        "except (ConfigError, FloorplanError) as exc:",
-        "except ConfigError as exc:",
+        "    except (SfwGymError, gym.error.Error) as exc:",
+        "    except gym.error.Error as exc:",
         "tests/cli/test_cli.py",
     ),
     (
@@ -64,21 +64,21 @@ CASES = [
     (
         "frontier.candidates",
         "sfw_gym/agents/frontier.py",
-        "            self.candidates.append((cell, u))\n",
-        "",
+        "zip(map(tuple, menu.target_rc[ok].tolist()), u.tolist(), strict=True)",
+        "zip(map(tuple, menu.target_rc[ok].tolist()), u[::-1].tolist(), strict=True)",
         "tests/agents/test_agent_behaviour.py -k chosen_goal",
     ),
     (
         "greedy.candidates",
         "sfw_gym/agents/greedy.py",
-        "zip(cells.tolist(), score.tolist(), strict=True)",
-        "zip(cells.tolist(), score[::-1].tolist(), strict=True)",
+        "zip(menu.target_rc.tolist(), score.tolist(), strict=True)",
+        "zip(menu.target_rc.tolist(), score[::-1].tolist(), strict=True)",
         "tests/agents/test_agent_behaviour.py tests/agents/test_agent_rules.py -k greedy",
     ),
     (
         "greedy.footprint-inside",
-        "sfw_gym/agents/greedy.py",
-        "& inside).sum(axis=1)",
+        "sfw_gym/navigation/candidates.py",
+        "* inside).sum(axis=1)",
         ").sum(axis=1)",
         "tests/agents/test_agent_rules.py -k expected_gain",
     ),
@@ -120,8 +120,8 @@ CASES = [
     (
         "cli.gym-error",
         "sfw_gym/cli.py",
-        "    except gym.error.Error as exc:",
-        "    except KeyError as exc:",
+        "    except (SfwGymError, gym.error.Error) as exc:",
+        "    except SfwGymError as exc:",
         "tests/cli/test_cli.py",
     ),
     (

@@ -83,8 +83,10 @@ class SfWVectorEnv(VectorEnv):
                 raise ConfigError(f"seed must give {self.num_envs} seeds, got {len(seeds)}")
         options = dict(options or {})
         mask = np.asarray(options.pop("reset_mask", np.ones(self.num_envs, np.bool_)))
-        if mask.shape != (self.num_envs,) or mask.dtype != np.bool_:
-            raise ConfigError(f"reset_mask must be {self.num_envs} booleans, got {mask!r}")
+        if mask.shape != (self.num_envs,) or mask.dtype != np.bool_ or not mask.any():
+            raise ConfigError(
+                f"reset_mask must be {self.num_envs} booleans, at least one True, got {mask!r}"
+            )
         # rows not reset keep their observation; a copy, so that a batch handed out stays as it was
         self._observations = {key: rows.copy() for key, rows in self._observations.items()}
         infos: list[dict[str, Any] | None] = [None] * self.num_envs
@@ -155,7 +157,7 @@ class SfWVectorEnv(VectorEnv):
         try:
             return getattr(self.envs[i], method)(*args, **kwargs)
         except SfwGymError as exc:
-            raise type(exc)(f"sub-env {i}: {exc}") from None
+            raise type(exc)(f"sub-env {i}: {exc}") from exc
 
     def _empty_batch(self, fn: Any = np.empty) -> dict[str, np.ndarray]:
         return create_empty_array(self.single_observation_space, self.num_envs, fn=fn)  # type: ignore[return-value]

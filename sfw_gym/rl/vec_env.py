@@ -41,13 +41,28 @@ class SB3VecEnv(VecEnv):
         self._actions: Any = None
 
     def reset(self) -> VecEnvObs:
+        """Reset every sub-env with its seed and options (``seed()``, ``set_options()``):
+        the sub-envs that share options in one call, through ``reset_mask``."""
         seeds = [None if s is None else int(s) for s in self._seeds]
-        options = self._options[0] if self._options and self._options[0] else None
-        obs, infos = self.venv.reset(seed=seeds, options=options)
-        self.reset_infos = unbatch_infos(infos, self.num_envs)
+        groups: list[tuple[dict[str, Any], list[int]]] = []
+        for i, options in enumerate(self._options):
+            group = next((g for g in groups if g[0] == (options or {})), None)
+            if group is None:
+                groups.append((dict(options or {}), [i]))
+            else:
+                group[1].append(i)
+        obs: dict[str, np.ndarray] = {}
+        self.reset_infos = [{} for _ in range(self.num_envs)]
+        for options, members in groups:
+            mask = np.zeros(self.num_envs, np.bool_)
+            mask[members] = True
+            obs, infos = self.venv.reset(seed=seeds, options={**options, "reset_mask": mask})
+            for i, info in enumerate(unbatch_infos(infos, self.num_envs)):
+                if mask[i]:
+                    self.reset_infos[i] = info
         self._reset_seeds()
         self._reset_options()
-        return obs
+        return obs  # the last call's batch holds every sub-env's first observation
 
     def step_async(self, actions: np.ndarray) -> None:
         self._actions = actions
@@ -56,10 +71,11 @@ class SB3VecEnv(VecEnv):
         obs, rewards, terminated, truncated, batched = self.venv.step(self._actions)
         dones = terminated | truncated
         infos = unbatch_infos(batched, self.num_envs)
+        for i, info in enumerate(infos):
+            info["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
         if dones.any():  # SB3 resets at once: the next observation is the new episode's first
             for i in np.flatnonzero(dones).tolist():
                 infos[i]["terminal_observation"] = {key: rows[i] for key, rows in obs.items()}
-                infos[i]["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
             first, reset_batched = self.venv.reset(options={"reset_mask": dones})
             reset_infos = unbatch_infos(reset_batched, self.num_envs)
             obs = {key: rows.copy() for key, rows in obs.items()}

@@ -120,8 +120,13 @@ def test_infos_are_batched_as_gymnasiums_vector_envs_batch_them():
 def test_a_batch_handed_out_is_never_written_again():
     vec = gym.make_vec(SMALL, num_envs=2)
     first, _ = vec.reset(seed=0)
-    kept = {key: rows.copy() for key, rows in first.items()}
+    stepped = vec.step(vec.action_space.sample())[0]
+    batches = [first, stepped]
+    kept = [{key: rows.copy() for key, rows in batch.items()} for batch in batches]
+    vec.reset(seed=5, options={"reset_mask": np.array([True, False])})  # row 1 stays as stepped
     vec.step(vec.action_space.sample())
-    vec.reset(seed=5, options={"reset_mask": np.array([True, False])})
-    for key in kept:
-        np.testing.assert_array_equal(first[key], kept[key])
+    for batch, copy in zip(batches, kept, strict=True):
+        for key in copy:
+            np.testing.assert_array_equal(batch[key], copy[key])
+    with pytest.raises(ConfigError, match="at least one True"):
+        vec.reset(options={"reset_mask": np.array([False, False])})

@@ -16,15 +16,16 @@ def test_the_adapter_gives_dummy_vec_envs_steps_resets_and_terminal_observations
 
     from sfw_gym.rl.vec_env import SB3VecEnv
 
-    n, kwargs = 3, {"max_steps": 40}
+    # a budget per m² of each plan: the sub-envs' episodes end at different steps
+    n, kwargs = 3, {"steps_per_m2": 1.0, "max_steps": 300}
     ours = SB3VecEnv(gym.make_vec(SMALL, num_envs=n, **kwargs))
     theirs = DummyVecEnv([lambda: gym.make(SMALL, **kwargs)] * n)
     for venv in (ours, theirs):
         venv.seed(7)
     a, b = ours.reset(), theirs.reset()
     rng = np.random.default_rng(0)
-    dones = 0
-    for _ in range(100):
+    dones, partial = 0, 0
+    for _ in range(150):
         for key in b:
             np.testing.assert_array_equal(a[key], b[key])
         actions = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
@@ -34,16 +35,35 @@ def test_the_adapter_gives_dummy_vec_envs_steps_resets_and_terminal_observations
         b, rb, db, ib = theirs.step_wait()
         np.testing.assert_array_equal(ra, rb)
         np.testing.assert_array_equal(da, db)
-        for x, y in zip(ia, ib, strict=True):
+        partial += 0 < db.sum() < n
+        for x, y, rx, ry in zip(ia, ib, ours.reset_infos, theirs.reset_infos, strict=True):
             assert x["coverage"] == y["coverage"] and x["floorplan"] == y["floorplan"]
+            assert x["TimeLimit.truncated"] == y["TimeLimit.truncated"]
+            assert rx.get("floorplan") == ry.get("floorplan")
             if "terminal_observation" in y:
                 dones += 1
-                assert x["TimeLimit.truncated"] == y["TimeLimit.truncated"]
                 for key in y["terminal_observation"]:
                     np.testing.assert_array_equal(
                         x["terminal_observation"][key], y["terminal_observation"][key]
                     )
-    assert dones >= n  # the resets were compared
+    assert dones >= n and partial  # resets were compared, some of one sub-env alone
+
+
+def test_each_sub_env_is_reset_with_its_own_options():
+    from stable_baselines3.common.vec_env import DummyVecEnv
+
+    from sfw_gym.rl.vec_env import SB3VecEnv
+
+    ours = SB3VecEnv(gym.make_vec(SMALL, num_envs=3))
+    theirs = DummyVecEnv([lambda: gym.make(SMALL)] * 3)
+    for venv in (ours, theirs):
+        venv.seed(2)
+        venv.set_options([{"routers": 1}, {}, {"routers": 1}])
+    a, b = ours.reset(), theirs.reset()
+    for key in b:
+        np.testing.assert_array_equal(a[key], b[key])
+    heard = a["state"][:, 3]  # the second router's heard flag: no second router with one
+    assert heard[0] == heard[2] == 0.0
 
 
 @pytest.mark.episode
