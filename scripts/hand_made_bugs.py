@@ -76,11 +76,11 @@ CASES = [
         "tests/agents/test_agent_behaviour.py tests/agents/test_agent_rules.py -k greedy",
     ),
     (
-        "greedy.footprint-inside",
+        "candidates.unknown-area-inside",
         "sfw_gym/navigation/candidates.py",
         "* inside).sum(axis=1)",
         ").sum(axis=1)",
-        "tests/agents/test_agent_rules.py -k expected_gain",
+        "tests/navigation/test_candidates.py -k unknown_area",
     ),
     (
         "driver.discrete-forward",

@@ -40,6 +40,22 @@ def corridor(free_cols: int = 33, length: int = 60) -> np.ndarray:
     return b
 
 
+def test_the_unknown_area_counts_only_the_cells_inside_the_grid():
+    from sfw_gym.mapping.grid import belief_classes
+    from sfw_gym.navigation.planning import disk_offsets
+
+    view = view_of(corridor(free_cols=33, length=38), xy=(0.25, 0.65))  # the map ends at col 37
+    menu = candidate_goals(view, max_candidates=8)
+    i = menu.of("frontier")[0]
+    offsets = disk_offsets(CandidateSettings().near_radius_m / RES)
+    rows, cols = menu.target_rc[i, 0] + offsets[:, 0], menu.target_rc[i, 1] + offsets[:, 1]
+    inside = (rows >= 0) & (rows < 14) & (cols >= 0) & (cols < 38)
+    assert not inside.all()  # the 1 m disk reaches past the grid's edge
+    unknown = belief_classes(view.belief_u8)[2]
+    expected = unknown[rows[inside], cols[inside]].sum() * RES**2
+    assert menu.feature("unknown_area_m2")[i] == pytest.approx(expected)
+
+
 def test_a_goal_down_a_corridor_costs_its_length_in_metres():
     view = view_of(corridor(), xy=(0.25, 0.65))  # column 2, the corridor's middle row 6
     menu = candidate_goals(view, max_candidates=8)
