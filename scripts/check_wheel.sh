@@ -34,9 +34,9 @@ PY
 
 "$py" -m pip install --quiet torch==2.13.0  # the CPU build (an unpinned torch pulls CUDA)
 "$py" -m pip install --quiet "$wheel[rl]"
-"$py" -c "from sfw_gym.rl import WaypointPPOAgent; a = WaypointPPOAgent(); print('WaypointPPOAgent() loads', a.path)"
-"$py" -c "from sfw_gym.rl import PPOAgent; a = PPOAgent(); print('PPOAgent() loads', a.path)"
-"$py" -c "from sfw_gym.rl import RegionsPPOAgent; a = RegionsPPOAgent(); print('RegionsPPOAgent() loads', a.path)"
+"$py" -c "from sfw_gym.rl import WaypointPPOAgent; a = WaypointPPOAgent(); print('WaypointPPOAgent() loads', a.settings.path)"
+"$py" -c "from sfw_gym.rl import PPOAgent; a = PPOAgent(); print('PPOAgent() loads', a.settings.path)"
+"$py" -c "from sfw_gym.rl import RegionsPPOAgent; a = RegionsPPOAgent(); print('RegionsPPOAgent() loads', a.settings.path)"
 "$work/venv/bin/sfw-gym" demo --episodes 1 --workers 1 --out "$work/report" --no-progress | tail -3
 "$work/venv/bin/sfw-gym" train ppo --env SfW-ExploreSmall-v0 --timesteps 256 --out "$work/run" \
     --no-progress | tail -2
