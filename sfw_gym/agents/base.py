@@ -24,6 +24,7 @@ what the env returns: wrap it in :class:`~sfw_gym.envs.robot_view_info.RobotView
 
 from __future__ import annotations
 
+import inspect
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -236,8 +237,19 @@ class Agent(ABC):
         return self._to_action(linear, angular)
 
     def params(self) -> dict[str, Any]:
-        """The parameters (for logs and result files): :attr:`settings` as a dict."""
-        return self.settings.to_dict()
+        """The parameters (for logs and result files): :attr:`settings` as a dict, plus the
+        constructor parameters of an agent written with its own ``__init__`` instead of a
+        settings class (as agents were before issue 32), read from its attributes."""
+        out = self.settings.to_dict()
+        for klass in type(self).__mro__:
+            init = klass.__dict__.get("__init__")
+            if init is None or klass is Agent:
+                continue
+            for p in inspect.signature(init).parameters.values():
+                plain = p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
+                if plain and p.name != "self" and p.name not in out and hasattr(self, p.name):
+                    out[p.name] = getattr(self, p.name)
+        return out
 
     # -- for subclasses -----------------------------------------------------------------------
     def _on_reset(self, view: RobotView) -> None:  # noqa: B027 (optional hook)

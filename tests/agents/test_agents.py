@@ -492,3 +492,19 @@ def test_an_old_agent_name_warns_and_builds_the_agent_it_names_now(old, new):
     with pytest.warns(FutureWarning, match=f"agent name {old!r} is deprecated: use {new!r}"):
         assert agent_class(old) is agent_class(new)
     assert known_agent(old) and not known_agent("ppo-nonsense")
+
+
+def test_params_hold_a_settings_class_and_an_own_constructors_parameters():
+    class OwnInit(RandomAgent):  # an agent written as before issue 32, with its own __init__
+        name = "own-init"
+
+        def __init__(self, turn_steps: int = 8, **params) -> None:
+            super().__init__(**params)
+            self.turn_steps = turn_steps
+
+    assert OwnInit(turn_steps=3, hold_steps=2).params() == {
+        "max_steps": None,
+        "hold_steps": 2,
+        "turn_steps": 3,
+    }
+    assert RandomAgent(hold_steps=4).params() == {"max_steps": None, "hold_steps": 4}
