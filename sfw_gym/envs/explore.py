@@ -333,11 +333,12 @@ class SfWExploreEnv(gym.Env):
         if self.map_history is not None:
             self.map_history.record(len(self.trajectory) - 1, self.mapper, bumped)
         updated, self.last_gain_bits = self._map_at(pose, rssi, bumped)
+        readings = rssi.tolist()  # dBm per router, as plain numbers
         if updated:
             # k = K means "K or more walls" (sfw_gym.mapping.metrics.k_value_accuracy with max_k)
             max_k = self.config.mapper.max_k
             for dbm, est, true in zip(
-                rssi.tolist(), self.mapper.last_k.tolist(), true_k.tolist(), strict=True
+                readings, self.mapper.last_k.tolist(), true_k.tolist(), strict=True
             ):
                 if dbm > NOT_HEARD_DBM and est >= 0:  # a few routers: plain Python is quickest
                     self.k_total += 1
@@ -346,8 +347,7 @@ class SfWExploreEnv(gym.Env):
             self.last_gain_bits = entropy_before - self.mapper.entropy_bits
         self.obs_builder.mark_visited(pose[0], pose[1])
         # the observation has a slot per router of the env; an episode may use fewer
-        rssi_slots = rssi.tolist()
-        rssi_slots += [NOT_HEARD_DBM] * (self.config.explore.n_routers - len(rssi_slots))
+        rssi_slots = readings + [NOT_HEARD_DBM] * (self.config.explore.n_routers - len(readings))
         obs = self.obs_builder.build(
             self.mapper.occupancy_u8, rssi_slots, bumped, pose, self.tracker.known_fraction
         )

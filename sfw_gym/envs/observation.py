@@ -96,7 +96,6 @@ class ObservationBuilder:
         src_c = np.floor((np.arange(map_px) - pad_c + 0.5) * self.cells_per_px).astype(np.int64)
         valid = ((src_r >= 0) & (src_r < rows))[:, None] & ((src_c >= 0) & (src_c < cols))[None, :]
         self._src_r, self._src_c = np.clip(src_r, 0, rows - 1), np.clip(src_c, 0, cols - 1)
-        self._flat_index = self._src_r[:, None] * cols + self._src_c[None, :]
         self._pad = ~valid
         self._pad_r, self._pad_c = pad_r, pad_c
         self._trajectory = np.zeros((map_px, map_px), np.uint8)
@@ -114,7 +113,7 @@ class ObservationBuilder:
 
     def image_of(self, grid_u8: np.ndarray) -> np.ndarray:
         """A ``(rows, cols)`` uint8 grid sampled onto the map image (padding reads unknown)."""
-        image = grid_u8.ravel().take(self._flat_index)
+        image = grid_u8[np.ix_(self._src_r, self._src_c)]
         image[self._pad] = U8_UNKNOWN
         return image
 

@@ -342,12 +342,12 @@ class RadioModel:
 
     def measure_with_k(self, point: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """One reading at ``point`` and the true k of each router there (one wall traversal)."""
-        rssi, k = self._model(self._points(point)[:1])
-        return self._reading(rssi[0]), k[0]
+        x, y = self._points(point)[0].tolist()
+        return self.measure_at(x, y)
 
     def measure_at(self, x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`measure_with_k` at ``(x, y)`` (floats), without the array checks (the step's
-        call: the same reading, the same random draws)."""
+        """:meth:`measure_with_k` at ``(x, y)`` (floats), without the array checks: the env's
+        step reads the radio this way."""
         if not (math.isfinite(x) and math.isfinite(y)):
             raise ConfigError(f"points must be finite (got {x!r}, {y!r})")
         pts = np.array(((x, y),))
