@@ -507,7 +507,8 @@ class Robot:
 
     def _sync_body(self) -> None:
         """Give pymunk's body the state the open-space shortcut left it (position, angle,
-        velocities): before anything reads the body or steps pymunk, and before a pickle."""
+        velocities): before anything reads the body or steps pymunk. A copy carries the pending
+        state with it and syncs when it needs to."""
         if self._unsynced is not None:
             x, y, a, vx, vy, w = self._unsynced
             body = self._body
@@ -516,10 +517,6 @@ class Robot:
             body.velocity = (vx, vy)
             body.angular_velocity = w
             self._unsynced = None
-
-    def __getstate__(self) -> dict[str, Any]:
-        self._sync_body()  # a copy carries the body as pymunk would hold it
-        return self.__dict__
 
     def _drive_by_callback(self, on: bool) -> None:
         """Switch the kinematic velocity callback on or off (off: pymunk keeps the velocity)."""

@@ -345,7 +345,7 @@ def test_act_before_reset_and_bad_parameters_raise():
         RandomAgent(hold_steps=0)
     with pytest.raises(ConfigError, match="unknown agent"):
         make_agent("nope")
-    with pytest.raises(ConfigError, match="agent 'frontier'"):
+    with pytest.raises(ConfigError, match="agent 'frontier': unknown key 'nope'"):
         make_agent("frontier", nope=1)
 
 

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import sfw_gym  # noqa: F401
+from sfw_gym.core.constants import NOT_HEARD_DBM
 from sfw_gym.mapping import metrics
 from sfw_gym.world import generate_floorplan
 from tests.conftest import two_rooms_polygon
@@ -24,8 +25,8 @@ def drive(env, n: int, seed: int = 0):
 
 def test_incremental_info_metrics_equal_the_full_map_metrics():
     env = gym.make("SfW-Explore-v0")
-    env.reset(seed=4)
-    *_, info = drive(env, 400)
+    env.reset(seed=1)
+    *_, info = drive(env, 800)
     u = env.unwrapped
     full = metrics.evaluate_map(u.mapper.occupancy_u8, u.scene.truth_u8)
     assert info["coverage"] == pytest.approx(full["coverage"])
@@ -34,6 +35,33 @@ def test_incremental_info_metrics_equal_the_full_map_metrics():
     assert info["wall_precision"] == pytest.approx(np.nan_to_num(full["wall_precision"]))
     assert info["interior_wall_recall"] == pytest.approx(full["interior_wall_recall"])
     assert 0 < info["coverage"] <= 1 and info["path_length_m"] > 0
+    assert 0 < info["wall_precision"] < 1 and info["interior_wall_recall"] > 0  # walls found
+
+
+def test_k_accuracy_reads_the_largest_k_as_that_many_walls_or_more():
+    """With max_k = 1 the truth often exceeds it: an estimate of 1 is right there (Eq. 8 with
+    max_k, as sfw_gym.mapping.metrics.k_value_accuracy computes it)."""
+    env = gym.make("SfW-Explore-v0", mapper={"max_k": 1}, pose_source="true")
+    _, info = env.reset(seed=0)  # up to 3 walls from a router within 300 random steps
+    env.action_space.seed(0)
+    u, est, true = env.unwrapped, [], []
+    for step in range(301):  # the reading at reset, then one per step
+        if step:
+            _, _, _, _, info = env.step(env.action_space.sample())
+        heard = u.rssi_history.view[-1] > NOT_HEARD_DBM
+        est.append(np.where(heard, u.mapper.last_k, -1))
+        true.append(u.scene.radio.true_k(info["true_pose"][:2])[0])
+    est, true = np.array(est), np.array(true)
+    assert (true[est >= 0] > 1).any()  # the cap mattered
+    assert info["k_accuracy"] == pytest.approx(metrics.k_value_accuracy(est, true, max_k=1))
+
+
+def test_router_slots_an_episode_does_not_use_read_not_heard():
+    env = gym.make("SfW-Explore-v0", n_routers=2)
+    obs, _ = env.reset(seed=0, options={"routers": 1})
+    obs, *_ = env.step(env.action_space.sample())
+    assert obs["state"][1] == 0.0 and obs["state"][3] == 0.0  # the second slot: RSSI, heard
+    assert obs["state"][2] == 1.0  # the one router is heard
 
 
 def test_reset_options(tmp_path):
@@ -116,3 +144,19 @@ def test_mapper_options_reach_the_mapper():
     assert cfg.k_estimator == "kmeans" and cfg.router_policy == "all" and cfg.k0_level_dbm is None
     default = gym.make("SfW-Explore-v0").unwrapped.config.mapper
     assert default.k0_level_dbm == pytest.approx(20.0 - 40.18, abs=0.01)  # P_tx − PL(1 m)
+
+
+def test_the_local_crop_reads_unknown_outside_the_grid_at_every_edge():
+    from sfw_gym.core.constants import U8_UNKNOWN
+    from sfw_gym.envs.observation import ObservationBuilder
+    from sfw_gym.mapping import GridSpec
+
+    belief = np.random.default_rng(0).integers(0, 256, (30, 50)).astype(np.uint8)
+    grid = GridSpec((0.0, 0.0), 0.1, belief.shape)
+    builder = ObservationBuilder(grid, np.array([[1.0, 1.0]]), 1, 36, 36)
+    half = 18
+    padded = np.pad(belief, half, constant_values=U8_UNKNOWN)  # the crop's definition
+    for x, y in [(0.05, 0.05), (4.95, 0.05), (0.05, 2.95), (4.95, 2.95), (2.5, 1.5)]:
+        local = builder.build(belief, [-60.0], False, (x, y, 0.0), 0.5)["local"][0]
+        r, c = int(y / 0.1), int(x / 0.1)
+        np.testing.assert_array_equal(local, padded[r : r + 36, c : c + 36])

@@ -27,6 +27,13 @@ def test_the_localization_study_writes_every_table_and_figure(tmp_path, capsys):
     assert (out / "error_over_time.png").stat().st_size > 10_000
 
 
+def test_json_is_the_old_name_of_out(tmp_path):
+    from sfw_gym.cli import build_parser
+
+    args = build_parser().parse_args(["localize", "--json", str(tmp_path / "study")])
+    assert args.out == str(tmp_path / "study")
+
+
 def test_an_output_path_that_is_a_file_is_refused(tmp_path, capsys):
     (tmp_path / "f").write_text("x")
     for option in ("--out", "--json"):  # --json: the old name, an alias
