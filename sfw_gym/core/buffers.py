@@ -24,11 +24,19 @@ class AppendOnlyArray:
     def append(self, row: np.ndarray | tuple[float, ...]) -> None:
         """Add one row (anything that broadcasts to ``(width,)``)."""
         if self._n == len(self._data):
-            grown = np.empty((2 * len(self._data), self._data.shape[1]), self._data.dtype)
-            grown[: self._n] = self._data
-            self._data = grown
+            self.reserve(self._n + 1)
         self._data[self._n] = row
         self._n += 1
+
+    def reserve(self, rows: int) -> None:
+        """Make room for ``rows`` rows in all (doubling the capacity as often as needed)."""
+        capacity = len(self._data)
+        if rows > capacity:
+            while capacity < rows:
+                capacity *= 2
+            grown = np.empty((capacity, self._data.shape[1]), self._data.dtype)
+            grown[: self._n] = self._data[: self._n]
+            self._data = grown
 
     def __len__(self) -> int:
         return self._n

@@ -232,7 +232,7 @@ class SfWExploreEnv(gym.Env):
         self.rssi_history = AppendOnlyArray(len(s.radio.routers), np.int32)
         self._routers_view = np.array(s.radio.routers, np.float64)
         self._routers_view.flags.writeable = False
-        self.trajectory: list[tuple[float, float]] = []
+        self.true_path = AppendOnlyArray(2, np.float64)  # the true positions, one per reading
         self.odometry_trajectory = AppendOnlyArray(2, np.float64)  # of the pose estimate
         self.pose_estimates = AppendOnlyArray(3, np.float64)
         self.pose_estimate = s.robot.odometry_pose
@@ -326,12 +326,12 @@ class SfWExploreEnv(gym.Env):
         pose = self._estimate_pose(true_pose)
         self.pose_estimate = pose
         self.rssi_history.append(rssi)
-        self.trajectory.append((true_pose.x, true_pose.y))
+        self.true_path.append((true_pose.x, true_pose.y))
         self.odometry_trajectory.append(pose[:2])
         self.pose_estimates.append(pose)
         self._squared_pose_errors += (pose[0] - true_pose.x) ** 2 + (pose[1] - true_pose.y) ** 2
         if self.map_history is not None:
-            self.map_history.record(len(self.trajectory) - 1, self.mapper, bumped)
+            self.map_history.record(len(self.true_path) - 1, self.mapper, bumped)
         updated, self.last_gain_bits = self._map_at(pose, rssi, bumped)
         readings = rssi.tolist()  # dBm per router, as plain numbers
         if updated:
@@ -406,7 +406,7 @@ class SfWExploreEnv(gym.Env):
             self.pose_estimates.append((x, y, theta))
             self.odometry_trajectory.append((x, y))
             self.obs_builder.mark_visited(x, y)
-        errors = self.pose_estimates.view[:, :2] - np.asarray(self.trajectory, np.float64)
+        errors = self.pose_estimates.view[:, :2] - self.true_path.view
         self._squared_pose_errors = float(np.sum(errors**2))
 
     def _info(self, *, terminal: bool, metrics: dict[str, float] | None = None) -> dict[str, Any]:
@@ -422,7 +422,7 @@ class SfWExploreEnv(gym.Env):
             "odometry_pose": np.array(s.robot.odometry_pose, np.float64),
             "pose_estimate": np.array(self.pose_estimate, np.float64),  # where it maps
             "pose_error_m": math.dist(self.pose_estimate[:2], s.robot.pose[:2]),
-            "ate_m": math.sqrt(self._squared_pose_errors / len(self.trajectory)),
+            "ate_m": math.sqrt(self._squared_pose_errors / len(self.true_path)),
             "entropy_bits": self.mapper.entropy_bits,
             "info_gain_bits": self.last_gain_bits,
             "steps_to_coverage_50": self.steps_to[0.5],
@@ -442,6 +442,11 @@ class SfWExploreEnv(gym.Env):
                 "map_mse": t.map_mse(self.mapper.occupancy_u8),
             }
         return info
+
+    @property
+    def trajectory(self) -> np.ndarray:
+        """The true positions so far, ``(n, 2)``, one per reading (a read-only view)."""
+        return self.true_path.view
 
     # ------------------------------------------------------------------------------ robot's view
     def robot_view(self) -> RobotView:
@@ -481,7 +486,7 @@ class SfWExploreEnv(gym.Env):
             truth_u8=s.truth_u8,
             grid=self.grid,
             radio=s.radio,
-            trajectory=np.asarray(self.trajectory, np.float64).reshape(-1, 2),
+            trajectory=self.true_path.view.copy(),
         )
 
     # ------------------------------------------------------------------------------ rendering

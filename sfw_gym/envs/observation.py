@@ -176,11 +176,34 @@ def _draw(
     cc: int,
     crop: int,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The ``map`` image (the belief sampled at ``src_r × src_c``, unknown on ``pad``; the
+    """:func:`draw_into` new arrays: the ``map`` image and the ``local`` crop."""
+    m = src_r.shape[0]
+    image = np.empty((3, m, m), np.uint8)
+    local = np.empty((1, crop, crop), np.uint8)
+    draw_into(belief, src_r, src_c, pad, trajectory, routers, r, c, cr, cc, crop, image, local)
+    return image, local
+
+
+@njit(cache=True)
+def draw_into(
+    belief: np.ndarray,
+    src_r: np.ndarray,
+    src_c: np.ndarray,
+    pad: np.ndarray,
+    trajectory: np.ndarray,
+    routers: np.ndarray,
+    r: int,
+    c: int,
+    cr: int,
+    cc: int,
+    crop: int,
+    image: np.ndarray,
+    local: np.ndarray,
+) -> None:
+    """Write the ``map`` image (the belief sampled at ``src_r × src_c``, unknown on ``pad``; the
     trajectory with the robot's 3 × 3 square at pixel (r, c); the routers) and the ``local`` crop
     of the belief centred on cell (cr, cc) (unknown outside the grid), in one pass."""
     m = src_r.shape[0]
-    image = np.empty((3, m, m), np.uint8)
     image[1] = trajectory
     image[2] = routers
     for i in range(m):
@@ -192,11 +215,10 @@ def _draw(
     image[1, max(r - 1, 0) : r + 2, max(c - 1, 0) : c + 2] = ROBOT_U8
     rows, cols = belief.shape
     half = crop // 2
-    local = np.full((1, crop, crop), U8_UNKNOWN, np.uint8)
+    local[:] = U8_UNKNOWN
     c0 = cc - half  # belief column of the crop's first column
     j0, j1 = max(0, -c0), min(crop, cols - c0)  # the crop's columns inside the grid
     for i in range(crop):
         br = cr + i - half
         if 0 <= br < rows and j0 < j1:
             local[0, i, j0:j1] = belief[br, c0 + j0 : c0 + j1]
-    return image, local

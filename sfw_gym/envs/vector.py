@@ -4,8 +4,12 @@
 ``vector_entry_point``; ``vectorization_mode="sync"`` or ``"async"`` still give Gymnasium's).
 Each sub-env is the single env with its seed, bit for bit. Autoreset is Gymnasium 1.x's
 ``NEXT_STEP``: the step after an episode ends resets that sub-env and returns its first
-observation with reward 0. There is no process boundary and no per-step deep copy, so N envs cost
-N single steps. The sub-envs are not batched into shared compiled calls yet.
+observation with reward 0. There is no process boundary and no per-step deep copy.
+
+Sub-envs of `SfWExploreEnv` (odometry or true poses, no LiDAR, no background access points) step
+together through `sfw_gym.envs.batch_step`: the robots' open-space motion in one compiled call,
+the readings, map updates, metrics and observations of all of them in another. The rest step one
+by one in Python, as do resets, a robot next to a wall (pymunk) and an episode's last step.
 """
 
 from __future__ import annotations
@@ -19,7 +23,10 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, create_empty_array, iterate
 from gymnasium.wrappers import TimeLimit
 
+from sfw_gym.core.constants import DISCRETE_ACTIONS
 from sfw_gym.core.errors import ConfigError, SfwGymError
+from sfw_gym.envs import batch_step
+from sfw_gym.envs.batch_step import BatchStepper
 
 
 class SfWVectorEnv(VectorEnv):
@@ -51,13 +58,13 @@ class SfWVectorEnv(VectorEnv):
         if not isinstance(num_envs, int | np.integer) or num_envs < 1:
             raise ConfigError(f"num_envs must be an int >= 1, got {num_envs!r}")
         self.num_envs = int(num_envs)
-        self.envs: list[gym.Env] = []
+        self._envs: list[gym.Env] = []
         for _ in range(self.num_envs):
             env = make(**kwargs)
-            self.envs.append(
+            self._envs.append(
                 env if max_episode_steps is None else TimeLimit(env, max_episode_steps)
             )
-        first = self.envs[0]
+        first = self._envs[0]
         self.metadata = {**first.metadata, "autoreset_mode": AutoresetMode.NEXT_STEP}
         self.render_mode = first.render_mode
         self.single_observation_space = first.observation_space
@@ -69,6 +76,16 @@ class SfWVectorEnv(VectorEnv):
         self._terminations = np.zeros(self.num_envs, np.bool_)
         self._truncations = np.zeros(self.num_envs, np.bool_)
         self._autoreset = np.zeros(self.num_envs, np.bool_)
+        self._stepper = BatchStepper(self.num_envs, len(first.observation_space["state"].low))
+        self._batched = all(_batches(env) for env in self._envs)
+        self._plan_names = np.full(self.num_envs, None, dtype=object)
+        self._metrics = np.zeros((self.num_envs, len(batch_step.METRICS)))
+
+    @property
+    def envs(self) -> list[gym.Env]:
+        """The sub-envs, their state up to date."""
+        self._sync_all()
+        return self._envs
 
     def reset(
         self, *, seed: int | list[int | None] | None = None, options: dict[str, Any] | None = None
@@ -106,7 +123,13 @@ class SfWVectorEnv(VectorEnv):
             )
         self._observations = self._empty_batch()  # every row is written below
         infos: list[dict[str, Any] | None] = [None] * self.num_envs
+        if self._batched:
+            together = self._step_together(actions, infos)
+        else:
+            together = np.zeros(self.num_envs, np.bool_)
         for i, action in enumerate(iterate(self.action_space, actions)):
+            if together[i]:
+                continue
             if self._autoreset[i]:
                 obs, infos[i] = self._sub(i, "reset")
                 reward, terminated, truncated = 0.0, False, False
@@ -117,13 +140,95 @@ class SfWVectorEnv(VectorEnv):
             self._terminations[i] = terminated
             self._truncations[i] = truncated
         self._autoreset = self._terminations | self._truncations
+        if together.any():
+            batched = self._stepper.infos(self._metrics, self._plan_names)
+            info = _merge_rows(batched, infos)
+        else:
+            info = batch_infos(infos)
         return (
             self._batch(),
             self._rewards.copy(),
             self._terminations.copy(),
             self._truncations.copy(),
-            batch_infos(infos),
+            info,
         )
+
+    def _step_together(self, actions: Any, infos: list[dict[str, Any] | None]) -> np.ndarray:
+        """Step the sub-envs that can go through `batch_step` (not resetting, on a plan whose
+        robot pymunk does not hold in part); returns which did. The last step of an episode
+        gets its info (with the summary) from the env."""
+        stepper, envs = self._stepper, self._envs
+        can = ~self._autoreset & np.array([_episode_batches(env) for env in envs])
+        active = np.flatnonzero(can)
+        if not len(active):
+            return can
+        v, w = self._commands(actions, active)
+        stepper.make_room(active, envs)
+        moved = batch_step.move_robots(active, v, w, stepper.state, stepper.consts, stepper.parts)
+        noise = stepper.noise
+        for n, i in enumerate(active.tolist()):
+            env = envs[i]
+            robot, radio = env.scene.robot, env.scene.radio
+            if not moved[n]:  # near a wall: pymunk moves it
+                stepper.sync(i, env)
+                result = self._call(i, robot.step, float(v[n]), float(w[n]))
+                stepper.load_robot(i, robot, result.distance_m)
+            odometry = 3 if moved[n] and robot._noisy else 0
+            readings = len(radio.routers) if radio.config.noise_sigma_db > 0 else 0
+            if odometry and readings and robot._rng is radio.rng:
+                noise[n, : odometry + readings] = radio.rng.standard_normal(odometry + readings)
+            else:
+                if odometry:
+                    noise[n, :3] = robot._rng.standard_normal(3)
+                if readings:
+                    noise[n, odometry : odometry + readings] = radio.rng.standard_normal(readings)
+        done = np.zeros(len(active), np.int8)
+        due = np.zeros(len(active), np.bool_)
+        obs = self._observations
+        batch_step.sense_and_map(
+            active, moved, noise, stepper.state, stepper.consts, stepper.parts, obs["map"],
+            obs["local"], obs["state"], self._rewards, self._metrics, done, due,
+        )  # fmt: skip
+        stepper.synced[active] = False
+        for i in active[due].tolist():
+            envs[i].mapper.k_estimator.refit()
+        if (done < 0).any():
+            i = int(active[np.flatnonzero(done < 0)[0]])
+            raise ConfigError(f"sub-env {i}: the pose estimate lies outside the map's grid")
+        self._terminations[active] = done == 1
+        self._truncations[active] = done == 2
+        for i in active[done > 0].tolist():
+            stepper.sync(i, envs[i])
+            metrics = dict(zip(batch_step.METRICS, self._metrics[i].tolist(), strict=True))
+            infos[i] = envs[i]._info(terminal=True, metrics=metrics)
+        return can
+
+    def _commands(self, actions: Any, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The ``active`` sub-envs' (linear, angular) commands, as `SfWExploreEnv._command`
+        makes them (an unusual action goes through it, its error naming the sub-env)."""
+        env = self._envs[0]
+        cfg = env.config.robot
+        a = actions if isinstance(actions, np.ndarray) else np.asarray(actions, dtype=object)
+        if env.config.explore.action_type == "discrete":
+            if a.dtype.kind in "iu" and a.shape == (self.num_envs,):
+                chosen = a[active]
+                if ((chosen >= 0) & (chosen < len(DISCRETE_ACTIONS))).all():
+                    fractions = np.array(DISCRETE_ACTIONS, np.float64)[chosen]
+                    return (
+                        fractions[:, 0] * cfg.max_linear_speed_m_s,
+                        fractions[:, 1] * cfg.max_angular_speed_rad_s,
+                    )
+        elif a.dtype.kind == "f" and a.shape == (self.num_envs, 2):
+            chosen = a[active].astype(np.float64)
+            if np.isfinite(chosen).all():
+                chosen = np.clip(chosen, -1.0, 1.0)
+                return (
+                    chosen[:, 0] * cfg.max_linear_speed_m_s,
+                    chosen[:, 1] * cfg.max_angular_speed_rad_s,
+                )
+        rows = list(iterate(self.action_space, actions))
+        commands = [self._call(i, self._envs[i].unwrapped._command, rows[i]) for i in active]
+        return np.array([c[0] for c in commands]), np.array([c[1] for c in commands])
 
     def render(self) -> tuple[Any, ...] | None:
         """Each sub-env's frame (``render_mode="rgb_array"``)."""
@@ -135,6 +240,7 @@ class SfWVectorEnv(VectorEnv):
         for env in self.envs:
             attr = env.get_wrapper_attr(name)
             out.append(attr(*args, **kwargs) if callable(attr) else attr)
+        self._load_all()  # a call may change a sub-env
         return tuple(out)
 
     def get_attr(self, name: str) -> tuple[Any, ...]:
@@ -147,17 +253,42 @@ class SfWVectorEnv(VectorEnv):
             values = [values] * self.num_envs
         for env, value in zip(self.envs, values, strict=True):
             env.set_wrapper_attr(name, value)
+        self._load_all()
 
     def close_extras(self, **kwargs: Any) -> None:
         for env in self.envs:
             env.close()
 
     def _sub(self, i: int, method: str, *args: Any, **kwargs: Any) -> Any:
-        """Sub-env ``i``'s ``method``; its errors name the sub-env."""
+        """Sub-env ``i``'s ``method`` (its state synced before and read after)."""
+        env = self._envs[i]
+        if not self._batched:
+            return self._call(i, getattr(env, method), *args, **kwargs)
+        self._stepper.sync(i, env)
+        out = self._call(i, getattr(env, method), *args, **kwargs)
+        if _episode_batches(env):
+            self._stepper.load(i, env)
+            self._plan_names[i] = env.scene.floorplan.name
+        return out
+
+    @staticmethod
+    def _call(i: int, fn: Any, *args: Any, **kwargs: Any) -> Any:
+        """``fn(*args, **kwargs)`` of sub-env ``i``: its errors name the sub-env."""
         try:
-            return getattr(self.envs[i], method)(*args, **kwargs)
+            return fn(*args, **kwargs)
         except SfwGymError as exc:
             raise type(exc)(f"sub-env {i}: {exc}") from exc
+
+    def _sync_all(self) -> None:
+        if self._batched:
+            for i, env in enumerate(self._envs):
+                self._stepper.sync(i, env)
+
+    def _load_all(self) -> None:
+        if self._batched:
+            for i, env in enumerate(self._envs):
+                if _episode_batches(env):
+                    self._stepper.load(i, env)
 
     def _empty_batch(self, fn: Any = np.empty) -> dict[str, np.ndarray]:
         return create_empty_array(self.single_observation_space, self.num_envs, fn=fn)  # type: ignore[return-value]
@@ -170,6 +301,43 @@ class SfWVectorEnv(VectorEnv):
         """The observations as the caller keeps them: never written again (a step writes a
         new batch, a reset a copy)."""
         return dict(self._observations)
+
+
+def _batches(env: gym.Env) -> bool:
+    """Whether ``env`` (a sub-env, as built) can step through `batch_step`."""
+    from sfw_gym.envs.explore import SfWExploreEnv
+
+    if type(env) is not SfWExploreEnv:  # a wrapper, or another env class
+        return False
+    cfg = env.config
+    return (
+        cfg.explore.pose_source in ("odometry", "true")
+        and cfg.lidar is None
+        and cfg.explore.n_background_aps == 0
+        and env.render_mode != "human"
+    )
+
+
+def _episode_batches(env: Any) -> bool:
+    """Whether this episode can: reset, on a plan whose walls pymunk holds all at once."""
+    return env.scene is not None and env.scene.robot._active_walls is None
+
+
+def _merge_rows(batched: dict[str, Any], infos: list[dict[str, Any] | None]) -> dict[str, Any]:
+    """``batched`` (every sub-env's info arrays) with the rows of the sub-envs that gave an
+    info dict replaced by it; keys only those have (the summary) batched after."""
+    extras: list[dict[str, Any] | None] = [None] * len(infos)
+    for i, info in enumerate(infos):
+        if info is None:
+            continue
+        rest = {}
+        for key, value in info.items():
+            if key in batched:
+                batched[key][i] = value
+            else:
+                rest[key] = value
+        extras[i] = rest or None
+    return batched | batch_infos(extras)
 
 
 def batch_infos(infos: list[dict[str, Any] | None]) -> dict[str, Any]:

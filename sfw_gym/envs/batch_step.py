@@ -1,0 +1,449 @@
+"""The explore env's step for many sub-envs in two compiled calls: the native vector env's fast path.
+
+:class:`BatchStepper` holds, per sub-env, the episode's arrays (walls, radio tables, the mapper's,
+the tracker's and the observation builder's buffers, the histories) in one numba list, and its
+scalar state (poses, counters) in one row of a float array. A batch step then runs the robot's
+open-space motion for every sub-env in one call, pymunk in Python only for a robot near a wall,
+and the reading, the map update, the metrics and the observations of every sub-env in a second
+call, written straight into the batch's arrays. Every compiled line repeats an operation of the
+env's Python step in the same IEEE order, or calls the same kernel, so each sub-env is the single
+env with its seed, bit for bit (tests/envs/test_vector_env.py).
+
+The env objects stay the record: :meth:`BatchStepper.sync` writes a sub-env's state back before
+anything else reads or steps it, and :meth:`BatchStepper.load` reads it after.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numba import njit
+from numba.typed import List
+
+from sfw_gym.core.constants import NOT_HEARD_DBM
+from sfw_gym.core.exact_math import hypot, wrap_angle
+from sfw_gym.envs.map_tracker import _apply as _track_changes
+from sfw_gym.envs.map_tracker import (
+    _AGREE,
+    _COVERED,
+    _FREE_INTER,
+    _INTERIOR_FOUND,
+    _KNOWN_BOTH,
+    _N_EST_FREE,
+    _N_EST_WALL,
+    _N_KNOWN,
+    _WALL_NEAR,
+)
+from sfw_gym.envs.observation import RSSI_FLOOR_DBM, RSSI_SPAN_DB, TRAJECTORY_U8, draw_into
+from sfw_gym.mapping.sparse import _S_ENTROPY, _S_N_CHANGED, _update_kernel
+from sfw_gym.world import robot as robot_module
+from sfw_gym.world.radio import _rssi_range
+
+# A sub-env's scalar state: one row of `BatchStepper.state`.
+(X, Y, A, ODO_X, ODO_Y, ODO_T, BUMPED, CLEAR_X, CLEAR_Y, CLEAR_D, VX, VY, W, UNSYNCED, CALLBACK,
+ STEPS, PATH_M, COLLISIONS, K_CORRECT, K_TOTAL, TO_50, TO_90, EST_X, EST_Y, EST_T, SQ_ERR, GAIN,
+ N_ROWS, N_UPDATES, X0, Y0, A0, MOVED_M, MAX_STEPS, TRUE_T, ODO_TW, POSE_ERR, ENTROPY
+ ) = range(38)  # fmt: skip
+N_STATE = 38
+# A sub-env's constants: one row of `BatchStepper.consts`.
+(RADIUS, MAX_V, MAX_W, PERIOD, SUBSTEPS, TRANS_STD, HEAD_STD, WALL_R, NOISE_DB, SENSITIVITY,
+ GX0, GY0, GX1, GY1, GRID_RES, OBS_CELLS_PER_PX, OBS_PAD_R, OBS_PAD_C, OBS_MAP_PX, OBS_CROP,
+ OBS_WIDTH_M, OBS_HEIGHT_M, GRID_ROWS, GRID_COLS, SCALE, PENALTY, TARGET, MAX_K, SLOTS, TRUE_POSE,
+ N_CELLS, N_FREE, N_INTERIOR) = range(33)  # fmt: skip
+N_CONSTS = 33
+# The five map metrics, in `MapTracker.metrics`' order.
+METRICS = ("coverage", "map_iou", "free_iou", "wall_precision", "interior_wall_recall")
+
+
+@njit(cache=True)
+def _ratio(num: float, den: float) -> float:
+    return num / den if den else 0.0
+
+
+@njit(cache=True)
+def _clearance_to_walls(walls, wall_radius, x, y, look):
+    """The distance from (x, y) to the nearest wall's surface, or ``look`` if none is nearer:
+    pymunk's ``point_query_nearest`` answer up to rounding (it only decides whether pymunk is
+    asked to move the robot, never where the robot goes)."""
+    best = look
+    for e in range(walls.shape[0]):
+        ax, ay, bx, by = walls[e, 0], walls[e, 1], walls[e, 2], walls[e, 3]
+        dx, dy = bx - ax, by - ay
+        len2 = dx * dx + dy * dy
+        t = ((x - ax) * dx + (y - ay) * dy) / len2 if len2 > 0.0 else 0.0
+        t = min(max(t, 0.0), 1.0)
+        d = math.sqrt((x - ax - t * dx) ** 2 + (y - ay - t * dy) ** 2) - wall_radius
+        best = min(best, d)
+    return best
+
+
+@njit(cache=True)
+def move_robots(active, v, w, state, consts, parts):
+    """The robots' motion (``Robot.step``) of the ``active`` sub-envs far from walls; returns
+    which moved here (the others need pymunk: near a wall or bumped last step)."""
+    moved = np.zeros(active.shape[0], np.bool_)
+    for n in range(active.shape[0]):
+        i = active[n]
+        s, c = state[i], consts[i]
+        vi, wi = v[n], w[n]
+        x0, y0, a0 = s[X], s[Y], s[A]
+        if s[BUMPED]:
+            continue
+        reach = c[RADIUS] + abs(vi) * c[PERIOD] + robot_module._REACH_MARGIN_M
+        if (
+            s[CLEAR_D] - hypot(x0 - s[CLEAR_X], y0 - s[CLEAR_Y]) - robot_module._CLEARANCE_ROUNDING_M
+            < reach
+        ):
+            look = reach + robot_module._CLEARANCE_LOOKAHEAD_M
+            s[CLEAR_X], s[CLEAR_Y] = x0, y0
+            s[CLEAR_D] = _clearance_to_walls(parts[i][0], c[WALL_R], x0, y0, look)
+            if s[CLEAR_D] < reach:
+                continue
+        vx, vy = vi * math.cos(a0), vi * math.sin(a0)
+        dt = c[PERIOD] / c[SUBSTEPS]
+        x, y, a = x0, y0, a0
+        for k in range(int(c[SUBSTEPS])):
+            if k and wi != 0.0:
+                vx, vy = vi * math.cos(a), vi * math.sin(a)
+            x += (vx + 0.0) * dt
+            y += (vy + 0.0) * dt
+            a += (wi + 0.0) * dt
+        s[X0], s[Y0], s[A0] = x0, y0, a0
+        s[X], s[Y], s[A] = x, y, a
+        s[VX], s[VY], s[W] = vx, vy, wi
+        s[UNSYNCED] = 1.0
+        s[CALLBACK] = 0.0
+        moved[n] = True
+    return moved
+
+
+@njit(cache=True)
+def _odometry(s, c, noise):
+    """``Robot.step``'s odometry from the move X0..X (noise: three standard normals, or none)."""
+    x0, y0, a0 = s[X0], s[Y0], s[A0]
+    dx, dy = s[X] - x0, s[Y] - y0
+    c0, s0 = math.cos(a0), math.sin(a0)
+    forward = c0 * dx + s0 * dy
+    lateral = -s0 * dx + c0 * dy
+    turn = s[A] - a0
+    distance = hypot(dx, dy)
+    if c[TRANS_STD] > 0.0 or c[HEAD_STD] > 0.0:
+        trans_std = c[TRANS_STD] * distance
+        forward += trans_std * noise[0]
+        lateral += trans_std * noise[1]
+        turn += c[HEAD_STD] * noise[2]
+    ox, oy, ot = s[ODO_X], s[ODO_Y], s[ODO_T]
+    co, so = math.cos(ot), math.sin(ot)
+    s[ODO_X] = ox + co * forward - so * lateral
+    s[ODO_Y] = oy + so * forward + co * lateral
+    s[ODO_T] = ot + turn
+    s[MOVED_M] = distance
+
+
+@njit(cache=True)
+def sense_and_map(
+    active, moved, noise, state, consts, parts, obs_map, obs_local, obs_state, reward, metrics,
+    done, due,
+):  # fmt: skip
+    """The rest of the step of the ``active`` sub-envs (``SfWExploreEnv.step`` after the robot's
+    motion): odometry, the reading, the histories, the map update, k-accuracy, the tracker, the
+    observation (into row ``active[n]`` of the batch arrays), the reward and the metrics;
+    ``done``: 1 terminated, 2 truncated; ``due``: the k-estimator wants a refit."""
+    for n in range(active.shape[0]):
+        i = active[n]
+        s, c = state[i], consts[i]
+        walls, radio, mapper, tracker, builder, history, scratch = parts[i]
+        edges, edge_loss, routers, radio_params, tables, origin, spacing = radio
+        (routers_g, policy_all, extend, map_params, kest, feature, k_est, selected, dist_buf,
+         raster, maps, track, ray, anchors) = mapper  # fmt: skip
+        est_cls, truth_cls, near_wall, interior, found_by, offsets, counts = tracker
+        src_r, src_c, pad, trajectory, router_px = builder
+        rssi_rows, true_rows, odometry_rows, estimate_rows = history
+        pts, mean_db, true_k, rssi = scratch
+        n_routers = routers.shape[0]
+        if moved[n]:
+            _odometry(s, c, noise[n])
+        s[STEPS] += 1.0
+        s[PATH_M] += s[MOVED_M]
+        s[COLLISIONS] += s[BUMPED]
+        # the reading at the true pose (RadioModel.measure_at)
+        tx, ty, tt = s[X], s[Y], wrap_angle(s[A])
+        pts[0, 0], pts[0, 1] = tx, ty
+        _rssi_range(
+            edges, edge_loss, routers, pts, radio_params, tables, origin, spacing, mean_db,
+            true_k, 0, 1,
+        )  # fmt: skip
+        offset = 3 if moved[n] and (c[TRANS_STD] > 0.0 or c[HEAD_STD] > 0.0) else 0
+        for r in range(n_routers):
+            db = mean_db[0, r]
+            if c[NOISE_DB] > 0.0:
+                db += 0.0 + c[NOISE_DB] * noise[n, offset + r]
+            reading = np.int32(np.rint(db))
+            rssi[r] = NOT_HEARD_DBM if reading < c[SENSITIVITY] else reading
+        # the pose it maps at, and the histories
+        if c[TRUE_POSE]:
+            px, py, pt = tx, ty, tt
+        else:
+            px, py, pt = s[ODO_X], s[ODO_Y], wrap_angle(s[ODO_T])
+        s[EST_X], s[EST_Y], s[EST_T] = px, py, pt
+        s[TRUE_T], s[ODO_TW] = tt, wrap_angle(s[ODO_T])
+        s[POSE_ERR] = hypot(px - tx, py - ty)
+        row = int(s[N_ROWS])
+        for r in range(n_routers):
+            rssi_rows[row, r] = rssi[r]
+        true_rows[row, 0], true_rows[row, 1] = tx, ty
+        odometry_rows[row, 0], odometry_rows[row, 1] = px, py
+        estimate_rows[row, 0], estimate_rows[row, 1], estimate_rows[row, 2] = px, py, pt
+        s[N_ROWS] = row + 1
+        s[SQ_ERR] += (px - tx) ** 2 + (py - ty) ** 2
+        # the map update (SfWExploreEnv._map_at)
+        gain = 0.0
+        if c[GX0] <= px < c[GX1] and c[GY0] <= py < c[GY1]:
+            gx = (px - c[GX0]) / c[GRID_RES]
+            gy = (py - c[GY0]) / c[GRID_RES]
+            if not (0.0 <= gx < c[GRID_COLS] and 0.0 <= gy < c[GRID_ROWS]):
+                done[n] = -1  # outside the grid although inside its bounds: the env raises
+                continue
+            readings = np.empty(n_routers)
+            for r in range(n_routers):
+                readings[r] = rssi[r]
+            gain, due[n] = _update_kernel(
+                gx, gy, readings, s[BUMPED] != 0.0, pt, routers_g, policy_all, extend,
+                map_params, kest, feature, k_est, selected, dist_buf, raster, maps, track, ray,
+                anchors,
+            )  # fmt: skip
+            s[N_UPDATES] += 1.0
+            n_changed = int(track[3][_S_N_CHANGED])
+            if n_changed:
+                _track_changes(
+                    track[2][:n_changed], maps[2], est_cls, truth_cls, near_wall, interior,
+                    found_by, offsets, int(c[GRID_COLS]), counts,
+                )  # fmt: skip
+            for r in range(n_routers):
+                if rssi[r] > NOT_HEARD_DBM and k_est[r] >= 0:
+                    s[K_TOTAL] += 1.0
+                    s[K_CORRECT] += k_est[r] == min(true_k[0, r], c[MAX_K])
+        s[GAIN] = gain
+        s[ENTROPY] = track[3][_S_ENTROPY]
+        # the observation (ObservationBuilder.mark_visited and build)
+        cells_px, map_px = c[OBS_CELLS_PER_PX], int(c[OBS_MAP_PX])
+        pr = math.floor((py - c[GY0]) / c[GRID_RES] / cells_px + c[OBS_PAD_R])
+        pc = math.floor((px - c[GX0]) / c[GRID_RES] / cells_px + c[OBS_PAD_C])
+        pr, pc = min(max(pr, 0), map_px - 1), min(max(pc, 0), map_px - 1)
+        trajectory[pr, pc] = TRAJECTORY_U8
+        rows, cols = int(c[GRID_ROWS]), int(c[GRID_COLS])
+        cr = min(max(int((py - c[GY0]) / c[GRID_RES]), 0), rows - 1)
+        cc = min(max(int((px - c[GX0]) / c[GRID_RES]), 0), cols - 1)
+        draw_into(
+            maps[2].reshape((rows, cols)), src_r, src_c, pad, trajectory, router_px, pr, pc, cr,
+            cc, int(c[OBS_CROP]), obs_map[i], obs_local[i],
+        )  # fmt: skip
+        out = obs_state[i]
+        slots = int(c[SLOTS])
+        for r in range(slots):
+            db = rssi[r] if r < n_routers else NOT_HEARD_DBM
+            if db > RSSI_FLOOR_DBM:
+                out[r] = min(max((db - RSSI_FLOOR_DBM) / RSSI_SPAN_DB, 0.0), 1.0)
+                out[slots + r] = 1.0
+            else:
+                out[r] = 0.0
+                out[slots + r] = 0.0
+        out[2 * slots] = s[BUMPED]
+        out[2 * slots + 1] = min(max((px - c[GX0]) / c[OBS_WIDTH_M], 0.0), 1.0)
+        out[2 * slots + 2] = min(max((py - c[GY0]) / c[OBS_HEIGHT_M], 0.0), 1.0)
+        out[2 * slots + 3] = math.sin(pt)
+        out[2 * slots + 4] = math.cos(pt)
+        out[2 * slots + 5] = counts[_N_KNOWN] / c[N_CELLS]
+        # the reward, the metrics (MapTracker.metrics) and the episode's end
+        reward[i] = c[SCALE] * gain - c[PENALTY] * s[BUMPED]
+        inter = counts[_FREE_INTER]
+        m = metrics[i]
+        m[0] = _ratio(counts[_COVERED], c[N_FREE])
+        m[1] = _ratio(counts[_AGREE], counts[_KNOWN_BOTH])
+        m[2] = _ratio(inter, counts[_N_EST_FREE] + c[N_FREE] - inter)
+        m[3] = _ratio(counts[_WALL_NEAR], counts[_N_EST_WALL])
+        m[4] = _ratio(counts[_INTERIOR_FOUND], c[N_INTERIOR])
+        if s[TO_50] < 0 and m[0] >= 0.5:
+            s[TO_50] = s[STEPS]
+        if s[TO_90] < 0 and m[0] >= 0.9:
+            s[TO_90] = s[STEPS]
+        if m[0] >= c[TARGET]:
+            done[n] = 1
+        elif s[STEPS] >= s[MAX_STEPS]:
+            done[n] = 2
+
+
+def _float_tuple(values: Any) -> tuple[Any, ...]:
+    """A tuple with Python numbers as floats, bools kept (one numba type for every sub-env)."""
+    return tuple(
+        v if isinstance(v, np.ndarray | bool | np.bool_) else float(v) for v in values
+    )
+
+
+class BatchStepper:
+    """The compiled state of ``num_envs`` explore sub-envs (see the module doc)."""
+
+    def __init__(self, num_envs: int, n_router_slots: int) -> None:
+        self.state = np.zeros((num_envs, N_STATE))
+        self.consts = np.zeros((num_envs, N_CONSTS))
+        self.parts: Any = List()
+        self._parts: list[Any] = [None] * num_envs
+        self._capacity = np.zeros(num_envs, np.int64)
+        self.noise = np.zeros((num_envs, 3 + n_router_slots))
+        self.synced = np.ones(num_envs, np.bool_)
+
+    # ------------------------------------------------------------------ env <-> arrays
+    def load(self, i: int, env: Any) -> None:
+        """Read sub-env ``i``'s state (after its reset, or a step it took in Python)."""
+        robot = env.scene.robot
+        self.load_robot(i, robot, 0.0)
+        s = self.state[i]
+        s[STEPS], s[PATH_M], s[COLLISIONS] = env.steps, env.path_length_m, env.collisions
+        s[K_CORRECT], s[K_TOTAL] = env.k_correct, env.k_total
+        s[TO_50], s[TO_90] = env.steps_to[0.5], env.steps_to[0.9]
+        s[EST_X], s[EST_Y], s[EST_T] = env.pose_estimate
+        s[SQ_ERR], s[GAIN] = env._squared_pose_errors, env.last_gain_bits
+        s[N_ROWS], s[N_UPDATES] = len(env.rssi_history), env.mapper.n_updates
+        s[MAX_STEPS] = env.episode_max_steps
+        s[TRUE_T], s[ODO_TW] = robot.pose[2], robot.odometry_pose[2]
+        s[POSE_ERR] = math.dist(env.pose_estimate[:2], robot.pose[:2])
+        s[ENTROPY] = env.mapper.entropy_bits
+        histories = (env.rssi_history, env.true_path, env.odometry_trajectory, env.pose_estimates)
+        buffers = tuple(h._data for h in histories)
+        if self._parts[i] is None or self._parts[i][0] is not env or any(
+            a is not b for a, b in zip(self._parts[i][1], buffers, strict=True)
+        ):
+            self._attach(i, env, buffers)
+        self.synced[i] = True
+
+    def load_robot(self, i: int, robot: Any, distance_m: float) -> None:
+        """Read sub-env ``i``'s robot after it stepped in Python (``distance_m``: its move)."""
+        s = self.state[i]
+        s[X], s[Y], s[A] = robot._xya
+        s[ODO_X], s[ODO_Y], s[ODO_T] = robot._odometry
+        s[BUMPED] = robot._bumped
+        s[CLEAR_X], s[CLEAR_Y], s[CLEAR_D] = robot._clearance
+        s[UNSYNCED] = robot._unsynced is not None
+        if robot._unsynced is not None:
+            _, _, _, s[VX], s[VY], s[W] = robot._unsynced
+        s[CALLBACK] = robot._callback_on
+        s[MOVED_M] = distance_m
+
+    def _attach(self, i: int, env: Any, buffers: tuple[np.ndarray, ...]) -> None:
+        """Gather sub-env ``i``'s episode arrays and constants (after a reset or a history's
+        growth)."""
+        scene, cfg = env.scene, env.config
+        robot, radio, mapper, tracker, builder = (
+            scene.robot, scene.radio, env.mapper, env.tracker, env.obs_builder,
+        )  # fmt: skip
+        n_r = len(radio.routers)
+        ke = mapper._k_estimator
+        table, origin, spacing = radio._shadow_args
+        parts = (
+            robot._walls,
+            (radio.floorplan.edges, radio._edge_loss_db, radio.routers, radio._params, table,
+             origin, float(spacing)),
+            (mapper._routers_g, bool(mapper._policy_all), bool(mapper.config.extend_past_robot),
+             mapper._params, _float_tuple(mapper._kest), ke._feature, ke._k, mapper._selected,
+             mapper._dist, mapper._raster, mapper._maps, mapper._track, mapper._ray,
+             mapper._anchors),
+            (tracker._est_cls, tracker._truth_cls, tracker._near_wall, tracker._interior,
+             tracker._found_by, tracker._offsets, tracker._counts),
+            (builder._src_r, builder._src_c, builder._pad, builder._trajectory, builder._routers),
+            buffers,
+            (np.zeros((1, 2)), np.zeros((1, n_r)), np.zeros((1, n_r), np.int32),
+             np.zeros(n_r, np.int32)),
+        )  # fmt: skip
+        if len(self.parts) > i:
+            self.parts[i] = parts
+        else:
+            while len(self.parts) < i:  # sub-envs attach in order at the first reset
+                self.parts.append(parts)
+            self.parts.append(parts)
+        self._parts[i] = (env, buffers)
+        self._capacity[i] = min(len(b) for b in buffers)
+        rc, grid, ob = cfg.robot, env.grid, builder
+        x0, y0, x1, y1 = env._grid_bounds
+        c = self.consts[i]
+        c[RADIUS], c[MAX_V], c[MAX_W] = rc.radius_m, rc.max_linear_speed_m_s, rc.max_angular_speed_rad_s
+        c[PERIOD], c[SUBSTEPS], c[WALL_R] = rc.control_period_s, rc.physics_substeps, rc.wall_radius_m
+        c[TRANS_STD], c[HEAD_STD] = rc.odometry_translation_std, rc.odometry_heading_std_rad
+        c[NOISE_DB], c[SENSITIVITY] = radio.config.noise_sigma_db, radio.config.sensitivity_dbm
+        c[GX0], c[GY0], c[GX1], c[GY1], c[GRID_RES] = x0, y0, x1, y1, grid.resolution_m
+        c[GRID_ROWS], c[GRID_COLS] = grid.shape
+        c[OBS_CELLS_PER_PX], c[OBS_PAD_R], c[OBS_PAD_C] = ob.cells_per_px, ob._pad_r, ob._pad_c
+        c[OBS_MAP_PX], c[OBS_CROP] = ob.map_px, ob.crop_px
+        c[OBS_WIDTH_M], c[OBS_HEIGHT_M] = ob._width_m, ob._height_m
+        c[SCALE], c[PENALTY] = cfg.reward.reward_scale, cfg.reward.collision_penalty
+        c[TARGET], c[MAX_K], c[SLOTS] = cfg.reward.coverage_target, cfg.mapper.max_k, ob.n_router_slots
+        c[TRUE_POSE] = cfg.explore.pose_source == "true"
+        c[N_CELLS], c[N_FREE], c[N_INTERIOR] = tracker._n_cells, tracker._n_truth_free, tracker._n_interior
+
+    def sync(self, i: int, env: Any) -> None:
+        """Write sub-env ``i``'s state back into its env objects (before anything reads them)."""
+        if self.synced[i]:
+            return
+        from sfw_gym.world import Pose
+
+        s = self.state[i].tolist()
+        robot = env.scene.robot
+        robot._xya = (s[X], s[Y], s[A])
+        robot._odometry = (s[ODO_X], s[ODO_Y], s[ODO_T])
+        robot._bumped = bool(s[BUMPED])
+        robot._clearance = (s[CLEAR_X], s[CLEAR_Y], s[CLEAR_D])
+        if s[UNSYNCED]:
+            robot._unsynced = (s[X], s[Y], s[A], s[VX], s[VY], s[W])
+        robot._drive_by_callback(bool(s[CALLBACK]))
+        env.steps, env.path_length_m = int(s[STEPS]), s[PATH_M]
+        env.collisions, env.k_correct, env.k_total = int(s[COLLISIONS]), int(s[K_CORRECT]), int(s[K_TOTAL])
+        env.steps_to = {0.5: int(s[TO_50]), 0.9: int(s[TO_90])}
+        env.pose_estimate = Pose(s[EST_X], s[EST_Y], s[EST_T])
+        env._squared_pose_errors, env.last_gain_bits = s[SQ_ERR], s[GAIN]
+        n_rows = int(s[N_ROWS])
+        for h in (env.rssi_history, env.true_path, env.odometry_trajectory, env.pose_estimates):
+            h._n = n_rows
+        env.mapper.n_updates = int(s[N_UPDATES])
+        self.synced[i] = True
+
+    def make_room(self, active: np.ndarray, envs: list[Any]) -> None:
+        """Grow the histories of the ``active`` sub-envs that are full (before a step)."""
+        for i in active[self.state[active, N_ROWS] >= self._capacity[active]].tolist():
+            env = envs[i]
+            self.sync(i, env)
+            for h in (env.rssi_history, env.true_path, env.odometry_trajectory, env.pose_estimates):
+                h.reserve(len(h) + 1)
+            self.load(i, env)
+
+    # ------------------------------------------------------------------ infos
+    def infos(self, metrics: np.ndarray, plan_names: np.ndarray) -> dict[str, Any]:
+        """The step's info of every sub-env as `SfWExploreEnv._info` gives it (without the
+        summary), batched as `sfw_gym.envs.vector.batch_infos` batches it."""
+        s = self.state
+        n = len(s)
+        k_total = s[:, K_TOTAL]
+        columns: dict[str, Any] = {name: metrics[:, j].copy() for j, name in enumerate(METRICS)}
+        columns |= {
+            "k_accuracy": np.divide(
+                s[:, K_CORRECT], k_total, out=np.zeros(n), where=k_total > 0
+            ),
+            "path_length_m": s[:, PATH_M].copy(),
+            "collisions": s[:, COLLISIONS].astype(np.int64),
+            "true_pose": s[:, [X, Y, TRUE_T]],
+            "odometry_pose": s[:, [ODO_X, ODO_Y, ODO_TW]],
+            "pose_estimate": s[:, [EST_X, EST_Y, EST_T]],
+            "pose_error_m": s[:, POSE_ERR].copy(),
+            "ate_m": np.sqrt(s[:, SQ_ERR] / s[:, N_ROWS]),
+            "entropy_bits": s[:, ENTROPY].copy(),
+            "info_gain_bits": s[:, GAIN].copy(),
+            "steps_to_coverage_50": s[:, TO_50].astype(np.int64),
+            "steps_to_coverage_90": s[:, TO_90].astype(np.int64),
+            "floorplan": plan_names.copy(),
+            "max_steps": s[:, MAX_STEPS].astype(np.int64),
+        }
+        out: dict[str, Any] = {}
+        every = np.ones(n, np.bool_)
+        for key, value in columns.items():
+            out[key], out[f"_{key}"] = value, every.copy()
+        return out
