@@ -36,17 +36,19 @@ from sfw_gym.envs.map_tracker import (
     _N_KNOWN,
     _WALL_NEAR,
 )
-from sfw_gym.envs.observation import RSSI_FLOOR_DBM, RSSI_SPAN_DB, TRAJECTORY_U8, draw_into
-from sfw_gym.mapping.sparse import _S_ENTROPY, _S_N_CHANGED, _update_kernel
+from sfw_gym.envs.observation import RSSI_FLOOR_DBM, RSSI_SPAN_DB, TRAJECTORY_U8, draw_rest_into
+from sfw_gym.mapping.sparse import _S_ENTROPY, _S_N_CHANGED, _S_N_TOUCHED, _update_kernel
 from sfw_gym.world import robot as robot_module
 from sfw_gym.world.radio import _rssi_range
 
 # A sub-env's scalar state: one row of `BatchStepper.state`.
 (X, Y, A, ODO_X, ODO_Y, ODO_T, BUMPED, CLEAR_X, CLEAR_Y, CLEAR_D, VX, VY, W, UNSYNCED, CALLBACK,
  STEPS, PATH_M, COLLISIONS, K_CORRECT, K_TOTAL, TO_50, TO_90, EST_X, EST_Y, EST_T, SQ_ERR, GAIN,
- N_ROWS, N_UPDATES, X0, Y0, A0, MOVED_M, MAX_STEPS, TRUE_T, ODO_TW, POSE_ERR, ENTROPY
- ) = range(38)  # fmt: skip
-N_STATE = 38
+ N_ROWS, N_UPDATES, X0, Y0, A0, MOVED_M, MAX_STEPS, TRUE_T, ODO_TW, POSE_ERR, ENTROPY,
+ NORMALS_USED) = range(39)  # fmt: skip
+N_STATE = 39
+#: Standard normals drawn ahead per sub-env (its generator is put back before Python uses it).
+NORMALS_AHEAD = 512
 # A sub-env's constants: one row of `BatchStepper.consts`.
 (RADIUS, MAX_V, MAX_W, PERIOD, SUBSTEPS, TRANS_STD, HEAD_STD, WALL_R, NOISE_DB, SENSITIVITY,
  GX0, GY0, GX1, GY1, GRID_RES, OBS_CELLS_PER_PX, OBS_PAD_R, OBS_PAD_C, OBS_MAP_PX, OBS_CROP,
@@ -120,8 +122,42 @@ def move_robots(active, v, w, state, consts, parts):
 
 
 @njit(cache=True)
-def _odometry(s, c, noise):
-    """``Robot.step``'s odometry from the move X0..X (noise: three standard normals, or none)."""
+def _redraw_touched(track, u8, n_cols, belief_px, px_rows, px_cols):
+    """Bring the map image's belief channel up to date with the cells the update touched
+    (``px_rows[r]``: the first image row sampling grid row r and how many do; ``px_cols``
+    alike)."""
+    touched = track[0]
+    for t in range(int(track[3][_S_N_TOUCHED])):
+        cell = touched[t]
+        r, c = cell // n_cols, cell % n_cols
+        i0, j0 = px_rows[r, 0], px_cols[c, 0]
+        for i in range(i0, i0 + px_rows[r, 1]):
+            for j in range(j0, j0 + px_cols[c, 1]):
+                belief_px[i, j] = u8[cell]
+
+
+def _pixels_of(src: np.ndarray, valid: np.ndarray, n_cells: int) -> np.ndarray:
+    """Per grid row (or column): the first image row (column) sampling it, and how many do."""
+    out = np.zeros((n_cells, 2), np.int64)
+    for px, cell in enumerate(src.tolist()):
+        if valid[px]:
+            if out[cell, 1] == 0:
+                out[cell, 0] = px
+            out[cell, 1] += 1
+    return out
+
+
+@njit(cache=True)
+def _normal(s, normals):
+    """The sub-env's next standard normal (drawn ahead from its generator)."""
+    z = normals[int(s[NORMALS_USED])]
+    s[NORMALS_USED] += 1.0
+    return z
+
+
+@njit(cache=True)
+def _odometry(s, c, normals):
+    """``Robot.step``'s odometry from the move X0..X (its noise from ``normals``)."""
     x0, y0, a0 = s[X0], s[Y0], s[A0]
     dx, dy = s[X] - x0, s[Y] - y0
     c0, s0 = math.cos(a0), math.sin(a0)
@@ -131,9 +167,10 @@ def _odometry(s, c, noise):
     distance = hypot(dx, dy)
     if c[TRANS_STD] > 0.0 or c[HEAD_STD] > 0.0:
         trans_std = c[TRANS_STD] * distance
-        forward += trans_std * noise[0]
-        lateral += trans_std * noise[1]
-        turn += c[HEAD_STD] * noise[2]
+        e_f, e_l, e_t = _normal(s, normals), _normal(s, normals), _normal(s, normals)
+        forward += trans_std * e_f
+        lateral += trans_std * e_l
+        turn += c[HEAD_STD] * e_t
     ox, oy, ot = s[ODO_X], s[ODO_Y], s[ODO_T]
     co, so = math.cos(ot), math.sin(ot)
     s[ODO_X] = ox + co * forward - so * lateral
@@ -144,7 +181,7 @@ def _odometry(s, c, noise):
 
 @njit(cache=True)
 def sense_and_map(
-    active, moved, noise, state, consts, parts, obs_map, obs_local, obs_state, reward, metrics,
+    active, moved, state, consts, parts, obs_map, obs_local, obs_state, reward, metrics,
     done, due,
 ):  # fmt: skip
     """The rest of the step of the ``active`` sub-envs (``SfWExploreEnv.step`` after the robot's
@@ -154,17 +191,17 @@ def sense_and_map(
     for n in range(active.shape[0]):
         i = active[n]
         s, c = state[i], consts[i]
-        walls, radio, mapper, tracker, builder, history, scratch = parts[i]
+        walls, radio, mapper, tracker, builder, history, scratch, normals = parts[i]
         edges, edge_loss, routers, radio_params, tables, origin, spacing = radio
         (routers_g, policy_all, extend, map_params, kest, feature, k_est, selected, dist_buf,
          raster, maps, track, ray, anchors) = mapper  # fmt: skip
         est_cls, truth_cls, near_wall, interior, found_by, offsets, counts = tracker
-        src_r, src_c, pad, trajectory, router_px = builder
+        belief_px, px_rows, px_cols, trajectory, router_px = builder
         rssi_rows, true_rows, odometry_rows, estimate_rows = history
         pts, mean_db, true_k, rssi = scratch
         n_routers = routers.shape[0]
         if moved[n]:
-            _odometry(s, c, noise[n])
+            _odometry(s, c, normals)
         s[STEPS] += 1.0
         s[PATH_M] += s[MOVED_M]
         s[COLLISIONS] += s[BUMPED]
@@ -175,11 +212,10 @@ def sense_and_map(
             edges, edge_loss, routers, pts, radio_params, tables, origin, spacing, mean_db,
             true_k, 0, 1,
         )  # fmt: skip
-        offset = 3 if moved[n] and (c[TRANS_STD] > 0.0 or c[HEAD_STD] > 0.0) else 0
         for r in range(n_routers):
             db = mean_db[0, r]
             if c[NOISE_DB] > 0.0:
-                db += 0.0 + c[NOISE_DB] * noise[n, offset + r]
+                db += 0.0 + c[NOISE_DB] * _normal(s, normals)
             reading = np.int32(np.rint(db))
             rssi[r] = NOT_HEARD_DBM if reading < c[SENSITIVITY] else reading
         # the pose it maps at, and the histories
@@ -215,6 +251,7 @@ def sense_and_map(
                 anchors,
             )  # fmt: skip
             s[N_UPDATES] += 1.0
+            _redraw_touched(track, maps[2], int(c[GRID_COLS]), belief_px, px_rows, px_cols)
             n_changed = int(track[3][_S_N_CHANGED])
             if n_changed:
                 _track_changes(
@@ -236,9 +273,10 @@ def sense_and_map(
         rows, cols = int(c[GRID_ROWS]), int(c[GRID_COLS])
         cr = min(max(int((py - c[GY0]) / c[GRID_RES]), 0), rows - 1)
         cc = min(max(int((px - c[GX0]) / c[GRID_RES]), 0), cols - 1)
-        draw_into(
-            maps[2].reshape((rows, cols)), src_r, src_c, pad, trajectory, router_px, pr, pc, cr,
-            cc, int(c[OBS_CROP]), obs_map[i], obs_local[i],
+        obs_map[i, 0] = belief_px
+        draw_rest_into(
+            maps[2].reshape((rows, cols)), trajectory, router_px, pr, pc, cr, cc,
+            int(c[OBS_CROP]), obs_map[i], obs_local[i],
         )  # fmt: skip
         out = obs_state[i]
         slots = int(c[SLOTS])
@@ -285,14 +323,16 @@ def _float_tuple(values: Any) -> tuple[Any, ...]:
 class BatchStepper:
     """The compiled state of ``num_envs`` explore sub-envs (see the module doc)."""
 
-    def __init__(self, num_envs: int, n_router_slots: int) -> None:
+    def __init__(self, num_envs: int) -> None:
         self.state = np.zeros((num_envs, N_STATE))
         self.consts = np.zeros((num_envs, N_CONSTS))
         self.parts: Any = List()
         self._parts: list[Any] = [None] * num_envs
         self._capacity = np.zeros(num_envs, np.int64)
-        self.noise = np.zeros((num_envs, 3 + n_router_slots))
         self.synced = np.ones(num_envs, np.bool_)
+        # the generator's state before the normals of each sub-env were drawn ahead (None: none)
+        self._drawn_from: list[Any] = [None] * num_envs
+        self._normals_per_step = np.zeros(num_envs, np.int64)
 
     # ------------------------------------------------------------------ env <-> arrays
     def load(self, i: int, env: Any) -> None:
@@ -312,10 +352,13 @@ class BatchStepper:
         s[ENTROPY] = env.mapper.entropy_bits
         histories = (env.rssi_history, env.true_path, env.odometry_trajectory, env.pose_estimates)
         buffers = tuple(h._data for h in histories)
+        self._put_back_generator(i)
         if self._parts[i] is None or self._parts[i][0] is not env or any(
             a is not b for a, b in zip(self._parts[i][1], buffers, strict=True)
         ):
             self._attach(i, env, buffers)
+        else:  # the map may have changed outside: redraw its image
+            self._parts[i][4][:] = env.obs_builder.image_of(env.mapper.occupancy_u8)
         self.synced[i] = True
 
     def load_robot(self, i: int, robot: Any, distance_m: float) -> None:
@@ -351,10 +394,14 @@ class BatchStepper:
              mapper._anchors),
             (tracker._est_cls, tracker._truth_cls, tracker._near_wall, tracker._interior,
              tracker._found_by, tracker._offsets, tracker._counts),
-            (builder._src_r, builder._src_c, builder._pad, builder._trajectory, builder._routers),
+            (builder.image_of(mapper.occupancy_u8),
+             _pixels_of(builder._src_r, ~builder._pad.all(axis=1), mapper.grid.shape[0]),
+             _pixels_of(builder._src_c, ~builder._pad.all(axis=0), mapper.grid.shape[1]),
+             builder._trajectory, builder._routers),
             buffers,
             (np.zeros((1, 2)), np.zeros((1, n_r)), np.zeros((1, n_r), np.int32),
              np.zeros(n_r, np.int32)),
+            np.zeros(NORMALS_AHEAD),
         )  # fmt: skip
         if len(self.parts) > i:
             self.parts[i] = parts
@@ -362,7 +409,10 @@ class BatchStepper:
             while len(self.parts) < i:  # sub-envs attach in order at the first reset
                 self.parts.append(parts)
             self.parts.append(parts)
-        self._parts[i] = (env, buffers)
+        self._parts[i] = (env, buffers, radio.rng, parts[-1], parts[4][0])
+        self._drawn_from[i] = None
+        self.state[i, NORMALS_USED] = NORMALS_AHEAD
+        self._normals_per_step[i] = 3 * robot._noisy + n_r * (radio.config.noise_sigma_db > 0)
         self._capacity[i] = min(len(b) for b in buffers)
         rc, grid, ob = cfg.robot, env.grid, builder
         x0, y0, x1, y1 = env._grid_bounds
@@ -381,8 +431,31 @@ class BatchStepper:
         c[TRUE_POSE] = cfg.explore.pose_source == "true"
         c[N_CELLS], c[N_FREE], c[N_INTERIOR] = tracker._n_cells, tracker._n_truth_free, tracker._n_interior
 
+    def draw_ahead(self, active: np.ndarray) -> None:
+        """Draw normals ahead for the ``active`` sub-envs that may run out this step."""
+        short = self.state[active, NORMALS_USED] + self._normals_per_step[active] > NORMALS_AHEAD
+        for i in active[short].tolist():
+            self._put_back_generator(i)
+            _, _, rng, normals, _ = self._parts[i]
+            self._drawn_from[i] = rng.bit_generator.state
+            normals[:] = rng.standard_normal(NORMALS_AHEAD)
+            self.state[i, NORMALS_USED] = 0
+
+    def _put_back_generator(self, i: int) -> None:
+        """Give sub-env ``i``'s generator the state it would have without the draws ahead."""
+        drawn_from = self._drawn_from[i]
+        if drawn_from is not None:
+            rng = self._parts[i][2]
+            rng.bit_generator.state = drawn_from
+            used = int(self.state[i, NORMALS_USED])
+            if used:
+                rng.standard_normal(used)
+            self._drawn_from[i] = None
+            self.state[i, NORMALS_USED] = NORMALS_AHEAD
+
     def sync(self, i: int, env: Any) -> None:
         """Write sub-env ``i``'s state back into its env objects (before anything reads them)."""
+        self._put_back_generator(i)
         if self.synced[i]:
             return
         from sfw_gym.world import Pose

@@ -204,14 +204,31 @@ def draw_into(
     trajectory with the robot's 3 × 3 square at pixel (r, c); the routers) and the ``local`` crop
     of the belief centred on cell (cr, cc) (unknown outside the grid), in one pass."""
     m = src_r.shape[0]
-    image[1] = trajectory
-    image[2] = routers
     for i in range(m):
         row = belief[src_r[i]]
         out = image[0, i]
         padded = pad[i]
         for j in range(m):
             out[j] = U8_UNKNOWN if padded[j] else row[src_c[j]]
+    draw_rest_into(belief, trajectory, routers, r, c, cr, cc, crop, image, local)
+
+
+@njit(cache=True)
+def draw_rest_into(
+    belief: np.ndarray,
+    trajectory: np.ndarray,
+    routers: np.ndarray,
+    r: int,
+    c: int,
+    cr: int,
+    cc: int,
+    crop: int,
+    image: np.ndarray,
+    local: np.ndarray,
+) -> None:
+    """:func:`draw_into` but the belief channel ``image[0]`` (the caller's)."""
+    image[1] = trajectory
+    image[2] = routers
     image[1, max(r - 1, 0) : r + 2, max(c - 1, 0) : c + 2] = ROBOT_U8
     rows, cols = belief.shape
     half = crop // 2

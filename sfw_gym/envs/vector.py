@@ -76,7 +76,7 @@ class SfWVectorEnv(VectorEnv):
         self._terminations = np.zeros(self.num_envs, np.bool_)
         self._truncations = np.zeros(self.num_envs, np.bool_)
         self._autoreset = np.zeros(self.num_envs, np.bool_)
-        self._stepper = BatchStepper(self.num_envs, len(first.observation_space["state"].low))
+        self._stepper = BatchStepper(self.num_envs)
         self._batched = all(_batches(env) for env in self._envs)
         self._plan_names = np.full(self.num_envs, None, dtype=object)
         self._metrics = np.zeros((self.num_envs, len(batch_step.METRICS)))
@@ -165,28 +165,18 @@ class SfWVectorEnv(VectorEnv):
         v, w = self._commands(actions, active)
         stepper.make_room(active, envs)
         moved = batch_step.move_robots(active, v, w, stepper.state, stepper.consts, stepper.parts)
-        noise = stepper.noise
-        for n, i in enumerate(active.tolist()):
-            env = envs[i]
-            robot, radio = env.scene.robot, env.scene.radio
-            if not moved[n]:  # near a wall: pymunk moves it
-                stepper.sync(i, env)
-                result = self._call(i, robot.step, float(v[n]), float(w[n]))
-                stepper.load_robot(i, robot, result.distance_m)
-            odometry = 3 if moved[n] and robot._noisy else 0
-            readings = len(radio.routers) if radio.config.noise_sigma_db > 0 else 0
-            if odometry and readings and robot._rng is radio.rng:
-                noise[n, : odometry + readings] = radio.rng.standard_normal(odometry + readings)
-            else:
-                if odometry:
-                    noise[n, :3] = robot._rng.standard_normal(3)
-                if readings:
-                    noise[n, odometry : odometry + readings] = radio.rng.standard_normal(readings)
+        for n in np.flatnonzero(~moved).tolist():  # near a wall: pymunk moves it
+            i = int(active[n])
+            robot = envs[i].scene.robot
+            stepper.sync(i, envs[i])
+            result = self._call(i, robot.step, float(v[n]), float(w[n]))
+            stepper.load_robot(i, robot, result.distance_m)
+        stepper.draw_ahead(active)
         done = np.zeros(len(active), np.int8)
         due = np.zeros(len(active), np.bool_)
         obs = self._observations
         batch_step.sense_and_map(
-            active, moved, noise, stepper.state, stepper.consts, stepper.parts, obs["map"],
+            active, moved, stepper.state, stepper.consts, stepper.parts, obs["map"],
             obs["local"], obs["state"], self._rewards, self._metrics, done, due,
         )  # fmt: skip
         stepper.synced[active] = False
@@ -320,7 +310,10 @@ def _batches(env: gym.Env) -> bool:
 
 def _episode_batches(env: Any) -> bool:
     """Whether this episode can: reset, on a plan whose walls pymunk holds all at once."""
-    return env.scene is not None and env.scene.robot._active_walls is None
+    if env.scene is None:
+        return False
+    robot = env.scene.robot
+    return robot._active_walls is None and (robot._rng is env.scene.radio.rng or not robot._noisy)
 
 
 def _merge_rows(batched: dict[str, Any], infos: list[dict[str, Any] | None]) -> dict[str, Any]:
