@@ -267,12 +267,19 @@ def _cmd_train(args: argparse.Namespace) -> int:
         resume=args.resume,
         progress_bar=not args.no_progress,
         num_threads=args.num_threads or None,
+        vec_env=args.vec_env,
     )
     print(
         f"trained {args.env} to "
         f"{summary['steps']:,} steps in {summary['wall_time_s']:.0f} s; model: {summary['model']}"
     )
     return 0
+
+
+def _vec_envs() -> tuple[str, ...]:
+    from sfw_gym.rl.training import VEC_ENVS
+
+    return VEC_ENVS
 
 
 def _train_on_rllib(args: argparse.Namespace) -> int:
@@ -677,6 +684,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     train.add_argument(
         "--n-envs", type=positive_int, default=None, help="parallel envs (default: YAML)"
+    )
+    train.add_argument(
+        "--vec-env",
+        choices=_vec_envs(),
+        default="native",
+        help="native: the n envs step together in this process (default; SubprocVecEnv under "
+        "an env_wrapper); subproc: SB3's SubprocVecEnv, one worker process per env",
     )
     train.add_argument("--seed", type=seed_int, default=0, help="seed of the run (default 0)")
     train.add_argument(

@@ -313,6 +313,13 @@ def sense_and_map(
             done[n] = 2
 
 
+def _read_only(array: np.ndarray) -> np.ndarray:
+    """A read-only view: one numba type whether the array came read-only or unpickled."""
+    view = array.view()
+    view.flags.writeable = False
+    return view
+
+
 def _float_tuple(values: Any) -> tuple[Any, ...]:
     """A tuple with Python numbers as floats, bools kept (one numba type for every sub-env)."""
     return tuple(
@@ -385,9 +392,9 @@ class BatchStepper:
         ke = mapper._k_estimator
         table, origin, spacing = radio._shadow_args
         parts = (
-            robot._walls,
-            (radio.floorplan.edges, radio._edge_loss_db, radio.routers, radio._params, table,
-             origin, float(spacing)),
+            _read_only(robot._walls),
+            (*map(_read_only, (radio.floorplan.edges, radio._edge_loss_db, radio.routers,
+                               radio._params, table, origin)), float(spacing)),
             (mapper._routers_g, bool(mapper._policy_all), bool(mapper.config.extend_past_robot),
              mapper._params, _float_tuple(mapper._kest), ke._feature, ke._k, mapper._selected,
              mapper._dist, mapper._raster, mapper._maps, mapper._track, mapper._ray,

@@ -14,6 +14,7 @@ by one in Python, as do resets, a robot next to a wall (pymunk) and an episode's
 
 from __future__ import annotations
 
+import pickle
 from functools import partial
 from typing import Any
 
@@ -244,6 +245,19 @@ class SfWVectorEnv(VectorEnv):
         for env, value in zip(self.envs, values, strict=True):
             env.set_wrapper_attr(name, value)
         self._load_all()
+
+    def snapshot(self, i: int) -> bytes:
+        """Sub-env ``i``'s whole state (its wrappers, the env, its generator) as bytes."""
+        self._stepper.sync(i, self._envs[i])
+        return pickle.dumps(self._envs[i])
+
+    def restore(self, i: int, blob: bytes) -> None:
+        """Put back a sub-env state from :meth:`snapshot` as sub-env ``i``."""
+        self._envs[i] = env = pickle.loads(blob)
+        self._autoreset[i] = False
+        if self._batched and _episode_batches(env):
+            self._stepper.load(i, env)
+            self._plan_names[i] = env.scene.floorplan.name
 
     def close_extras(self, **kwargs: Any) -> None:
         for env in self.envs:

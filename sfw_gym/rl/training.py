@@ -252,6 +252,11 @@ def _make_env_fn(env_id: str, env_kwargs: dict[str, Any], wrappers: list[tuple[s
     return make
 
 
+#: ``vec_env`` choices of `train_ppo`: the native vector env in this process (each sub-env a
+#: bare env; with an ``env_wrapper``, SubprocVecEnv instead), or SB3's worker processes.
+VEC_ENVS = ("native", "subproc")
+
+
 def _make_venv(
     env_id: str,
     n_envs: int,
@@ -259,13 +264,26 @@ def _make_venv(
     env_kwargs: dict[str, Any],
     wrappers: list[tuple[str, dict]],
     monitor: Path,
+    vec_env: str = "native",
 ):
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecMonitor
 
     # Workers start by forkserver and have not imported sfw_gym: name the module in the id.
     qualified = env_id if ":" in env_id else f"sfw_gym:{env_id}"
-    fns = [_make_env_fn(qualified, env_kwargs, wrappers) for _ in range(n_envs)]
-    venv = SubprocVecEnv(fns) if n_envs > 1 else DummyVecEnv(fns)
+    venv: Any
+    if n_envs > 1 and vec_env == "native" and not wrappers:
+        import gymnasium as gym
+
+        from sfw_gym.rl.vec_env import SB3VecEnv
+
+        venv = SB3VecEnv(
+            gym.make_vec(
+                qualified, num_envs=n_envs, vectorization_mode="vector_entry_point", **env_kwargs
+            )
+        )
+    else:
+        fns = [_make_env_fn(qualified, env_kwargs, wrappers) for _ in range(n_envs)]
+        venv = SubprocVecEnv(fns) if n_envs > 1 else DummyVecEnv(fns)
     if seed is not None:  # None: the envs' states are restored instead
         venv.seed(seed)
     # The floorplan column lets a later comparison prove its plans were never trained on.
@@ -289,6 +307,7 @@ def train_ppo(
     device: str = "auto",
     algo: str = "ppo",
     num_threads: int | None = 1,
+    vec_env: str = "native",
 ) -> dict[str, Any]:
     """Train (or resume training) PPO on ``env_id`` up to ``timesteps`` env steps in total
     (None: the hyperparameters' ``n_timesteps``, as rl-zoo).
@@ -307,6 +326,11 @@ def train_ppo(
     ``num_threads``: PyTorch's CPU threads in this process (rl-zoo's ``--num-threads``; None:
     PyTorch's default). One suits these small networks: more contend with the env workers for
     the cores (a policy 5× slower measured on a busy 2-core machine).
+
+    ``vec_env``: ``"native"`` steps the ``n_envs`` envs together in this process
+    (`sfw_gym.envs.vector`, through `sfw_gym.rl.vec_env.SB3VecEnv`; an ``env_wrapper`` in the
+    YAML makes it SubprocVecEnv, as the wrapped envs do not step together); ``"subproc"``:
+    SB3's SubprocVecEnv. Both give the same episodes for the same seed.
     """
     from stable_baselines3.common.callbacks import CallbackList
 
@@ -318,6 +342,8 @@ def train_ppo(
         torch.set_num_threads(num_threads)
     if algo not in ALGOS:
         raise ConfigError(f"unknown algo {algo!r}; known: {list(ALGOS)}")
+    if vec_env not in VEC_ENVS:
+        raise ConfigError(f"unknown vec_env {vec_env!r}; known: {list(VEC_ENVS)}")
     Algo: Any
     EvalCallback: Any
     params = load_hyperparams(env_id, hyperparams_path)
@@ -375,6 +401,7 @@ def train_ppo(
             env_kwargs,
             wrappers,
             out / f"train_{start_steps}.monitor.csv",
+            vec_env,
         )
         eval_env = _make_venv(
             env_id,

@@ -99,6 +99,13 @@ class SB3VecEnv(VecEnv):
     def env_method(
         self, method_name: str, *method_args: Any, indices: Any = None, **method_kwargs: Any
     ) -> list[Any]:
+        """Each sub-env's method; ``snapshot`` and ``restore`` (`sfw_gym.rl.resume`'s): the
+        vector env's, which keep a sub-env's whole state as bytes."""
+        if method_name in ("snapshot", "restore") and hasattr(self.venv, method_name):
+            method = getattr(self.venv, method_name)
+            return [
+                method(i, *method_args, **method_kwargs) for i in self._get_indices(indices)
+            ]
         envs = self.venv.envs
         return [
             envs[i].get_wrapper_attr(method_name)(*method_args, **method_kwargs)
