@@ -9,69 +9,76 @@ import pytest
 
 import sfw_gym  # noqa: F401  (registers the ids)
 from sfw_gym.core.errors import ConfigError
-from sfw_gym.envs.vector import SfWVectorEnv
+from sfw_gym.envs.vector import SfWVectorEnv, batch_infos
 
 SMALL = "SfW-ExploreSmall-v0"
 
 
-def single_run(env_id: str, seed: int, actions: list, **kwargs) -> list:
+def single_run(env_id: str, seed: int, actions: list, **kwargs) -> tuple[list, gym.Env]:
     """The single env driven by ``actions`` with NEXT_STEP autoreset: per step (obs, reward,
-    terminated, truncated)."""
+    terminated, truncated, info), and the env."""
     env = gym.make(env_id, **kwargs)
     obs, _ = env.reset(seed=seed)
     out, done = [], False
     for action in actions:
         if done:
-            obs, _ = env.reset()
+            obs, info = env.reset()
             reward, terminated, truncated = 0.0, False, False
         else:
-            obs, reward, terminated, truncated, _ = env.step(action)
-        out.append((obs, reward, terminated, truncated))
+            obs, reward, terminated, truncated, info = env.step(action)
+        out.append((obs, reward, terminated, truncated, info))
         done = terminated or truncated
-    return out
+    return out, env
 
 
 @pytest.mark.parametrize(
     ("env_id", "steps", "kwargs"),
     [
         (SMALL, 1000, {"max_steps": 120}),  # eight episodes a sub-env, wall contacts
-        pytest.param("SfW-ExploreGoals-v0", 30, {}, marks=pytest.mark.episode),
+        pytest.param(SMALL, 1000, {"max_steps": 150, "pose_source": "true"}, marks=pytest.mark.slow),
+        pytest.param(  # odometry noise: normals drawn ahead for the robot and the radio
+            SMALL,
+            1000,
+            {"robot": {"odometry_translation_std": 0.05, "odometry_heading_std_rad": 0.02}},
+            marks=pytest.mark.slow,
+        ),
+        pytest.param("SfW-ExploreDiscrete-v0", 1000, {}, marks=pytest.mark.slow),
+        pytest.param("SfW-ExploreGoals-v0", 30, {}, marks=pytest.mark.episode),  # not batched
     ],
 )
 def test_each_sub_env_is_the_single_env_with_its_seed_through_autoresets(env_id, steps, kwargs):
+    """Observations, rewards, ends and infos, bit for bit, and the generators and robots left
+    in the same state; the explore sub-envs step together (batch_step), near walls included."""
     seeds = [4, 9, 13]
     vec = gym.make_vec(env_id, num_envs=len(seeds), **kwargs)
     assert isinstance(vec, SfWVectorEnv)
+    assert vec._batched == (env_id != "SfW-ExploreGoals-v0")  # Goals: one by one in Python
     vec.action_space.seed(0)
     actions = [vec.action_space.sample() for _ in range(steps)]
     vec.reset(seed=seeds)
     got = [vec.step(a) for a in actions]
     ends = 0
+    runs, singles = [], []
     for i, seed in enumerate(seeds):
-        expected = single_run(env_id, seed, [a[i] for a in actions], **kwargs)
-        for (obs, reward, terminated, truncated), step in zip(expected, got, strict=True):
+        expected, env = single_run(env_id, seed, [a[i] for a in actions], **kwargs)
+        runs.append(expected)
+        singles.append(env)
+        for (obs, reward, terminated, truncated, _), step in zip(expected, got, strict=True):
             for key in obs:
                 np.testing.assert_array_equal(step[0][key][i], obs[key])
             assert (step[1][i], step[2][i], step[3][i]) == (reward, terminated, truncated)
             ends += terminated or truncated
+    for t, step in enumerate(got):
+        _same(step[4], batch_infos([run[t][4] for run in runs]))
+    for env, sub in zip(singles, vec.envs, strict=True):
+        assert sub.np_random.bit_generator.state == env.unwrapped.np_random.bit_generator.state
+        if vec._batched:
+            assert sub.unwrapped.scene.robot.pose == env.unwrapped.scene.robot.pose
+            assert sub.unwrapped.collisions == env.unwrapped.collisions
+    if vec._batched:
+        assert sum(env.unwrapped.collisions for env in singles) > 0  # contacts were compared
     assert ends >= (len(seeds) if env_id == SMALL else 0)  # autoresets were compared
     vec.close()
-
-
-def test_the_native_env_passes_the_vector_api_checks():
-    vec = gym.make_vec(SMALL, num_envs=2)
-    obs, info = vec.reset(seed=0)
-    assert vec.observation_space.contains(obs) and "coverage" in info
-    assert vec.metadata["autoreset_mode"] is gym.vector.AutoresetMode.NEXT_STEP
-    obs, rewards, terminated, truncated, info = vec.step(vec.action_space.sample())
-    assert vec.observation_space.contains(obs)
-    assert rewards.shape == terminated.shape == truncated.shape == (2,)
-    assert info["_coverage"].all()
-    again, _ = gym.make_vec(SMALL, num_envs=2).reset(seed=0)  # int seed: seed + i
-    first, _ = vec.reset(seed=0)
-    np.testing.assert_array_equal(again["map"], first["map"])
-    assert not np.array_equal(first["map"][0], first["map"][1])
-    assert gym.make_vec(SMALL, num_envs=2, vectorization_mode="sync").num_envs == 2
 
 
 def test_a_bad_action_or_option_names_its_sub_env():
@@ -130,3 +137,19 @@ def test_a_batch_handed_out_is_never_written_again():
             np.testing.assert_array_equal(batch[key], copy[key])
     with pytest.raises(ConfigError, match="at least one True"):
         vec.reset(options={"reset_mask": np.array([False, False])})
+
+
+def test_a_sub_env_restored_from_its_snapshot_continues_as_it_did():
+    """The resume state of ``sfw-gym train`` on the native env: a snapshot taken mid-episode
+    (normals drawn ahead, state not yet written back) and restored replays the same steps."""
+    vec = gym.make_vec(SMALL, num_envs=2, max_steps=60)
+    vec.reset(seed=[1, 2])
+    vec.action_space.seed(0)
+    actions = [vec.action_space.sample() for _ in range(90)]
+    for a in actions[:20]:
+        vec.step(a)
+    blob = vec.snapshot(1)
+    first = [vec.step(a)[0]["state"][1].copy() for a in actions[20:]]
+    vec.restore(1, blob)
+    again = [vec.step(a)[0]["state"][1].copy() for a in actions[20:]]
+    np.testing.assert_array_equal(np.array(first), np.array(again))
