@@ -1,14 +1,17 @@
 """Env steps/s of N SfW envs: the native vector env (``gym.make_vec``'s default) beside
 Gymnasium's ``SyncVectorEnv`` and ``AsyncVectorEnv``, each as a multiple of one env's steps/s
-measured in the same run (issue 33).
+measured in the same run; and P processes each stepping a native N-env batch at once (issue 33).
 
     python scripts/bench_vector_envs.py --env SfW-Explore-v0 --num-envs 16 --steps 200
+    python scripts/bench_vector_envs.py --floorplan ../shared/floorplans/houseexpo/PLAN.json
 """
 
 from __future__ import annotations
 
 import argparse
+import multiprocessing
 import time
+from typing import Any
 
 import gymnasium as gym
 
@@ -32,24 +35,44 @@ def env_steps_per_s(env: gym.Env | gym.vector.VectorEnv, steps: int, batch: int)
     return rate
 
 
+def _native_rate(job: tuple[str, int, int, dict[str, Any], Any]) -> float:
+    """One worker process of the P-process row: its native batch's env steps/s, timed after
+    every worker is ready (``barrier``)."""
+    env_id, n, steps, kwargs, barrier = job
+    vec = gym.make_vec(env_id, num_envs=n, **kwargs)
+    env_steps_per_s(vec, 20, n)  # compile and first resets outside the timing
+    barrier.wait()
+    return env_steps_per_s(gym.make_vec(env_id, num_envs=n, **kwargs), steps, n)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--env", default="SfW-Explore-v0")
     parser.add_argument("--num-envs", type=int, default=16)
     parser.add_argument("--steps", type=int, default=200, help="vector steps per measurement")
+    parser.add_argument("--processes", type=int, default=2, help="processes of the last row")
+    parser.add_argument("--floorplan", default=None, help="a plan file for every episode")
     args = parser.parse_args()
-    n = args.num_envs
-    env_steps_per_s(gym.make(args.env), 200, 1)  # warm-up: compiled kernels, first resets
-    one = env_steps_per_s(gym.make(args.env), args.steps, 1)  # as far into its episode as each
+    n, kwargs = args.num_envs, {} if args.floorplan is None else {"floorplan": args.floorplan}
+    env_steps_per_s(gym.make(args.env, **kwargs), 200, 1)  # warm-up: compiled kernels
+    one = env_steps_per_s(gym.make(args.env, **kwargs), args.steps, 1)
     rows = [("one env", one)]
     for mode in ("vector_entry_point", "sync"):
-        vec = gym.make_vec(args.env, num_envs=n, vectorization_mode=mode)
+        vec = gym.make_vec(args.env, num_envs=n, vectorization_mode=mode, **kwargs)
         rows.append((f"{n} envs, {mode}", env_steps_per_s(vec, args.steps, n)))
-    vec = gym.make_vec(args.env, num_envs=2, vectorization_mode="async")
+    vec = gym.make_vec(args.env, num_envs=2, vectorization_mode="async", **kwargs)
     rows.append(("2 envs, async (2 processes)", env_steps_per_s(vec, args.steps * 2, 2)))
+    p = args.processes
+    context = multiprocessing.get_context("spawn")
+    barrier = context.Manager().Barrier(p)
+    with context.Pool(p) as pool:
+        rates = pool.map(_native_rate, [(args.env, n, args.steps, kwargs, barrier)] * p)
+    rows.append((f"{p} processes x {n} envs, native", sum(rates)))
     print(f"{args.env}: env steps/s, and as a multiple of one env's in this run")
     for name, rate in rows:
         print(f"  {name:34s} {rate:10,.0f}  {rate / one:5.2f}x")
+    native = rows[1][1]
+    print(f"  {p} processes / one process (native, {n} envs each): {sum(rates) / native:.2f}x")
 
 
 if __name__ == "__main__":
