@@ -1,4 +1,4 @@
-"""The explore env's step for many sub-envs in two compiled calls: the native vector env's fast path.
+"""The explore env's step for many sub-envs in two compiled calls: the vector env's fast path.
 
 :class:`BatchStepper` holds, per sub-env, the episode's arrays (walls, radio tables, the mapper's,
 the tracker's and the observation builder's buffers, the histories) in one numba list, and its
@@ -24,7 +24,6 @@ from numba.typed import List
 
 from sfw_gym.core.constants import NOT_HEARD_DBM
 from sfw_gym.core.exact_math import hypot, wrap_angle
-from sfw_gym.envs.map_tracker import _apply as _track_changes
 from sfw_gym.envs.map_tracker import (
     _AGREE,
     _COVERED,
@@ -36,6 +35,7 @@ from sfw_gym.envs.map_tracker import (
     _N_KNOWN,
     _WALL_NEAR,
 )
+from sfw_gym.envs.map_tracker import _apply as _track_changes
 from sfw_gym.envs.observation import RSSI_FLOOR_DBM, RSSI_SPAN_DB, TRAJECTORY_U8, draw_rest_into
 from sfw_gym.mapping.sparse import _S_ENTROPY, _S_N_CHANGED, _S_N_TOUCHED, _update_kernel
 from sfw_gym.world import robot as robot_module
@@ -95,7 +95,9 @@ def move_robots(active, v, w, state, consts, parts):
             continue
         reach = c[RADIUS] + abs(vi) * c[PERIOD] + robot_module._REACH_MARGIN_M
         if (
-            s[CLEAR_D] - hypot(x0 - s[CLEAR_X], y0 - s[CLEAR_Y]) - robot_module._CLEARANCE_ROUNDING_M
+            s[CLEAR_D]
+            - hypot(x0 - s[CLEAR_X], y0 - s[CLEAR_Y])
+            - robot_module._CLEARANCE_ROUNDING_M
             < reach
         ):
             look = reach + robot_module._CLEARANCE_LOOKAHEAD_M
@@ -191,7 +193,7 @@ def sense_and_map(
     for n in range(active.shape[0]):
         i = active[n]
         s, c = state[i], consts[i]
-        walls, radio, mapper, tracker, builder, history, scratch, normals = parts[i]
+        _, radio, mapper, tracker, builder, history, scratch, normals = parts[i]
         edges, edge_loss, routers, radio_params, tables, origin, spacing = radio
         (routers_g, policy_all, extend, map_params, kest, feature, k_est, selected, dist_buf,
          raster, maps, track, ray, anchors) = mapper  # fmt: skip
@@ -322,9 +324,7 @@ def _read_only(array: np.ndarray) -> np.ndarray:
 
 def _float_tuple(values: Any) -> tuple[Any, ...]:
     """A tuple with Python numbers as floats, bools kept (one numba type for every sub-env)."""
-    return tuple(
-        v if isinstance(v, np.ndarray | bool | np.bool_) else float(v) for v in values
-    )
+    return tuple(v if isinstance(v, np.ndarray | bool | np.bool_) else float(v) for v in values)
 
 
 class BatchStepper:
@@ -360,8 +360,10 @@ class BatchStepper:
         histories = (env.rssi_history, env.true_path, env.odometry_trajectory, env.pose_estimates)
         buffers = tuple(h._data for h in histories)
         self._put_back_generator(i)
-        if self._parts[i] is None or self._parts[i][0] is not env or any(
-            a is not b for a, b in zip(self._parts[i][1], buffers, strict=True)
+        if (
+            self._parts[i] is None
+            or self._parts[i][0] is not env
+            or any(a is not b for a, b in zip(self._parts[i][1], buffers, strict=True))
         ):
             self._attach(i, env, buffers)
         else:  # the map may have changed outside: redraw its image
@@ -424,8 +426,16 @@ class BatchStepper:
         rc, grid, ob = cfg.robot, env.grid, builder
         x0, y0, x1, y1 = env._grid_bounds
         c = self.consts[i]
-        c[RADIUS], c[MAX_V], c[MAX_W] = rc.radius_m, rc.max_linear_speed_m_s, rc.max_angular_speed_rad_s
-        c[PERIOD], c[SUBSTEPS], c[WALL_R] = rc.control_period_s, rc.physics_substeps, rc.wall_radius_m
+        c[RADIUS], c[MAX_V], c[MAX_W] = (
+            rc.radius_m,
+            rc.max_linear_speed_m_s,
+            rc.max_angular_speed_rad_s,
+        )
+        c[PERIOD], c[SUBSTEPS], c[WALL_R] = (
+            rc.control_period_s,
+            rc.physics_substeps,
+            rc.wall_radius_m,
+        )
         c[TRANS_STD], c[HEAD_STD] = rc.odometry_translation_std, rc.odometry_heading_std_rad
         c[NOISE_DB], c[SENSITIVITY] = radio.config.noise_sigma_db, radio.config.sensitivity_dbm
         c[GX0], c[GY0], c[GX1], c[GY1], c[GRID_RES] = x0, y0, x1, y1, grid.resolution_m
@@ -434,9 +444,17 @@ class BatchStepper:
         c[OBS_MAP_PX], c[OBS_CROP] = ob.map_px, ob.crop_px
         c[OBS_WIDTH_M], c[OBS_HEIGHT_M] = ob._width_m, ob._height_m
         c[SCALE], c[PENALTY] = cfg.reward.reward_scale, cfg.reward.collision_penalty
-        c[TARGET], c[MAX_K], c[SLOTS] = cfg.reward.coverage_target, cfg.mapper.max_k, ob.n_router_slots
+        c[TARGET], c[MAX_K], c[SLOTS] = (
+            cfg.reward.coverage_target,
+            cfg.mapper.max_k,
+            ob.n_router_slots,
+        )
         c[TRUE_POSE] = cfg.explore.pose_source == "true"
-        c[N_CELLS], c[N_FREE], c[N_INTERIOR] = tracker._n_cells, tracker._n_truth_free, tracker._n_interior
+        c[N_CELLS], c[N_FREE], c[N_INTERIOR] = (
+            tracker._n_cells,
+            tracker._n_truth_free,
+            tracker._n_interior,
+        )
 
     def draw_ahead(self, active: np.ndarray) -> None:
         """Draw normals ahead for the ``active`` sub-envs that may run out this step."""
@@ -477,7 +495,11 @@ class BatchStepper:
             robot._unsynced = (s[X], s[Y], s[A], s[VX], s[VY], s[W])
         robot._drive_by_callback(bool(s[CALLBACK]))
         env.steps, env.path_length_m = int(s[STEPS]), s[PATH_M]
-        env.collisions, env.k_correct, env.k_total = int(s[COLLISIONS]), int(s[K_CORRECT]), int(s[K_TOTAL])
+        env.collisions, env.k_correct, env.k_total = (
+            int(s[COLLISIONS]),
+            int(s[K_CORRECT]),
+            int(s[K_TOTAL]),
+        )
         env.steps_to = {0.5: int(s[TO_50]), 0.9: int(s[TO_90])}
         env.pose_estimate = Pose(s[EST_X], s[EST_Y], s[EST_T])
         env._squared_pose_errors, env.last_gain_bits = s[SQ_ERR], s[GAIN]
@@ -505,9 +527,7 @@ class BatchStepper:
         k_total = s[:, K_TOTAL]
         columns: dict[str, Any] = {name: metrics[:, j].copy() for j, name in enumerate(METRICS)}
         columns |= {
-            "k_accuracy": np.divide(
-                s[:, K_CORRECT], k_total, out=np.zeros(n), where=k_total > 0
-            ),
+            "k_accuracy": np.divide(s[:, K_CORRECT], k_total, out=np.zeros(n), where=k_total > 0),
             "path_length_m": s[:, PATH_M].copy(),
             "collisions": s[:, COLLISIONS].astype(np.int64),
             "true_pose": s[:, [X, Y, TRUE_T]],

@@ -34,7 +34,7 @@ def draw_frame(
     routers_xy: np.ndarray,
     pose: Sequence[float],
     odometry_pose: Sequence[float],
-    trajectory: Sequence[tuple[float, float]],
+    trajectory: Sequence[tuple[float, float]] | np.ndarray,
     odometry_trajectory: Sequence[tuple[float, float]] | np.ndarray,
     robot_radius_m: float,
     size: tuple[int, int] | None = None,

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import pickle
 from functools import partial
-from typing import Any
+from typing import Any, cast
 
 import gymnasium as gym
 import numpy as np
@@ -158,7 +158,7 @@ class SfWVectorEnv(VectorEnv):
         """Step the sub-envs that can go through `batch_step` (not resetting, on a plan whose
         robot pymunk does not hold in part); returns which did. The last step of an episode
         gets its info (with the summary) from the env."""
-        stepper, envs = self._stepper, self._envs
+        stepper, envs = self._stepper, cast(list[Any], self._envs)
         can = ~self._autoreset & np.array([_episode_batches(env) for env in envs])
         active = np.flatnonzero(can)
         if not len(active):
@@ -197,7 +197,7 @@ class SfWVectorEnv(VectorEnv):
     def _commands(self, actions: Any, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The ``active`` sub-envs' (linear, angular) commands, as `SfWExploreEnv._command`
         makes them (an unusual action goes through it, its error naming the sub-env)."""
-        env = self._envs[0]
+        env: Any = self._envs[0]
         cfg = env.config.robot
         a = actions if isinstance(actions, np.ndarray) else np.asarray(actions, dtype=object)
         if env.config.explore.action_type == "discrete":
@@ -253,11 +253,10 @@ class SfWVectorEnv(VectorEnv):
 
     def restore(self, i: int, blob: bytes) -> None:
         """Put back a sub-env state from :meth:`snapshot` as sub-env ``i``."""
-        self._envs[i] = env = pickle.loads(blob)
+        env: Any = pickle.loads(blob)
+        self._envs[i] = env
         self._autoreset[i] = False
-        if self._batched and _episode_batches(env):
-            self._stepper.load(i, env)
-            self._plan_names[i] = env.scene.floorplan.name
+        self._load(i, env)
 
     def close_extras(self, **kwargs: Any) -> None:
         for env in self.envs:
@@ -270,10 +269,14 @@ class SfWVectorEnv(VectorEnv):
             return self._call(i, getattr(env, method), *args, **kwargs)
         self._stepper.sync(i, env)
         out = self._call(i, getattr(env, method), *args, **kwargs)
-        if _episode_batches(env):
+        self._load(i, env)
+        return out
+
+    def _load(self, i: int, env: Any) -> None:
+        """Read sub-env ``i`` into the batched state, if this episode steps there."""
+        if self._batched and _episode_batches(env):
             self._stepper.load(i, env)
             self._plan_names[i] = env.scene.floorplan.name
-        return out
 
     @staticmethod
     def _call(i: int, fn: Any, *args: Any, **kwargs: Any) -> Any:
@@ -289,10 +292,8 @@ class SfWVectorEnv(VectorEnv):
                 self._stepper.sync(i, env)
 
     def _load_all(self) -> None:
-        if self._batched:
-            for i, env in enumerate(self._envs):
-                if _episode_batches(env):
-                    self._stepper.load(i, env)
+        for i, env in enumerate(self._envs):
+            self._load(i, env)
 
     def _empty_batch(self, fn: Any = np.empty) -> dict[str, np.ndarray]:
         return create_empty_array(self.single_observation_space, self.num_envs, fn=fn)  # type: ignore[return-value]

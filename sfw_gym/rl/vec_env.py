@@ -103,9 +103,7 @@ class SB3VecEnv(VecEnv):
         vector env's, which keep a sub-env's whole state as bytes."""
         if method_name in ("snapshot", "restore") and hasattr(self.venv, method_name):
             method = getattr(self.venv, method_name)
-            return [
-                method(i, *method_args, **method_kwargs) for i in self._get_indices(indices)
-            ]
+            return [method(i, *method_args, **method_kwargs) for i in self._get_indices(indices)]
         envs = self.venv.envs
         return [
             envs[i].get_wrapper_attr(method_name)(*method_args, **method_kwargs)

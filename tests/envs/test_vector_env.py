@@ -35,7 +35,9 @@ def single_run(env_id: str, seed: int, actions: list, **kwargs) -> tuple[list, g
     ("env_id", "steps", "kwargs"),
     [
         (SMALL, 1000, {"max_steps": 120}),  # eight episodes a sub-env, wall contacts
-        pytest.param(SMALL, 1000, {"max_steps": 150, "pose_source": "true"}, marks=pytest.mark.slow),
+        pytest.param(
+            SMALL, 1000, {"max_steps": 150, "pose_source": "true"}, marks=pytest.mark.slow
+        ),
         pytest.param(  # odometry noise: normals drawn ahead for the robot and the radio
             SMALL,
             1000,
