@@ -16,7 +16,7 @@ anything else reads or steps it, and :meth:`BatchStepper.load` reads it after.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numba import njit
@@ -327,6 +327,16 @@ def _float_tuple(values: Any) -> tuple[Any, ...]:
     return tuple(v if isinstance(v, np.ndarray | bool | np.bool_) else float(v) for v in values)
 
 
+class _Episode(NamedTuple):
+    """What a sub-env's batched state was gathered from, and the Python handles to keep."""
+
+    env: Any
+    buffers: tuple[np.ndarray, ...]  # the histories' arrays (they move when they grow)
+    rng: np.random.Generator
+    normals: np.ndarray  # drawn ahead from ``rng``
+    belief_px: np.ndarray  # the map image's belief channel, kept up to date
+
+
 class BatchStepper:
     """The compiled state of ``num_envs`` explore sub-envs (see the module doc)."""
 
@@ -334,7 +344,7 @@ class BatchStepper:
         self.state = np.zeros((num_envs, N_STATE))
         self.consts = np.zeros((num_envs, N_CONSTS))
         self.parts: Any = List()
-        self._parts: list[Any] = [None] * num_envs
+        self._episodes: list[Any] = [None] * num_envs  # an _Episode once attached
         self._capacity = np.zeros(num_envs, np.int64)
         self.synced = np.ones(num_envs, np.bool_)
         # the generator's state before the normals of each sub-env were drawn ahead (None: none)
@@ -361,13 +371,13 @@ class BatchStepper:
         buffers = tuple(h._data for h in histories)
         self._put_back_generator(i)
         if (
-            self._parts[i] is None
-            or self._parts[i][0] is not env
-            or any(a is not b for a, b in zip(self._parts[i][1], buffers, strict=True))
+            self._episodes[i] is None
+            or self._episodes[i].env is not env
+            or any(a is not b for a, b in zip(self._episodes[i].buffers, buffers, strict=True))
         ):
             self._attach(i, env, buffers)
         else:  # the map may have changed outside: redraw its image
-            self._parts[i][4][:] = env.obs_builder.image_of(env.mapper.occupancy_u8)
+            self._episodes[i].belief_px[:] = env.obs_builder.image_of(env.mapper.occupancy_u8)
         self.synced[i] = True
 
     def load_robot(self, i: int, robot: Any, distance_m: float) -> None:
@@ -418,7 +428,7 @@ class BatchStepper:
             while len(self.parts) < i:  # sub-envs attach in order at the first reset
                 self.parts.append(parts)
             self.parts.append(parts)
-        self._parts[i] = (env, buffers, radio.rng, parts[-1], parts[4][0])
+        self._episodes[i] = _Episode(env, buffers, radio.rng, parts[-1], parts[4][0])
         self._drawn_from[i] = None
         self.state[i, NORMALS_USED] = NORMALS_AHEAD
         self._normals_per_step[i] = 3 * robot._noisy + n_r * (radio.config.noise_sigma_db > 0)
@@ -461,7 +471,7 @@ class BatchStepper:
         short = self.state[active, NORMALS_USED] + self._normals_per_step[active] > NORMALS_AHEAD
         for i in active[short].tolist():
             self._put_back_generator(i)
-            _, _, rng, normals, _ = self._parts[i]
+            rng, normals = self._episodes[i].rng, self._episodes[i].normals
             self._drawn_from[i] = rng.bit_generator.state
             normals[:] = rng.standard_normal(NORMALS_AHEAD)
             self.state[i, NORMALS_USED] = 0
@@ -470,7 +480,7 @@ class BatchStepper:
         """Give sub-env ``i``'s generator the state it would have without the draws ahead."""
         drawn_from = self._drawn_from[i]
         if drawn_from is not None:
-            rng = self._parts[i][2]
+            rng = self._episodes[i].rng
             rng.bit_generator.state = drawn_from
             used = int(self.state[i, NORMALS_USED])
             if used:

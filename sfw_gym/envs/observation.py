@@ -176,34 +176,12 @@ def _draw(
     cc: int,
     crop: int,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`draw_into` new arrays: the ``map`` image and the ``local`` crop."""
-    m = src_r.shape[0]
-    image = np.empty((3, m, m), np.uint8)
-    local = np.empty((1, crop, crop), np.uint8)
-    draw_into(belief, src_r, src_c, pad, trajectory, routers, r, c, cr, cc, crop, image, local)
-    return image, local
-
-
-@njit(cache=True)
-def draw_into(
-    belief: np.ndarray,
-    src_r: np.ndarray,
-    src_c: np.ndarray,
-    pad: np.ndarray,
-    trajectory: np.ndarray,
-    routers: np.ndarray,
-    r: int,
-    c: int,
-    cr: int,
-    cc: int,
-    crop: int,
-    image: np.ndarray,
-    local: np.ndarray,
-) -> None:
-    """Write the ``map`` image (the belief sampled at ``src_r × src_c``, unknown on ``pad``; the
+    """The ``map`` image (the belief sampled at ``src_r × src_c``, unknown on ``pad``; the
     trajectory with the robot's 3 × 3 square at pixel (r, c); the routers) and the ``local`` crop
     of the belief centred on cell (cr, cc) (unknown outside the grid), in one pass."""
     m = src_r.shape[0]
+    image = np.empty((3, m, m), np.uint8)
+    local = np.empty((1, crop, crop), np.uint8)
     for i in range(m):
         row = belief[src_r[i]]
         out = image[0, i]
@@ -211,6 +189,7 @@ def draw_into(
         for j in range(m):
             out[j] = U8_UNKNOWN if padded[j] else row[src_c[j]]
     draw_rest_into(belief, trajectory, routers, r, c, cr, cc, crop, image, local)
+    return image, local
 
 
 @njit(cache=True)
@@ -226,7 +205,8 @@ def draw_rest_into(
     image: np.ndarray,
     local: np.ndarray,
 ) -> None:
-    """:func:`draw_into` but the belief channel ``image[0]`` (the caller's)."""
+    """Write every part of :func:`_draw`'s ``map`` image but its belief channel ``image[0]``
+    (the caller's), and the ``local`` crop."""
     image[1] = trajectory
     image[2] = routers
     image[1, max(r - 1, 0) : r + 2, max(c - 1, 0) : c + 2] = ROBOT_U8
