@@ -65,26 +65,10 @@ def _ratio(num: float, den: float) -> float:
 
 
 @njit(cache=True)
-def _clearance_to_walls(walls, wall_radius, x, y, look):
-    """The distance from (x, y) to the nearest wall's surface, or ``look`` if none is nearer:
-    pymunk's ``point_query_nearest`` answer up to rounding (it only decides whether pymunk is
-    asked to move the robot, never where the robot goes)."""
-    best = look
-    for e in range(walls.shape[0]):
-        ax, ay, bx, by = walls[e, 0], walls[e, 1], walls[e, 2], walls[e, 3]
-        dx, dy = bx - ax, by - ay
-        len2 = dx * dx + dy * dy
-        t = ((x - ax) * dx + (y - ay) * dy) / len2 if len2 > 0.0 else 0.0
-        t = min(max(t, 0.0), 1.0)
-        d = math.sqrt((x - ax - t * dx) ** 2 + (y - ay - t * dy) ** 2) - wall_radius
-        best = min(best, d)
-    return best
-
-
-@njit(cache=True)
 def move_robots(active, v, w, state, consts, parts):
-    """The robots' motion (``Robot.step``) of the ``active`` sub-envs far from walls; returns
-    which moved here (the others need pymunk: near a wall or bumped last step)."""
+    """The robots' motion (``Robot.step``) of the ``active`` sub-envs whose discs touch no wall
+    this step; returns which moved here (the others need pymunk: a contact, or a bump last
+    step)."""
     moved = np.zeros(active.shape[0], np.bool_)
     for n in range(active.shape[0]):
         i = active[n]
@@ -94,26 +78,25 @@ def move_robots(active, v, w, state, consts, parts):
         if s[BUMPED]:
             continue
         reach = c[RADIUS] + abs(vi) * c[PERIOD] + robot_module._REACH_MARGIN_M
+        walls = parts[i][0]
+        far = True
         if (
             s[CLEAR_D]
             - hypot(x0 - s[CLEAR_X], y0 - s[CLEAR_Y])
             - robot_module._CLEARANCE_ROUNDING_M
             < reach
-        ):
+        ):  # Robot._may_touch_wall, its pymunk query done here (up to rounding: it only
+            # decides which walls drive_substeps checks, never where the robot goes)
             look = reach + robot_module._CLEARANCE_LOOKAHEAD_M
             s[CLEAR_X], s[CLEAR_Y] = x0, y0
-            s[CLEAR_D] = _clearance_to_walls(parts[i][0], c[WALL_R], x0, y0, look)
-            if s[CLEAR_D] < reach:
-                continue
-        vx, vy = vi * math.cos(a0), vi * math.sin(a0)
-        dt = c[PERIOD] / c[SUBSTEPS]
-        x, y, a = x0, y0, a0
-        for k in range(int(c[SUBSTEPS])):
-            if k and wi != 0.0:
-                vx, vy = vi * math.cos(a), vi * math.sin(a)
-            x += (vx + 0.0) * dt
-            y += (vy + 0.0) * dt
-            a += (wi + 0.0) * dt
+            s[CLEAR_D] = min(look, robot_module.nearest_wall_m(walls, x0, y0) - c[WALL_R])
+            far = s[CLEAR_D] >= reach
+        clear, x, y, a, vx, vy = robot_module.drive_substeps(
+            x0, y0, a0, vi, wi, vi * math.cos(a0), vi * math.sin(a0), c[PERIOD] / c[SUBSTEPS],
+            int(c[SUBSTEPS]), walls[:0] if far else walls, c[RADIUS] + c[WALL_R],
+        )  # fmt: skip
+        if not clear:
+            continue
         s[X0], s[Y0], s[A0] = x0, y0, a0
         s[X], s[Y], s[A] = x, y, a
         s[VX], s[VY], s[W] = vx, vy, wi
@@ -531,29 +514,38 @@ class BatchStepper:
     # ------------------------------------------------------------------ infos
     def infos(self, metrics: np.ndarray, plan_names: np.ndarray) -> dict[str, Any]:
         """The step's info of every sub-env as `SfWExploreEnv._info` gives it (without the
-        summary), batched as `sfw_gym.envs.vector.batch_infos` batches it."""
+        summary), batched as `sfw_gym.envs.vector.batch_infos` batches it (the ``_key`` masks
+        one read-only array)."""
         s = self.state
         n = len(s)
         k_total = s[:, K_TOTAL]
-        columns: dict[str, Any] = {name: metrics[:, j].copy() for j, name in enumerate(METRICS)}
+        k_accuracy = np.divide(s[:, K_CORRECT], k_total, out=np.zeros(n), where=k_total > 0)
+        floats = np.concatenate([metrics, k_accuracy[:, None], s[:, _FLOAT_INFO]], axis=1).T.copy()
+        ints = s[:, _INT_INFO].T.astype(np.int64)
+        columns: dict[str, Any] = dict(zip(_FLOAT_NAMES, floats, strict=True))
+        columns |= dict(zip(_INT_NAMES, ints, strict=True))
         columns |= {
-            "k_accuracy": np.divide(s[:, K_CORRECT], k_total, out=np.zeros(n), where=k_total > 0),
-            "path_length_m": s[:, PATH_M].copy(),
-            "collisions": s[:, COLLISIONS].astype(np.int64),
             "true_pose": s[:, [X, Y, TRUE_T]],
             "odometry_pose": s[:, [ODO_X, ODO_Y, ODO_TW]],
             "pose_estimate": s[:, [EST_X, EST_Y, EST_T]],
-            "pose_error_m": s[:, POSE_ERR].copy(),
-            "ate_m": np.sqrt(s[:, SQ_ERR] / s[:, N_ROWS]),
-            "entropy_bits": s[:, ENTROPY].copy(),
-            "info_gain_bits": s[:, GAIN].copy(),
-            "steps_to_coverage_50": s[:, TO_50].astype(np.int64),
-            "steps_to_coverage_90": s[:, TO_90].astype(np.int64),
             "floorplan": plan_names.copy(),
-            "max_steps": s[:, MAX_STEPS].astype(np.int64),
         }
-        out: dict[str, Any] = {}
+        columns["ate_m"] = np.sqrt(columns["ate_m"] / s[:, N_ROWS])
         every = np.ones(n, np.bool_)
-        for key, value in columns.items():
-            out[key], out[f"_{key}"] = value, every.copy()
+        every.flags.writeable = False
+        out: dict[str, Any] = {}
+        for key in _INFO_ORDER:
+            out[key], out[f"_{key}"] = columns[key], every
         return out
+
+
+# The info entries from the state, and their order in `SfWExploreEnv._info`.
+_FLOAT_INFO = [PATH_M, POSE_ERR, SQ_ERR, ENTROPY, GAIN]  # SQ_ERR: ate_m once divided
+_FLOAT_NAMES = (*METRICS, "k_accuracy", "path_length_m", "pose_error_m", "ate_m", "entropy_bits",
+                "info_gain_bits")  # fmt: skip
+_INT_INFO = [COLLISIONS, TO_50, TO_90, MAX_STEPS]
+_INT_NAMES = ("collisions", "steps_to_coverage_50", "steps_to_coverage_90", "max_steps")
+_INFO_ORDER = (*METRICS, "k_accuracy", "path_length_m", "collisions", "true_pose",
+               "odometry_pose", "pose_estimate", "pose_error_m", "ate_m", "entropy_bits",
+               "info_gain_bits", "steps_to_coverage_50", "steps_to_coverage_90", "floorplan",
+               "max_steps")  # fmt: skip

@@ -81,6 +81,7 @@ class SfWVectorEnv(VectorEnv):
         self._batched = all(_batches(env) for env in self._envs)
         self._plan_names = np.full(self.num_envs, None, dtype=object)
         self._metrics = np.zeros((self.num_envs, len(batch_step.METRICS)))
+        self._can_batch = np.zeros(self.num_envs, np.bool_)  # this episode steps together
 
     @property
     def envs(self) -> list[gym.Env]:
@@ -128,9 +129,10 @@ class SfWVectorEnv(VectorEnv):
             together = self._step_together(actions, infos)
         else:
             together = np.zeros(self.num_envs, np.bool_)
-        for i, action in enumerate(iterate(self.action_space, actions)):
-            if together[i]:
-                continue
+        one_by_one = np.flatnonzero(~together).tolist()
+        rows = list(iterate(self.action_space, actions)) if one_by_one else []
+        for i in one_by_one:
+            action = rows[i]
             if self._autoreset[i]:
                 obs, infos[i] = self._sub(i, "reset")
                 reward, terminated, truncated = 0.0, False, False
@@ -159,7 +161,7 @@ class SfWVectorEnv(VectorEnv):
         robot pymunk does not hold in part); returns which did. The last step of an episode
         gets its info (with the summary) from the env."""
         stepper, envs = self._stepper, cast(list[Any], self._envs)
-        can = ~self._autoreset & np.array([_episode_batches(env) for env in envs])
+        can = ~self._autoreset & self._can_batch
         active = np.flatnonzero(can)
         if not len(active):
             return can
@@ -274,7 +276,8 @@ class SfWVectorEnv(VectorEnv):
 
     def _load(self, i: int, env: Any) -> None:
         """Read sub-env ``i`` into the batched state, if this episode steps there."""
-        if self._batched and _episode_batches(env):
+        self._can_batch[i] = self._batched and _episode_batches(env)
+        if self._can_batch[i]:
             self._stepper.load(i, env)
             self._plan_names[i] = env.scene.floorplan.name
 

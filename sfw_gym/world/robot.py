@@ -37,6 +37,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 import pymunk
+from numba import njit
 
 from sfw_gym.core.config import Config, setting
 from sfw_gym.core.constants import BULK_VERTICES
@@ -65,6 +66,8 @@ _REACH_MARGIN_M = 1e-3
 _CLEARANCE_LOOKAHEAD_M = 1.0
 # Rounding allowance of that answer: closer calls ask pymunk, so every answer is pymunk's own.
 _CLEARANCE_ROUNDING_M = 1e-9
+#: A substep's disc this much farther from a wall than touching it cannot start a contact.
+_CONTACT_MARGIN_M = 1e-6
 # The drive is kinematic and the walls static, so the mass only scales the solver's impulses.
 _ROBOT_MASS_KG = 5.0
 # Overlap that pymunk leaves uncorrected (its default, 0.1, assumes pixels, not metres).
@@ -373,25 +376,26 @@ class Robot:
             vx, vy = self._slide_along_contacts(vx, vy)
         dt = cfg.substep_s
         substeps = cfg.physics_substeps
-        if self._open_space_shortcut and not self._may_touch_wall(
-            x0, y0, abs(v) * cfg.control_period_s
-        ):
-            # No wall within reach this step, hence no contact, and the substeps are chipmunk's
-            # position update alone (cpBodyUpdatePosition: p += (v + v_bias)·dt, a += (w +
-            # w_bias)·dt, no bias without contacts; its velocity update keeps v and w exactly
-            # without gravity, damping or force), done here in the same IEEE operations: bit for
-            # bit what pymunk's substeps give, without their cost (tests/world/test_robot.py).
+        clear = False
+        if self._open_space_shortcut:
+            far = not self._may_touch_wall(x0, y0, abs(v) * cfg.control_period_s)
+            if far or not self._bumped:
+                # Without a contact, pymunk's substeps are chipmunk's position update alone
+                # (cpBodyUpdatePosition; the velocity as _kinematic_drive sets it): done in the
+                # same IEEE operations by drive_substeps, bit for bit what pymunk gives without
+                # its cost (tests/world/test_robot.py). Far from walls no contact is possible;
+                # nearer, none arises if the disc stays clear of every wall after each substep,
+                # where chipmunk looks for contacts. (After a bump the first substep's velocity
+                # is the slid one, which the callback would reset: pymunk then.)
+                clear, x, y, a, end_vx, end_vy = drive_substeps(
+                    x0, y0, a0, v, w, vx, vy, dt, substeps,
+                    self._walls[:0] if far else self._walls, cfg.radius_m + cfg.wall_radius_m,
+                )  # fmt: skip
+        if clear:
             self._drive_by_callback(False)
-            x, y, a = x0, y0, a0
-            for i in range(substeps):
-                if i and w != 0.0:
-                    vx, vy = v * math.cos(a), v * math.sin(a)
-                x += (vx + 0.0) * dt
-                y += (vy + 0.0) * dt
-                a += (w + 0.0) * dt
             # pymunk's body is told only when it next matters (_sync_body): four attribute sets
-            # through pymunk's Python layer cost more than the substeps above
-            self._unsynced = (x, y, a, vx, vy, w)
+            # through pymunk's Python layer cost more than the substeps
+            self._unsynced = (x, y, a, end_vx, end_vy, w)
             bumped = False
             x1, y1, a1 = x, y, a  # what the body now holds, exactly
         else:
@@ -556,6 +560,39 @@ class Robot:
             f"Robot(pose=({x:.3f}, {y:.3f}, {theta:.3f}), walls={len(self._walls)}, "
             f"bumped={self._bumped})"
         )
+
+
+@njit(cache=True)
+def nearest_wall_m(walls: np.ndarray, x: float, y: float) -> float:
+    """Distance from (x, y) to the nearest wall segment's line (inf without walls)."""
+    best = math.inf
+    for e in range(walls.shape[0]):
+        ax, ay, bx, by = walls[e, 0], walls[e, 1], walls[e, 2], walls[e, 3]
+        dx, dy = bx - ax, by - ay
+        len2 = dx * dx + dy * dy
+        t = ((x - ax) * dx + (y - ay) * dy) / len2 if len2 > 0.0 else 0.0
+        t = min(max(t, 0.0), 1.0)
+        best = min(best, math.sqrt((x - ax - t * dx) ** 2 + (y - ay - t * dy) ** 2))
+    return best
+
+
+@njit(cache=True)
+def drive_substeps(x, y, a, v, w, vx, vy, dt, substeps, walls, radii_m):
+    """Chipmunk's position update over ``substeps`` contact-free substeps from pose (x, y, a) at
+    velocity (vx, vy, w), the drive resetting (vx, vy) to ``v`` along the heading after each:
+    ``(clear, x, y, a, vx, vy)``. ``clear``: after each substep the centre stayed farther than
+    ``radii_m`` (the disc's and the walls' radii, where chipmunk finds a contact) plus a margin
+    from every one of ``walls`` (only then is the result pymunk's)."""
+    contact_m = radii_m + _CONTACT_MARGIN_M
+    for i in range(substeps):
+        if i and w != 0.0:
+            vx, vy = v * math.cos(a), v * math.sin(a)
+        x += (vx + 0.0) * dt
+        y += (vy + 0.0) * dt
+        a += (w + 0.0) * dt
+        if walls.shape[0] and nearest_wall_m(walls, x, y) <= contact_m:
+            return False, x, y, a, vx, vy
+    return True, x, y, a, vx, vy
 
 
 def _wrap(theta: float) -> float:

@@ -11,6 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import sfw_gym.world.robot as robot_module
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.world.robot import Pose, Robot, RobotConfig, StepResult
 
@@ -279,12 +280,25 @@ def wander(robot: Robot, n: int, seed: int) -> tuple[list, list[StepResult]]:
 
 
 def test_open_space_shortcut_changes_nothing(monkeypatch):
+    """Far from walls and, near them, along substeps that keep clear of every wall, the robot
+    skips pymunk: the same poses, bumps and odometry as pymunk's every step."""
+    near_clear = []
+    original = robot_module.drive_substeps
+
+    def counted(*args):
+        out = original(*args)
+        near_clear.append(len(args[-2]) > 0 and out[0])
+        return out
+
+    monkeypatch.setattr(robot_module, "drive_substeps", counted)
     walls = thin_wall_room()
     commands, fast_run = wander(make(walls, pose=(1.0, 1.0, 0.3)), 600, seed=8)
+    monkeypatch.undo()
     monkeypatch.setattr(Robot, "_open_space_shortcut", False)
     slow = make(walls, pose=(1.0, 1.0, 0.3))
     assert [slow.step(v, w) for v, w in commands] == fast_run
     assert 50 < sum(r.bumped for r in fast_run) < 500  # both open space and contacts
+    assert sum(near_clear) > 20  # and steps near a wall without a contact
 
 
 # ---------------------------------------------------------------- odometry
