@@ -57,6 +57,17 @@ NORMALS_AHEAD = 512
 N_CONSTS = 33
 # The five map metrics, in `MapTracker.metrics`' order.
 METRICS = ("coverage", "map_iou", "free_iou", "wall_precision", "interior_wall_recall")
+# The info entries the batched step writes per sub-env (a row of `BatchStepper.info_rows`).
+FLOAT_INFO = (*METRICS, "k_accuracy", "path_length_m", "pose_error_m", "ate_m", "entropy_bits",
+              "info_gain_bits")  # fmt: skip
+INT_INFO = ("collisions", "steps_to_coverage_50", "steps_to_coverage_90", "max_steps")
+POSE_INFO = ("true_pose", "odometry_pose", "pose_estimate")
+N_INFO = len(FLOAT_INFO) + len(INT_INFO) + 3 * len(POSE_INFO)
+# All info entries in `SfWExploreEnv._info`'s order.
+INFO_ORDER = (*METRICS, "k_accuracy", "path_length_m", "collisions", "true_pose",
+              "odometry_pose", "pose_estimate", "pose_error_m", "ate_m", "entropy_bits",
+              "info_gain_bits", "steps_to_coverage_50", "steps_to_coverage_90", "floorplan",
+              "max_steps")  # fmt: skip
 
 
 @njit(cache=True)
@@ -166,8 +177,8 @@ def _odometry(s, c, normals):
 
 @njit(cache=True)
 def sense_and_map(
-    active, moved, state, consts, parts, obs_map, obs_local, obs_state, reward, metrics,
-    done, due,
+    active, moved, state, consts, parts, obs_map, obs_local, obs_state, reward, info, done,
+    due,
 ):  # fmt: skip
     """The rest of the step of the ``active`` sub-envs (``SfWExploreEnv.step`` after the robot's
     motion): odometry, the reading, the histories, the map update, k-accuracy, the tracker, the
@@ -282,7 +293,7 @@ def sense_and_map(
         # the reward, the metrics (MapTracker.metrics) and the episode's end
         reward[i] = c[SCALE] * gain - c[PENALTY] * s[BUMPED]
         inter = counts[_FREE_INTER]
-        m = metrics[i]
+        m = info[i]
         m[0] = _ratio(counts[_COVERED], c[N_FREE])
         m[1] = _ratio(counts[_AGREE], counts[_KNOWN_BOTH])
         m[2] = _ratio(inter, counts[_N_EST_FREE] + c[N_FREE] - inter)
@@ -292,6 +303,14 @@ def sense_and_map(
             s[TO_50] = s[STEPS]
         if s[TO_90] < 0 and m[0] >= 0.9:
             s[TO_90] = s[STEPS]
+        m[5] = s[K_CORRECT] / s[K_TOTAL] if s[K_TOTAL] else 0.0
+        m[6], m[7] = s[PATH_M], s[POSE_ERR]
+        m[8] = math.sqrt(s[SQ_ERR] / s[N_ROWS])
+        m[9], m[10] = s[ENTROPY], s[GAIN]
+        m[11], m[12], m[13], m[14] = s[COLLISIONS], s[TO_50], s[TO_90], s[MAX_STEPS]
+        m[15], m[16], m[17] = tx, ty, tt
+        m[18], m[19], m[20] = s[ODO_X], s[ODO_Y], s[ODO_TW]
+        m[21], m[22], m[23] = px, py, pt
         if m[0] >= c[TARGET]:
             done[n] = 1
         elif s[STEPS] >= s[MAX_STEPS]:
@@ -330,6 +349,7 @@ class BatchStepper:
         self._episodes: list[Any] = [None] * num_envs  # an _Episode once attached
         self._capacity = np.zeros(num_envs, np.int64)
         self.synced = np.ones(num_envs, np.bool_)
+        self.info_rows = np.zeros((num_envs, N_INFO))
         # the generator's state before the normals of each sub-env were drawn ahead (None: none)
         self._drawn_from: list[Any] = [None] * num_envs
         self._normals_per_step = np.zeros(num_envs, np.int64)
@@ -512,40 +532,23 @@ class BatchStepper:
             self.load(i, env)
 
     # ------------------------------------------------------------------ infos
-    def infos(self, metrics: np.ndarray, plan_names: np.ndarray) -> dict[str, Any]:
+    def infos(self, plan_names: np.ndarray) -> dict[str, Any]:
         """The step's info of every sub-env as `SfWExploreEnv._info` gives it (without the
         summary), batched as `sfw_gym.envs.vector.batch_infos` batches it (the ``_key`` masks
         one read-only array)."""
-        s = self.state
-        n = len(s)
-        k_total = s[:, K_TOTAL]
-        k_accuracy = np.divide(s[:, K_CORRECT], k_total, out=np.zeros(n), where=k_total > 0)
-        floats = np.concatenate([metrics, k_accuracy[:, None], s[:, _FLOAT_INFO]], axis=1).T.copy()
-        ints = s[:, _INT_INFO].T.astype(np.int64)
-        columns: dict[str, Any] = dict(zip(_FLOAT_NAMES, floats, strict=True))
-        columns |= dict(zip(_INT_NAMES, ints, strict=True))
-        columns |= {
-            "true_pose": s[:, [X, Y, TRUE_T]],
-            "odometry_pose": s[:, [ODO_X, ODO_Y, ODO_TW]],
-            "pose_estimate": s[:, [EST_X, EST_Y, EST_T]],
-            "floorplan": plan_names.copy(),
-        }
-        columns["ate_m"] = np.sqrt(columns["ate_m"] / s[:, N_ROWS])
-        every = np.ones(n, np.bool_)
+        n_float, n_int = len(FLOAT_INFO), len(INT_INFO)
+        table = self.info_rows.T.copy()
+        columns: dict[str, Any] = dict(zip(FLOAT_INFO, table[:n_float], strict=True))
+        ints = table[n_float : n_float + n_int].astype(np.int64)
+        columns |= dict(zip(INT_INFO, ints, strict=True))
+        start = n_float + n_int
+        for name in POSE_INFO:
+            columns[name] = self.info_rows[:, start : start + 3].copy()
+            start += 3
+        columns["floorplan"] = plan_names.copy()
+        every = np.ones(len(table[0]), np.bool_)
         every.flags.writeable = False
         out: dict[str, Any] = {}
-        for key in _INFO_ORDER:
+        for key in INFO_ORDER:
             out[key], out[f"_{key}"] = columns[key], every
         return out
-
-
-# The info entries from the state, and their order in `SfWExploreEnv._info`.
-_FLOAT_INFO = [PATH_M, POSE_ERR, SQ_ERR, ENTROPY, GAIN]  # SQ_ERR: ate_m once divided
-_FLOAT_NAMES = (*METRICS, "k_accuracy", "path_length_m", "pose_error_m", "ate_m", "entropy_bits",
-                "info_gain_bits")  # fmt: skip
-_INT_INFO = [COLLISIONS, TO_50, TO_90, MAX_STEPS]
-_INT_NAMES = ("collisions", "steps_to_coverage_50", "steps_to_coverage_90", "max_steps")
-_INFO_ORDER = (*METRICS, "k_accuracy", "path_length_m", "collisions", "true_pose",
-               "odometry_pose", "pose_estimate", "pose_error_m", "ate_m", "entropy_bits",
-               "info_gain_bits", "steps_to_coverage_50", "steps_to_coverage_90", "floorplan",
-               "max_steps")  # fmt: skip

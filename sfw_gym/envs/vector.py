@@ -73,6 +73,7 @@ class SfWVectorEnv(VectorEnv):
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self._observations: dict[str, np.ndarray] = self._empty_batch(np.zeros)
+        self._layout = [(k, v.shape, v.dtype) for k, v in self._observations.items()]
         self._rewards = np.zeros(self.num_envs, np.float64)
         self._terminations = np.zeros(self.num_envs, np.bool_)
         self._truncations = np.zeros(self.num_envs, np.bool_)
@@ -80,7 +81,6 @@ class SfWVectorEnv(VectorEnv):
         self._stepper = BatchStepper(self.num_envs)
         self._batched = all(_batches(env) for env in self._envs)
         self._plan_names = np.full(self.num_envs, None, dtype=object)
-        self._metrics = np.zeros((self.num_envs, len(batch_step.METRICS)))
         self._can_batch = np.zeros(self.num_envs, np.bool_)  # this episode steps together
 
     @property
@@ -144,7 +144,7 @@ class SfWVectorEnv(VectorEnv):
             self._truncations[i] = truncated
         self._autoreset = self._terminations | self._truncations
         if together.any():
-            batched = self._stepper.infos(self._metrics, self._plan_names)
+            batched = self._stepper.infos(self._plan_names)
             info = _merge_rows(batched, infos)
         else:
             info = batch_infos(infos)
@@ -180,7 +180,7 @@ class SfWVectorEnv(VectorEnv):
         obs = self._observations
         batch_step.sense_and_map(
             active, moved, stepper.state, stepper.consts, stepper.parts, obs["map"],
-            obs["local"], obs["state"], self._rewards, self._metrics, done, due,
+            obs["local"], obs["state"], self._rewards, stepper.info_rows, done, due,
         )  # fmt: skip
         stepper.synced[active] = False
         for i in active[due].tolist():
@@ -192,7 +192,8 @@ class SfWVectorEnv(VectorEnv):
         self._truncations[active] = done == 2
         for i in active[done > 0].tolist():
             stepper.sync(i, envs[i])
-            metrics = dict(zip(batch_step.METRICS, self._metrics[i].tolist(), strict=True))
+            row = stepper.info_rows[i, : len(batch_step.METRICS)].tolist()
+            metrics = dict(zip(batch_step.METRICS, row, strict=True))
             infos[i] = envs[i]._info(terminal=True, metrics=metrics)
         return can
 
@@ -299,6 +300,8 @@ class SfWVectorEnv(VectorEnv):
             self._load(i, env)
 
     def _empty_batch(self, fn: Any = np.empty) -> dict[str, np.ndarray]:
+        if fn is np.empty:  # every step: the layout found once
+            return {key: np.empty(shape, dtype) for key, shape, dtype in self._layout}
         return create_empty_array(self.single_observation_space, self.num_envs, fn=fn)  # type: ignore[return-value]
 
     def _write(self, i: int, obs: dict[str, np.ndarray]) -> None:
