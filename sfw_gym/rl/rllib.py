@@ -57,12 +57,23 @@ def require_rllib() -> Any:
 
 
 def make_env(env_id: str, wrappers: list[tuple[str, dict]], env_config: Any = None) -> Any:
-    """The env for ``env_id`` with rl-zoo's wrappers applied (``env_config``: its kwargs)."""
+    """The env for ``env_id`` with rl-zoo's wrappers applied (``env_config``: its kwargs). With
+    ``num_envs`` in ``env_config`` (RLlib's runners under ``gym_env_vectorize_mode=
+    "vector_entry_point"``, which `ppo_config` sets for an id without wrappers): the native
+    vector env of that many sub-envs (`sfw_gym.envs.vector`)."""
     import gymnasium as gym
 
     import sfw_gym  # noqa: F401  (registration in this runner)
 
-    env = gym.make(env_id, **dict(env_config or {}))
+    kwargs = dict(env_config or {})
+    num_envs = kwargs.pop("num_envs", None)
+    if num_envs is not None:
+        if wrappers:
+            raise ConfigError(f"{env_id}: wrapped envs step one by one, not as a native batch")
+        return gym.make_vec(
+            env_id, num_envs=num_envs, vectorization_mode="vector_entry_point", **kwargs
+        )
+    env = gym.make(env_id, **kwargs)
     for name, kwargs in wrappers:
         env = import_dotted(name)(env, **kwargs)
     return env
@@ -92,7 +103,9 @@ def ppo_config(
     """RLlib's PPOConfig from an rl-zoo block (:func:`load_hyperparams`): one iteration collects
     ``n_steps × n_envs`` env steps, as one SB3 rollout does; the other keys map one to one;
     ``policy`` names the RLModule class by dotted path (an SB3 policy name such as
-    ``MultiInputPolicy``, or none: :data:`DEFAULT_MODULE`)."""
+    ``MultiInputPolicy``, or none: :data:`DEFAULT_MODULE`). Each runner's envs are the native
+    vector env (``gym.make_vec``'s ``vector_entry_point``), unless the block wraps them
+    (``env_wrapper``): then Gymnasium's ``SyncVectorEnv``."""
     PPOConfig = require_rllib()
     from ray.rllib.core.rl_module.rl_module import RLModuleSpec
 
@@ -109,6 +122,7 @@ def ppo_config(
             num_env_runners=num_env_runners,
             num_envs_per_env_runner=max(1, n_envs // max(1, num_env_runners)),
             rollout_fragment_length="auto",
+            gym_env_vectorize_mode="sync" if params.get("env_wrapper") else "vector_entry_point",
         )
         .training(
             train_batch_size_per_learner=batch,

@@ -149,5 +149,30 @@ def test_the_rl_zoo_block_maps_onto_rllibs_ppo_config():
     assert config.minibatch_size == 128  # never above the batch
     assert (config.num_epochs, config.lambda_, config.lr) == (3, 0.9, 1e-3)
     assert config.num_envs_per_env_runner == 1 and config.seed == 5
+    assert config.gym_env_vectorize_mode == "vector_entry_point"  # the native vector env
+    wrapped = {**params, "env_wrapper": [{"sfw_gym.envs.waypoint.WaypointWrapper": {}}]}
+    assert ppo_config(SMALL, wrapped).gym_env_vectorize_mode == "sync"
     spec = config.rl_module_spec
     assert spec.module_class is DictObsModule and spec.model_config == {"hidden": 32}
+
+
+@needs_rllib
+def test_rllibs_runners_step_the_native_vector_env(tmp_path):
+    """``gym_env_vectorize_mode="vector_entry_point"``: a runner's envs are sfw_gym's native
+    vector env, and an iteration trains on it."""
+    import ray
+
+    from sfw_gym.envs.vector import SfWVectorEnv
+    from sfw_gym.rl.rllib import ppo_config, register_rllib_envs
+
+    params = {"n_envs": 2, "n_steps": 32, "batch_size": 32, "n_epochs": 1}
+    ray.init(num_cpus=1, include_dashboard=False, log_to_driver=False)
+    try:
+        register_rllib_envs()
+        algo = ppo_config(SMALL, params, env_kwargs={"max_steps": 40}).build_algo()
+        vec = algo.env_runner.env.unwrapped
+        assert isinstance(vec, SfWVectorEnv) and vec.num_envs == 2 and vec._batched
+        assert algo.train()["env_runners"]["num_env_steps_sampled_lifetime"] >= 64
+        algo.stop()
+    finally:
+        ray.shutdown()
