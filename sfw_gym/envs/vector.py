@@ -82,6 +82,9 @@ class SfWVectorEnv(VectorEnv):
         self._batched = all(_batches(env) for env in self._envs)
         self._plan_names = np.full(self.num_envs, None, dtype=object)
         self._can_batch = np.zeros(self.num_envs, np.bool_)  # this episode steps together
+        if self._batched:  # an action's fractions of the robot's speed limits
+            limits = cast(Any, first).config.robot
+            self._speeds = np.array([limits.max_linear_speed_m_s, limits.max_angular_speed_rad_s])
 
     @property
     def envs(self) -> list[gym.Env]:
@@ -165,64 +168,71 @@ class SfWVectorEnv(VectorEnv):
         active = np.flatnonzero(can)
         if not len(active):
             return can
-        v, w = self._commands(actions, active)
+        commands = self._commands(actions, active)
         stepper.make_room(active, envs)
-        moved = batch_step.move_robots(active, v, w, stepper.state, stepper.consts, stepper.parts)
-        for n in np.flatnonzero(~moved).tolist():  # near a wall: pymunk moves it
-            i = int(active[n])
-            robot = envs[i].scene.robot
-            stepper.sync(i, envs[i])
-            result = self._call(i, robot.step, float(v[n]), float(w[n]))
-            stepper.load_robot(i, robot, result.distance_m)
+        moved = batch_step.move_robots(
+            active, commands, stepper.state, stepper.consts, stepper.parts
+        )
+        if not moved.all():
+            for n in np.flatnonzero(~moved).tolist():  # a contact: pymunk moves the robot
+                i = int(active[n])
+                robot = envs[i].scene.robot
+                stepper.sync(i, envs[i])
+                v, w = commands[n].tolist()
+                result = self._call(i, robot.step, v, w)
+                stepper.load_robot(i, robot, result.distance_m)
         stepper.draw_ahead(active)
         done = np.zeros(len(active), np.int8)
         due = np.zeros(len(active), np.bool_)
         obs = self._observations
-        batch_step.sense_and_map(
+        anything = batch_step.sense_and_map(
             active, moved, stepper.state, stepper.consts, stepper.parts, obs["map"],
-            obs["local"], obs["state"], self._rewards, stepper.info_rows, done, due,
+            obs["local"], obs["state"], self._rewards, self._terminations, self._truncations,
+            stepper.synced, stepper.info_rows, done, due,
         )  # fmt: skip
-        stepper.synced[active] = False
+        if anything:
+            self._after_together(active, done, due, infos)
+        return can
+
+    def _after_together(
+        self,
+        active: np.ndarray,
+        done: np.ndarray,
+        due: np.ndarray,
+        infos: list[dict[str, Any] | None],
+    ) -> None:
+        """The rarer ends of a batched step: k-means refits, the pose off the grid, the last
+        step of an episode (its info, with the summary, from the env)."""
+        envs: list[Any] = self._envs
         for i in active[due].tolist():
             envs[i].mapper.k_estimator.refit()
         if (done < 0).any():
             i = int(active[np.flatnonzero(done < 0)[0]])
             raise ConfigError(f"sub-env {i}: the pose estimate lies outside the map's grid")
-        self._terminations[active] = done == 1
-        self._truncations[active] = done == 2
         for i in active[done > 0].tolist():
-            stepper.sync(i, envs[i])
-            row = stepper.info_rows[i, : len(batch_step.METRICS)].tolist()
+            self._stepper.sync(i, envs[i])
+            row = self._stepper.info_rows[i, : len(batch_step.METRICS)].tolist()
             metrics = dict(zip(batch_step.METRICS, row, strict=True))
             infos[i] = envs[i]._info(terminal=True, metrics=metrics)
-        return can
 
-    def _commands(self, actions: Any, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The ``active`` sub-envs' (linear, angular) commands, as `SfWExploreEnv._command`
-        makes them (an unusual action goes through it, its error naming the sub-env)."""
+    def _commands(self, actions: Any, active: np.ndarray) -> np.ndarray:
+        """The ``active`` sub-envs' (linear, angular) commands, a row each, as
+        `SfWExploreEnv._command` makes them (an unusual action goes through it, its error
+        naming the sub-env)."""
         env: Any = self._envs[0]
-        cfg = env.config.robot
         a = actions if isinstance(actions, np.ndarray) else np.asarray(actions, dtype=object)
+        chosen = a if len(active) == self.num_envs else a[active]
         if env.config.explore.action_type == "discrete":
             if a.dtype.kind in "iu" and a.shape == (self.num_envs,):
-                chosen = a[active]
                 if ((chosen >= 0) & (chosen < len(DISCRETE_ACTIONS))).all():
-                    fractions = np.array(DISCRETE_ACTIONS, np.float64)[chosen]
-                    return (
-                        fractions[:, 0] * cfg.max_linear_speed_m_s,
-                        fractions[:, 1] * cfg.max_angular_speed_rad_s,
-                    )
+                    return _DISCRETE_FRACTIONS[chosen] * self._speeds
         elif a.dtype.kind == "f" and a.shape == (self.num_envs, 2):
-            chosen = a[active].astype(np.float64)
-            if np.isfinite(chosen).all():
-                chosen = np.clip(chosen, -1.0, 1.0)
-                return (
-                    chosen[:, 0] * cfg.max_linear_speed_m_s,
-                    chosen[:, 1] * cfg.max_angular_speed_rad_s,
-                )
+            fractions = chosen.astype(np.float64)
+            if np.isfinite(fractions).all():
+                return np.clip(fractions, -1.0, 1.0) * self._speeds
         rows = list(iterate(self.action_space, actions))
-        commands = [self._call(i, self._envs[i].unwrapped._command, rows[i]) for i in active]
-        return np.array([c[0] for c in commands]), np.array([c[1] for c in commands])
+        envs: list[Any] = self._envs
+        return np.array([self._call(i, envs[i]._command, rows[i]) for i in active.tolist()])
 
     def render(self) -> tuple[Any, ...] | None:
         """Each sub-env's frame (``render_mode="rgb_array"``)."""
@@ -312,6 +322,9 @@ class SfWVectorEnv(VectorEnv):
         """The observations as the caller keeps them: never written again (a step writes a
         new batch, a reset a copy)."""
         return dict(self._observations)
+
+
+_DISCRETE_FRACTIONS = np.array(DISCRETE_ACTIONS, np.float64)
 
 
 def _batches(env: gym.Env) -> bool:
