@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+VECTOR_TESTS = '-m "slow or not slow" tests/envs/test_vector_env.py'  # its 1,000-step runs
 CASES = [
     (
         "bug1.worst-goal",
@@ -320,6 +321,77 @@ CASES = [
         "                raise unknown_key_error(what, key, names)",
         "                pass",
         "tests/agents/test_agents.py -k act_before",
+    ),
+    # issue 33, the batched step: each breaks one line of what keeps a sub-env the single env
+    (
+        "batch.generator-not-put-back",
+        "sfw_gym/envs/batch_step.py",
+        "        if drawn_from is not None:",
+        "        if False:",
+        VECTOR_TESTS,
+    ),
+    (
+        "batch.image-not-redrawn",
+        "sfw_gym/envs/batch_step.py",
+        "            _redraw_touched(track, maps[2], int(c[GRID_COLS]), belief_px, px_rows, px_cols)",  # noqa: E501
+        "            pass",
+        VECTOR_TESTS,
+    ),
+    (
+        "batch.libm-hypot",
+        "sfw_gym/envs/batch_step.py",
+        "    distance = hypot(dx, dy)",
+        "    distance = math.hypot(dx, dy)",
+        VECTOR_TESTS,
+    ),
+    (
+        "batch.unwrapped-heading",
+        "sfw_gym/envs/batch_step.py",
+        "        tx, ty, tt = s[X], s[Y], wrap_angle(s[A])",
+        "        tx, ty, tt = s[X], s[Y], s[A]",
+        VECTOR_TESTS,
+    ),
+    (
+        "batch.k-accuracy-counts-unheard",
+        "sfw_gym/envs/batch_step.py",
+        "                if rssi[r] > NOT_HEARD_DBM and k_est[r] >= 0:",
+        "                if k_est[r] >= 0:",
+        VECTOR_TESTS,
+    ),
+    (
+        "batch.odometry-not-written-back",
+        "sfw_gym/envs/batch_step.py",
+        "        robot._odometry = (s[ODO_X], s[ODO_Y], s[ODO_T])",
+        "        pass",
+        VECTOR_TESTS,
+    ),
+    (
+        "batch.history-growth-not-reattached",
+        "sfw_gym/envs/batch_step.py",
+        "                h.reserve(len(h) + 1)\n            self.load(i, env)",
+        "                h.reserve(len(h) + 1)",
+        VECTOR_TESTS,
+    ),
+    (
+        "batch.image-not-redrawn-after-python",
+        "sfw_gym/envs/batch_step.py",
+        "            self._episodes[i].belief_px[:] = env.obs_builder.image_of(env.mapper.occupancy_u8)",  # noqa: E501
+        "            pass",
+        VECTOR_TESTS,
+    ),
+    (
+        "vector.steps-an-ended-episode",
+        "sfw_gym/envs/vector.py",
+        "        can = ~self._autoreset & self._can_batch",
+        "        can = self._can_batch",
+        VECTOR_TESTS,
+    ),
+    (
+        "robot.no-contact-margin",
+        "sfw_gym/world/robot.py",
+        "    contact_m = radii_m + _CONTACT_MARGIN_M",
+        "    contact_m = radii_m - 0.01",
+        "tests/world/test_robot.py",
     ),
 ]
 only = sys.argv[1:]
