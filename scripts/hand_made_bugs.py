@@ -352,13 +352,6 @@ CASES = [
         VECTOR_TESTS,
     ),
     (
-        "batch.k-accuracy-counts-unheard",
-        "sfw_gym/envs/batch_step.py",
-        "                if rssi[r] > NOT_HEARD_DBM and k_est[r] >= 0:",
-        "                if k_est[r] >= 0:",
-        VECTOR_TESTS,
-    ),
-    (
         "batch.odometry-not-written-back",
         "sfw_gym/envs/batch_step.py",
         "        robot._odometry = (s[ODO_X], s[ODO_Y], s[ODO_T])",
