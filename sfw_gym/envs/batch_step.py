@@ -2,10 +2,10 @@
 
 :class:`BatchStepper` holds, per sub-env, the episode's arrays (walls, radio tables, the mapper's,
 the tracker's and the observation builder's buffers, the histories) in one numba list, and its
-scalar state (poses, counters) in one row of a float array. A batch step then runs the robot's
-open-space motion for every sub-env in one call, pymunk in Python only for a robot near a wall,
-and the reading, the map update, the metrics and the observations of every sub-env in a second
-call, written straight into the batch's arrays. Every compiled line repeats an operation of the
+scalar state (poses, counters) in one row of a float array. A batch step then moves every robot
+whose disc touches no wall in one call (pymunk moves the others, in Python), and does the
+reading, the map update, the metrics and the observations of every sub-env in a second call,
+written straight into the batch's arrays. Every compiled line repeats an operation of the
 env's Python step in the same IEEE order, or calls the same kernel, so each sub-env is the single
 env with its seed, bit for bit (tests/envs/test_vector_env.py).
 
@@ -50,11 +50,11 @@ N_STATE = 39
 #: Standard normals drawn ahead per sub-env (its generator is put back before Python uses it).
 NORMALS_AHEAD = 512
 # A sub-env's constants: one row of `BatchStepper.consts`.
-(RADIUS, MAX_V, MAX_W, PERIOD, SUBSTEPS, TRANS_STD, HEAD_STD, WALL_R, NOISE_DB, SENSITIVITY,
+(RADIUS, PERIOD, SUBSTEPS, TRANS_STD, HEAD_STD, WALL_R, NOISE_DB, SENSITIVITY,
  GX0, GY0, GX1, GY1, GRID_RES, OBS_CELLS_PER_PX, OBS_PAD_R, OBS_PAD_C, OBS_MAP_PX, OBS_CROP,
  OBS_WIDTH_M, OBS_HEIGHT_M, GRID_ROWS, GRID_COLS, SCALE, PENALTY, TARGET, MAX_K, SLOTS, TRUE_POSE,
- N_CELLS, N_FREE, N_INTERIOR, CAPACITY, NORMALS_PER_STEP) = range(35)  # fmt: skip
-N_CONSTS = 35
+ N_CELLS, N_FREE, N_INTERIOR, CAPACITY, NORMALS_PER_STEP) = range(33)  # fmt: skip
+N_CONSTS = 33
 # The five map metrics, in `MapTracker.metrics`' order.
 METRICS = ("coverage", "map_iou", "free_iou", "wall_precision", "interior_wall_recall")
 # The info entries the batched step writes per sub-env (a row of `BatchStepper.info_rows`).
@@ -63,6 +63,9 @@ FLOAT_INFO = (*METRICS, "k_accuracy", "path_length_m", "pose_error_m", "ate_m", 
 INT_INFO = ("collisions", "steps_to_coverage_50", "steps_to_coverage_90", "max_steps")
 POSE_INFO = ("true_pose", "odometry_pose", "pose_estimate")
 N_INFO = len(FLOAT_INFO) + len(INT_INFO) + 3 * len(POSE_INFO)
+_K_ACCURACY, _PATH, _POSE_ERROR, _ATE, _ENTROPY, _GAIN = range(len(METRICS), len(FLOAT_INFO))
+_COLLISIONS, _TO_50, _TO_90, _MAX_STEPS = range(len(FLOAT_INFO), len(FLOAT_INFO) + len(INT_INFO))
+_TRUE_POSE, _ODOMETRY_POSE, _POSE_ESTIMATE = range(len(FLOAT_INFO) + len(INT_INFO), N_INFO, 3)
 # All info entries in `SfWExploreEnv._info`'s order.
 INFO_ORDER = (*METRICS, "k_accuracy", "path_length_m", "collisions", "true_pose",
               "odometry_pose", "pose_estimate", "pose_error_m", "ate_m", "entropy_bits",
@@ -220,7 +223,7 @@ def sense_and_map(
         est_cls, truth_cls, near_wall, interior, found_by, offsets, counts = tracker
         belief_px, px_rows, px_cols, trajectory, router_px = builder
         rssi_rows, true_rows, odometry_rows, estimate_rows = history
-        pts, mean_db, true_k, rssi = scratch
+        pts, mean_db, true_k, rssi, readings = scratch
         n_routers = routers.shape[0]
         if moved[n]:
             _odometry(s, c, normals)
@@ -264,7 +267,6 @@ def sense_and_map(
             if not (0.0 <= gx < c[GRID_COLS] and 0.0 <= gy < c[GRID_ROWS]):
                 done[n] = -1  # outside the grid although inside its bounds: the env raises
                 return True
-            readings = np.empty(n_routers)
             for r in range(n_routers):
                 readings[r] = rssi[r]
             gain, due[n] = _update_kernel(
@@ -329,14 +331,16 @@ def sense_and_map(
             s[TO_50] = s[STEPS]
         if s[TO_90] < 0 and m[0] >= 0.9:
             s[TO_90] = s[STEPS]
-        m[5] = s[K_CORRECT] / s[K_TOTAL] if s[K_TOTAL] else 0.0
-        m[6], m[7] = s[PATH_M], s[POSE_ERR]
-        m[8] = math.sqrt(s[SQ_ERR] / s[N_ROWS])
-        m[9], m[10] = s[ENTROPY], s[GAIN]
-        m[11], m[12], m[13], m[14] = s[COLLISIONS], s[TO_50], s[TO_90], s[MAX_STEPS]
-        m[15], m[16], m[17] = tx, ty, tt
-        m[18], m[19], m[20] = s[ODO_X], s[ODO_Y], s[ODO_TW]
-        m[21], m[22], m[23] = px, py, pt
+        m[_K_ACCURACY] = s[K_CORRECT] / s[K_TOTAL] if s[K_TOTAL] else 0.0
+        m[_PATH], m[_POSE_ERROR] = s[PATH_M], s[POSE_ERR]
+        m[_ATE] = math.sqrt(s[SQ_ERR] / s[N_ROWS])
+        m[_ENTROPY], m[_GAIN] = s[ENTROPY], s[GAIN]
+        m[_COLLISIONS], m[_TO_50], m[_TO_90] = s[COLLISIONS], s[TO_50], s[TO_90]
+        m[_MAX_STEPS] = s[MAX_STEPS]
+        m[_TRUE_POSE], m[_TRUE_POSE + 1], m[_TRUE_POSE + 2] = tx, ty, tt
+        m[_ODOMETRY_POSE], m[_ODOMETRY_POSE + 1] = s[ODO_X], s[ODO_Y]
+        m[_ODOMETRY_POSE + 2] = s[ODO_TW]
+        m[_POSE_ESTIMATE], m[_POSE_ESTIMATE + 1], m[_POSE_ESTIMATE + 2] = px, py, pt
         if m[0] >= c[TARGET]:
             done[n] = 1
         elif s[STEPS] >= s[MAX_STEPS]:
@@ -451,7 +455,7 @@ class BatchStepper:
              builder._trajectory, builder._routers),
             buffers,
             (np.zeros((1, 2)), np.zeros((1, n_r)), np.zeros((1, n_r), np.int32),
-             np.zeros(n_r, np.int32)),
+             np.zeros(n_r, np.int32), np.zeros(n_r)),
             np.zeros(NORMALS_AHEAD),
         )  # fmt: skip
         if len(self.parts) > i:
@@ -463,18 +467,13 @@ class BatchStepper:
         self._episodes[i] = _Episode(env, buffers, radio.rng, parts[-1], parts[4][0])
         self._drawn_from[i] = None
         self.state[i, NORMALS_USED] = NORMALS_AHEAD
-        self.consts[i, NORMALS_PER_STEP] = 3 * robot._noisy + n_r * (
-            radio.config.noise_sigma_db > 0
-        )
+        noisy_radio = radio.config.noise_sigma_db > 0
+        self.consts[i, NORMALS_PER_STEP] = 3 * robot._noisy + n_r * noisy_radio
         self.consts[i, CAPACITY] = min(len(b) for b in buffers)
         rc, grid, ob = cfg.robot, env.grid, builder
         x0, y0, x1, y1 = env._grid_bounds
         c = self.consts[i]
-        c[RADIUS], c[MAX_V], c[MAX_W] = (
-            rc.radius_m,
-            rc.max_linear_speed_m_s,
-            rc.max_angular_speed_rad_s,
-        )
+        c[RADIUS] = rc.radius_m
         c[PERIOD], c[SUBSTEPS], c[WALL_R] = (
             rc.control_period_s,
             rc.physics_substeps,
