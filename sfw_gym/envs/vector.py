@@ -7,9 +7,10 @@ Each sub-env is the single env with its seed, bit for bit. Autoreset is Gymnasiu
 observation with reward 0. There is no process boundary and no per-step deep copy.
 
 Sub-envs of `SfWExploreEnv` (odometry or true poses, no LiDAR, no background access points) step
-together through `sfw_gym.envs.batch_step`: the robots' open-space motion in one compiled call,
-the readings, map updates, metrics and observations of all of them in another. The rest step one
-by one in Python, as do resets, a robot next to a wall (pymunk) and an episode's last step.
+together through `sfw_gym.envs.batch_step`: the robots' contact-free motion in one compiled call,
+the readings, map updates, metrics and observations of all of them in another. Other env classes
+step one by one in Python, as do resets, a robot's step with a wall contact (pymunk) and the
+info of an episode's last step.
 """
 
 from __future__ import annotations
