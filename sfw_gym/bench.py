@@ -16,6 +16,9 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+#: Sub-envs of the native vector env that ``sfw-gym speed`` times beside one env.
+VECTOR_ENVS = 16
+
 
 @dataclass
 class EnvTiming:
@@ -49,6 +52,24 @@ def time_env(env_id: str, steps: int, resets: int, seed: int = 0, **kwargs) -> E
         reset_times.append((time.perf_counter() - start) * 1e3)
     env.close()
     return EnvTiming(env_id, steps_per_s, statistics.median(reset_times))
+
+
+def time_vector_env(env_id: str, num_envs: int, steps: int, seed: int = 0) -> float:
+    """Env steps/s of ``num_envs`` sub-envs of the native vector env (``gym.make_vec``'s
+    default: one process, the explore sub-envs stepped together), ``steps`` vector steps of
+    random actions after a warm-up; its autoreset resets inside the timing."""
+    vec = gym.make_vec(env_id, num_envs=num_envs)
+    vec.reset(seed=seed)
+    vec.action_space.seed(seed)
+    actions = [vec.action_space.sample() for _ in range(steps + 20)]
+    for action in actions[:20]:
+        vec.step(action)
+    start = time.perf_counter()
+    for action in actions[20:]:
+        vec.step(action)
+    rate = steps * num_envs / (time.perf_counter() - start)
+    vec.close()
+    return rate
 
 
 def current_rss_mib() -> float:
@@ -97,6 +118,12 @@ def run_bench(env_id: str, steps: int, resets: int, memory_steps: int = 0) -> li
         ratio = ours.steps_per_s / r.steps_per_s
         lines.append(f"{r.env_id:<28} {r.steps_per_s:>10,.0f} {r.reset_ms:>9.2f} {ratio:>13.3f}x")
     lines.append(f"(ratio = {env_id} steps/s ÷ that env's; {steps} random steps, {resets} resets)")
+    n = VECTOR_ENVS
+    batch = time_vector_env(env_id, n, max(steps // n, 20))
+    lines.append(
+        f"{env_id} × {n} in one process (gym.make_vec): {batch:,.0f} env steps/s = "
+        f"{batch / ours.steps_per_s:.2f}× one env"
+    )
     lines.append(
         f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} CPUs; "
         f"1-min load average {load_before:.2f} before, {os.getloadavg()[0]:.2f} after"
