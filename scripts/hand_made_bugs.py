@@ -347,7 +347,7 @@ CASES = [
     (
         "batch.unwrapped-heading",
         "sfw_gym/envs/batch_step.py",
-        "        tx, ty, tt = s[X], s[Y], wrap_angle(s[A])",
+        "        tx, ty, tt = s[X], s[Y], wrap_heading(s[A])",
         "        tx, ty, tt = s[X], s[Y], s[A]",
         VECTOR_TESTS,
     ),

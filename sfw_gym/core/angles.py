@@ -15,7 +15,7 @@ def wrap_angle(a: A) -> A:
 
     The robot's own heading (``world.robot``) and the LiDAR gate use IEEE ``math.remainder``
     instead, which rounds differently in the last bit; they keep it so that the simulation's
-    behaviour digest stays as recorded.
+    behaviour digest stays as recorded (compiled: `sfw_gym.core.exact_math.wrap_heading`).
     """
     return (a + np.pi) % (2.0 * np.pi) - np.pi
 

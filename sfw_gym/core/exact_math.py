@@ -84,6 +84,7 @@ def remainder(x: float, y: float) -> float:
 
 
 @njit(cache=True)
-def wrap_angle(theta: float) -> float:
-    """``math.remainder(theta, math.tau)``: the angle in [-π, π], as the robot wraps it."""
+def wrap_heading(theta: float) -> float:
+    """``math.remainder(theta, math.tau)``: the angle in [-π, π], as the robot wraps its
+    heading (not `sfw_gym.core.angles.wrap_angle`, which rounds differently in the last bit)."""
     return remainder(theta, 2.0 * math.pi)

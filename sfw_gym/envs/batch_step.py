@@ -23,7 +23,7 @@ from numba import njit
 from numba.typed import List
 
 from sfw_gym.core.constants import NOT_HEARD_DBM
-from sfw_gym.core.exact_math import hypot, wrap_angle
+from sfw_gym.core.exact_math import hypot, wrap_heading
 from sfw_gym.envs.map_tracker import (
     _AGREE,
     _COVERED,
@@ -66,11 +66,6 @@ N_INFO = len(FLOAT_INFO) + len(INT_INFO) + 3 * len(POSE_INFO)
 _K_ACCURACY, _PATH, _POSE_ERROR, _ATE, _ENTROPY, _GAIN = range(len(METRICS), len(FLOAT_INFO))
 _COLLISIONS, _TO_50, _TO_90, _MAX_STEPS = range(len(FLOAT_INFO), len(FLOAT_INFO) + len(INT_INFO))
 _TRUE_POSE, _ODOMETRY_POSE, _POSE_ESTIMATE = range(len(FLOAT_INFO) + len(INT_INFO), N_INFO, 3)
-# All info entries in `SfWExploreEnv._info`'s order.
-INFO_ORDER = (*METRICS, "k_accuracy", "path_length_m", "collisions", "true_pose",
-              "odometry_pose", "pose_estimate", "pose_error_m", "ate_m", "entropy_bits",
-              "info_gain_bits", "steps_to_coverage_50", "steps_to_coverage_90", "floorplan",
-              "max_steps")  # fmt: skip
 
 
 @njit(cache=True)
@@ -231,7 +226,7 @@ def sense_and_map(
         s[PATH_M] += s[MOVED_M]
         s[COLLISIONS] += s[BUMPED]
         # the reading at the true pose (RadioModel.measure_at)
-        tx, ty, tt = s[X], s[Y], wrap_angle(s[A])
+        tx, ty, tt = s[X], s[Y], wrap_heading(s[A])
         pts[0, 0], pts[0, 1] = tx, ty
         _rssi_range(
             edges, edge_loss, routers, pts, radio_params, tables, origin, spacing, mean_db,
@@ -247,9 +242,9 @@ def sense_and_map(
         if c[TRUE_POSE]:
             px, py, pt = tx, ty, tt
         else:
-            px, py, pt = s[ODO_X], s[ODO_Y], wrap_angle(s[ODO_T])
+            px, py, pt = s[ODO_X], s[ODO_Y], wrap_heading(s[ODO_T])
         s[EST_X], s[EST_Y], s[EST_T] = px, py, pt
-        s[TRUE_T], s[ODO_TW] = tt, wrap_angle(s[ODO_T])
+        s[TRUE_T], s[ODO_TW] = tt, wrap_heading(s[ODO_T])
         s[POSE_ERR] = hypot(px - tx, py - ty)
         row = int(s[N_ROWS])
         for r in range(n_routers):
@@ -402,6 +397,7 @@ class BatchStepper:
         self._episodes: list[Any] = [None] * num_envs  # an _Episode once attached
         self.synced = np.ones(num_envs, np.bool_)
         self.info_rows = np.zeros((num_envs, N_INFO))
+        self.info_order: tuple[str, ...] = ()  # the keys of `SfWExploreEnv._info`, in order
         # the generator's state before the normals of each sub-env were drawn ahead (None: none)
         self._drawn_from: list[Any] = [None] * num_envs
 
@@ -430,6 +426,8 @@ class BatchStepper:
             or any(a is not b for a, b in zip(self._episodes[i].buffers, buffers, strict=True))
         ):
             self._attach(i, env, buffers)
+            if not self.info_order:  # the env's own order: one place for it
+                self.info_order = tuple(env._info(terminal=False))
         else:  # the map may have changed outside: redraw its image
             self._episodes[i].belief_px[:] = env.obs_builder.image_of(env.mapper.occupancy_u8)
         self.synced[i] = True
@@ -593,6 +591,6 @@ class BatchStepper:
         every = np.ones(len(table[0]), np.bool_)
         every.flags.writeable = False
         out: dict[str, Any] = {}
-        for key in INFO_ORDER:
+        for key in self.info_order:  # a key the env added and this lacks: a KeyError here
             out[key], out[f"_{key}"] = columns[key], every
         return out

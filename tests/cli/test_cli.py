@@ -347,6 +347,8 @@ def test_bench_memory_option_reports_rss(inputs, capsys):
     out = run_cli([*BENCH, "--memory-steps", "30"], capsys)
     assert re.search(r"memory: RSS .* MiB before, .* MiB after 30 steps", out)
     assert "SfW-ExploreSmall-v0" in out and "CartPole-v1" in out and "load average" in out
+    # the native vector env beside one env (issue 33)
+    assert re.search(r"SfW-ExploreSmall-v0 × 16 in one process .*: [\d,]+ env steps/s = ", out)
 
 
 def test_a_failure_is_one_line_and_status_1_and_debug_shows_the_traceback(monkeypatch, capsys):

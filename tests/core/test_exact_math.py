@@ -8,7 +8,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from sfw_gym.core.exact_math import hypot, remainder, wrap_angle
+from sfw_gym.core.exact_math import hypot, remainder, wrap_heading
 
 finite = st.floats(allow_nan=False, allow_infinity=False)
 
@@ -40,4 +40,4 @@ def test_remainder_is_cpythons_to_the_bit(x, y):
 def test_wrap_angle_is_the_robots_wrap_including_the_half_way_cases():
     angles = [k * math.pi for k in range(-9, 10)] + [-0.0, 0.0, 1e6, -3 * math.tau + 1e-12]
     for a in angles:
-        assert _bits(wrap_angle(a)) == _bits(math.remainder(a, math.tau)), a
+        assert _bits(wrap_heading(a)) == _bits(math.remainder(a, math.tau)), a
