@@ -484,3 +484,27 @@ def test_the_model_of_a_run_folder_is_found_by_its_env_id_or_the_old_name(tmp_pa
     (run / "SfW-ExploreRegions-v0").mkdir()
     (run / "SfW-ExploreRegions-v0" / "config.yml").write_text("{}")
     assert find_model(run) == run / "SfW-ExploreRegions-v0.zip"
+
+
+def test_n_envs_step_in_the_native_vector_env_unless_wrapped_or_told_otherwise(tmp_path):
+    """``sfw-gym train``'s ``--vec-env``: the native env for bare envs (issue 33), SB3's
+    SubprocVecEnv under an ``env_wrapper`` or with ``vec_env="subproc"``."""
+    from stable_baselines3.common.vec_env import SubprocVecEnv
+
+    from sfw_gym.envs.vector import SfWVectorEnv
+    from sfw_gym.rl.training import _make_venv
+    from sfw_gym.rl.vec_env import SB3VecEnv
+
+    waypoints = [("sfw_gym.envs.waypoint.WaypointWrapper", {})]
+    cases = [("native", [], SB3VecEnv), ("native", waypoints, SubprocVecEnv)]
+    cases.append(("subproc", [], SubprocVecEnv))
+    for vec_env, wrappers, kind in cases:
+        venv = _make_venv(SMALL_ID, 2, 0, TINY, wrappers, tmp_path / "m.csv", vec_env)
+        try:
+            assert type(venv.venv) is kind, (vec_env, wrappers)
+            if kind is SB3VecEnv:
+                assert isinstance(venv.venv.venv, SfWVectorEnv) and venv.venv.venv._batched
+        finally:
+            venv.close()
+    with pytest.raises(ConfigError, match="unknown vec_env 'dummy'"):
+        train_ppo(SMALL_ID, 64, tmp_path / "run", vec_env="dummy", progress_bar=False)
