@@ -486,6 +486,7 @@ def test_the_model_of_a_run_folder_is_found_by_its_env_id_or_the_old_name(tmp_pa
     assert find_model(run) == run / "SfW-ExploreRegions-v0.zip"
 
 
+@pytest.mark.episode  # starts SB3's worker processes
 def test_n_envs_step_in_the_native_vector_env_unless_wrapped_or_told_otherwise(tmp_path):
     """``sfw-gym train``'s ``--vec-env``: the native env for bare envs (issue 33), SB3's
     SubprocVecEnv under an ``env_wrapper`` or with ``vec_env="subproc"``."""
