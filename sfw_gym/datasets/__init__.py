@@ -1,0 +1,24 @@
+"""Real WiFi fingerprint data: one :class:`Fingerprints` type (positions in metres, RSSI with "not
+heard" kept apart, access point names, optional floor, building, trajectory and time) and its
+readers: the generic CSV (the command line's contract), UJIIndoorLoc and WiFine."""
+
+from __future__ import annotations
+
+from sfw_gym.datasets.fingerprints import META_COLUMNS, Fingerprints
+from sfw_gym.datasets.readers import (
+    GENERIC_NOT_HEARD,
+    concatenate,
+    read_csv,
+    read_ujiindoorloc,
+    read_wifine,
+)
+
+__all__ = [
+    "GENERIC_NOT_HEARD",
+    "META_COLUMNS",
+    "Fingerprints",
+    "concatenate",
+    "read_csv",
+    "read_ujiindoorloc",
+    "read_wifine",
+]
