@@ -5,6 +5,12 @@ readers: the generic CSV (the command line's contract), UJIIndoorLoc and WiFine.
 from __future__ import annotations
 
 from sfw_gym.datasets.fingerprints import META_COLUMNS, Fingerprints
+from sfw_gym.datasets.odometry import (
+    DRIFT_HEADING_STD_RAD,
+    DRIFT_TRANSLATION_STD,
+    synthetic_odometry,
+    walk_poses,
+)
 from sfw_gym.datasets.readers import (
     GENERIC_NOT_HEARD,
     concatenate,
@@ -14,6 +20,8 @@ from sfw_gym.datasets.readers import (
 )
 
 __all__ = [
+    "DRIFT_HEADING_STD_RAD",
+    "DRIFT_TRANSLATION_STD",
     "GENERIC_NOT_HEARD",
     "META_COLUMNS",
     "Fingerprints",
@@ -21,4 +29,6 @@ __all__ = [
     "read_csv",
     "read_ujiindoorloc",
     "read_wifine",
+    "synthetic_odometry",
+    "walk_poses",
 ]
