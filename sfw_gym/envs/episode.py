@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -63,15 +63,17 @@ class GroundTruth:
 
 
 def resolve_floorplan(source: Any, generator_params: dict[str, Any] | None = None) -> Floorplan:
-    """A Floorplan from a Floorplan, a generator seed (int) or a JSON file path."""
+    """A Floorplan from a Floorplan, a generator seed (int) or a plan file's path (JSON, or a
+    ROS map's YAML: :func:`~sfw_gym.world.load_floorplan`)."""
     if isinstance(source, Floorplan):
         return source
     if isinstance(source, int | np.integer) and not isinstance(source, bool):
         return generate_floorplan(int(source), **(generator_params or {}))
-    if isinstance(source, str | Path):
+    if isinstance(source, str | os.PathLike):
         return load_floorplan(source)
     raise ConfigError(
-        f"floorplan must be a Floorplan, a generator seed (int) or a JSON path, got {source!r:.80}"
+        "floorplan must be a Floorplan, a generator seed (int) or a plan file's path, got "
+        f"{source!r:.80}"
     )
 
 

@@ -216,7 +216,8 @@ class Floorplan:
 
 
 def load_floorplan(source: str | os.PathLike[str] | Mapping[str, Any]) -> Floorplan:
-    """Load a HouseExpo JSON file or an sfw_gym JSON file (or an already parsed dict).
+    """Load a HouseExpo JSON file, an sfw_gym JSON file (or an already parsed dict) or a ROS
+    map_server map (a ``.yaml`` / ``.yml`` path: :mod:`sfw_gym.world.ros_map`).
 
     Raises:
         FloorplanError: naming the file and the problem (not JSON, missing keys, too few vertices,
@@ -225,6 +226,10 @@ def load_floorplan(source: str | os.PathLike[str] | Mapping[str, Any]) -> Floorp
     if isinstance(source, Mapping):
         where, data = "<dict>", source
     else:
+        from sfw_gym.world.ros_map import ROS_MAP_SUFFIXES, load_ros_map
+
+        if Path(source).suffix.lower() in ROS_MAP_SUFFIXES:
+            return load_ros_map(source)
         where = str(source) if str(source).isprintable() else repr(str(source))
         try:
             size = Path(source).stat().st_size
