@@ -27,6 +27,9 @@ class RadioSlamConfig(Config):
 
     prefix: ClassVar[str | None] = "slam"
     sigma_db: float = setting(6.0, gt=0.0, le=50.0)  # the kernel similarity's width
+    # readings weaker than this count as not heard in the similarity (None: every reading);
+    # real scans carry weak, flickering and stale readings near the sensitivity floor
+    min_rssi_dbm: float | None = setting(None, optional=True)
     train_travel_m: float = setting(3.0, gt=0.0)  # pairs this short a drive apart fit the model
     train_lag: int = setting(40, integer=True, ge=1)  # … at most this many poses apart
     min_travel_m: float = setting(10.0, ge=0.0)  # closures: at least this long a drive apart
@@ -37,6 +40,9 @@ class RadioSlamConfig(Config):
     max_closures: int = setting(2000, integer=True, ge=1)  # an even subsample beyond this
     min_sigma_m: float = setting(0.3, gt=0.0)  # a closure's standard deviation at least
     odometry_sigma_m: float = setting(0.02, gt=0.0)  # per step
+    # … plus this much per metre of each step's odometry travel, added in quadrature (odometry
+    # whose error grows with the distance driven, as the robot's and the datasets' synthetic one)
+    odometry_sigma_per_m: float = setting(0.0, ge=0.0)
     odometry_sigma_rad: float = setting(0.02, gt=0.0)  # per step
     robust: str = setting("cauchy", choices=("none", "huber", "cauchy"))
     robust_scale: float = setting(0.5, gt=0.0)  # the kernel's scale, in closure sigmas
@@ -82,13 +88,23 @@ def fit_range_model(
     is ``since`` or after: called on a growing run, each pair is added once."""
     n = len(odometry)
     along = travelled_m(odometry)
+    fp = heard_readings(fingerprints, config)
     for lag in range(1, min(config.train_lag, n - 1) + 1):
         j = np.arange(max(since, lag), n)
         i = j - lag
         short = along[j] - along[i] <= config.train_travel_m
         i, j = i[short], j[short]
         d = np.linalg.norm(odometry[j, :2] - odometry[i, :2], axis=1)
-        model.update(kernel_similarity(fingerprints[i], fingerprints[j], config.sigma_db), d)
+        model.update(kernel_similarity(fp[i], fp[j], config.sigma_db), d)
+
+
+def heard_readings(fingerprints: np.ndarray, config: RadioSlamConfig) -> np.ndarray:
+    """``fingerprints`` ``(N, L)`` with the readings weaker than ``config.min_rssi_dbm`` set to
+    not heard (NaN); as they are where it is None."""
+    fp = np.asarray(fingerprints, np.float64)
+    if config.min_rssi_dbm is None:
+        return fp
+    return np.where(fp >= config.min_rssi_dbm, fp, np.nan)
 
 
 def radio_slam(
@@ -115,17 +131,17 @@ def radio_slam(
     node = np.full(n, -1)
     node[keys] = np.arange(len(keys))
     start = (odo if initial is None else np.asarray(initial, np.float64))[keys]
+    sigma_xy = odometry_sigmas_m(odo, keys, cfg)
 
     def solve(use: np.ndarray, start: np.ndarray) -> np.ndarray:
         graph = PoseGraph(len(keys), robust=cfg.robust, robust_scale=cfg.robust_scale)
         for k, (a, b) in enumerate(zip(keys[:-1].tolist(), keys[1:].tolist(), strict=True)):
-            spread = math.sqrt(b - a)  # independent per-step errors add up
             graph.add_odometry(
                 k,
                 k + 1,
                 relative_pose(odo[a], odo[b]),
-                cfg.odometry_sigma_m * spread,
-                cfg.odometry_sigma_rad * spread,
+                float(sigma_xy[k]),
+                cfg.odometry_sigma_rad * math.sqrt(b - a),  # independent per-step errors add up
             )
         for (i, j), m, sd in zip(
             node[pairs[use]].tolist(), mean[use].tolist(), sigma[use].tolist(), strict=True
@@ -142,6 +158,18 @@ def radio_slam(
     anchor = keys[np.searchsorted(keys, np.arange(n), side="right") - 1]
     poses = chain(solved[node[anchor]], odo[anchor], odo)
     return RadioSlamResult(poses, pairs[use], mean[use], sigma[use])
+
+
+def odometry_sigmas_m(
+    odometry: np.ndarray, keys: np.ndarray, config: RadioSlamConfig
+) -> np.ndarray:
+    """The translation standard deviation (m) of each odometry edge between consecutive
+    ``keys``: ``odometry_sigma_m`` per step and ``odometry_sigma_per_m`` per metre of each
+    step's travel, independent per step (their variances add up)."""
+    step = np.linalg.norm(np.diff(odometry[:, :2], axis=0), axis=1)
+    per_step = config.odometry_sigma_m**2 + (config.odometry_sigma_per_m * step) ** 2
+    var = np.r_[0.0, np.cumsum(per_step)]
+    return np.sqrt(np.diff(var[keys]))
 
 
 def consistent_closures(
@@ -164,7 +192,7 @@ def radio_closures(
     and standard deviations (m); the arguments as :func:`radio_slam`'s."""
     cfg = config or RadioSlamConfig()
     odo = np.asarray(odometry, np.float64)
-    fp = np.asarray(fingerprints, np.float64)
+    fp = heard_readings(fingerprints, cfg)
     travelled = travelled_m(odo)
     if model is None:
         model = SimilarityRangeModel()
