@@ -232,6 +232,64 @@ def _cmd_localize(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_fingerprints(args: argparse.Namespace) -> int:
+    from sfw_gym.datasets import read_csv, read_ujiindoorloc, read_wifine
+
+    if args.action == "convert":
+        if args.format == "ujiindoorloc":
+            data = read_ujiindoorloc(args.source, args.split)
+        elif args.format == "wifine":
+            data = read_wifine(args.source)
+        else:
+            data = read_csv(args.source, not_heard=args.not_heard)
+        data.to_csv(args.output)
+        print(f"wrote {args.output}: {len(data)} scans, {data.n_access_points} access points")
+        return 0
+    from sfw_gym.evaluation.fingerprints import TrackSettings, evaluate, write_evaluation
+    from sfw_gym.world.floorplan import load_floorplan
+
+    train = read_csv(args.train, not_heard=args.not_heard)
+    test = read_csv(args.test, not_heard=args.not_heard)
+    track = None
+    if args.track:
+        plans = {floor: load_floorplan(path) for floor, path in args.floorplan}
+        track = TrackSettings(
+            translation_std=args.odometry_translation_std,
+            heading_std_rad=args.odometry_heading_std_rad,
+            seed=args.seed,
+            particles=args.particles,
+            floorplans=plans,
+        )
+    elif args.floorplan:
+        raise ConfigError("--floorplan: only used with --track")
+    metrics, columns = evaluate(train, test, args.method, track)
+    paths = write_evaluation(args.out, metrics, columns)
+    print(_fingerprint_summary(metrics))
+    print(f"wrote {paths['metrics']} and {paths['predictions']}")
+    return 0
+
+
+def _fingerprint_summary(metrics: dict) -> str:
+    line = (
+        f"{metrics['method']}: {metrics['n_test']} scans, mean error {metrics['mean_error_m']:.2f}"
+        f" (median {metrics['median_error_m']:.2f}, p95 {metrics['p95_error_m']:.2f})"
+    )
+    if "per_scan_mean_error_m" in metrics:
+        line += f", per scan {metrics['per_scan_mean_error_m']:.2f}"
+    for key in ("floor_hit_rate", "building_hit_rate"):
+        if key in metrics:
+            line += f", {key.split('_')[0]} {100 * metrics[key]:.1f} %"
+    return line + f"; fit {metrics['fit_s']:.1f} s, {metrics['query_ms_per_scan']:.2f} ms a scan"
+
+
+def parse_floorplan_option(text: str) -> tuple[int | None, str]:
+    """``--floorplan``: ``PATH`` (every floor) or ``FLOOR=PATH``."""
+    floor, sep, path = text.partition("=")
+    if sep and floor.strip().lstrip("-").isdigit():
+        return int(floor), path
+    return None, text
+
+
 def _cmd_bench(args: argparse.Namespace) -> int:
     from sfw_gym.bench import main_bench
 
@@ -408,6 +466,7 @@ EXAMPLES = {
     "record": "sfw-gym record walk.csv --seed 3 --routers 2",
     "slam": "sfw-gym slam drift.csv --record 7",
     "localize": "sfw-gym localize --plans 10 --out localize",
+    "fingerprints": "sfw-gym fingerprints evaluate --train train.csv --test test.csv --out fp",
     "speed": "sfw-gym speed --steps 5000 --resets 50",
     "train": "sfw-gym train ppo_mask --env SfW-ExploreRegions-v0 --out runs/regions --resume",
     "evaluate": "sfw-gym evaluate --agents frontier,ppo,greedy --episodes 10 --seed 2000000",
@@ -613,6 +672,8 @@ def build_parser() -> argparse.ArgumentParser:
     slam.add_argument("--out", type=folder, default=None, help="output folder (default LOG_slam/)")
     slam.set_defaults(func=_cmd_slam)
 
+    _add_fingerprints_parser(sub)
+
     loc = sub.add_parser(
         "localize",
         help="WiFi Monte-Carlo localisation on Gaussian gridmaps: the paper's tables → OUT/",
@@ -785,6 +846,77 @@ def build_parser() -> argparse.ArgumentParser:
         sub.choices[name].formatter_class = HelpWithDefaults
         sub.choices[name].epilog = f"example:\n  {example}"
     return parser
+
+
+def _add_fingerprints_parser(sub) -> None:
+    """``fingerprints evaluate`` and ``fingerprints convert``."""
+    from sfw_gym.datasets import DRIFT_HEADING_STD_RAD, DRIFT_TRANSLATION_STD
+    from sfw_gym.datasets.readers import GENERIC_NOT_HEARD, UJI_SPLITS
+    from sfw_gym.localization.fingerprinting import DEFAULT_METHOD, METHODS
+    from sfw_gym.localization.tracking import TRACK_PARTICLES
+
+    fp = sub.add_parser(
+        "fingerprints",
+        help="WiFi fingerprint localisation on real surveys (CSV): evaluate, or convert a dataset",
+        description="sfw-gym fingerprints evaluate --train TRAIN.csv --test TEST.csv --out DIR | "
+        "sfw-gym fingerprints convert --format FORMAT SOURCE OUT.csv",
+    )
+    actions = fp.add_subparsers(dest="action", metavar="{evaluate,convert}", required=True)
+    ev = actions.add_parser(
+        "evaluate",
+        help="fit on TRAIN, locate TEST → DIR/metrics.json, DIR/predictions.csv",
+        description="CSV: a header; x, y (metres); optional floor, building (integers), "
+        "trajectory (a label), t (seconds); every other column one access point's RSSI in dBm, "
+        "--not-heard or an empty cell meaning not heard. --track: the test rows of each "
+        "trajectory, in t order, are one walk; its odometry is SYNTHETIC (the true positions "
+        "plus noise), and WiFi MCL on the Gaussian gridmaps tracks it.",
+    )
+    ev.add_argument("--train", required=True, help="training fingerprints (CSV)")
+    ev.add_argument("--test", required=True, help="test fingerprints (CSV)")
+    ev.add_argument("--out", type=folder, required=True, help="output folder")
+    ev.add_argument("--method", default=DEFAULT_METHOD, choices=METHODS)
+    ev.add_argument(
+        "--not-heard", type=float, default=GENERIC_NOT_HEARD, help="the value meaning not heard"
+    )
+    ev.add_argument("--track", action="store_true", help="track each test trajectory (MCL)")
+    ev.add_argument(
+        "--floorplan",
+        type=parse_floorplan_option,
+        action="append",
+        default=[],
+        metavar="[FLOOR=]PLAN",
+        help="with --track: particles keep to this plan's free space (a ROS map .yaml or a "
+        "plan JSON); FLOOR=PLAN for one floor, repeatable",
+    )
+    ev.add_argument(
+        "--odometry-translation-std",
+        type=non_negative_float,
+        default=DRIFT_TRANSLATION_STD,
+        help="synthetic odometry: translation noise per metre walked",
+    )
+    ev.add_argument(
+        "--odometry-heading-std-rad",
+        type=non_negative_float,
+        default=DRIFT_HEADING_STD_RAD,
+        help="synthetic odometry: heading noise per step (rad)",
+    )
+    ev.add_argument("--seed", type=seed_int, default=0, help="the odometry and particles' seed")
+    ev.add_argument(
+        "--particles", type=positive_int, default=TRACK_PARTICLES, help="particles per walk"
+    )
+    conv = actions.add_parser("convert", help="a dataset in its own layout → the generic CSV")
+    conv.add_argument("--format", required=True, choices=["csv", "ujiindoorloc", "wifine"])
+    conv.add_argument(
+        "--split", default="train", choices=sorted(UJI_SPLITS), help="UJIIndoorLoc's split"
+    )
+    conv.add_argument(
+        "--not-heard", type=float, default=GENERIC_NOT_HEARD, help="csv: the value meaning not heard"
+    )
+    conv.add_argument("source", help="UJIIndoorLoc's zip, a WiFine CSV or folder, or a CSV")
+    conv.add_argument("output", help="the generic CSV to write")
+    for parser_ in (ev, conv):
+        parser_.formatter_class = HelpWithDefaults
+    fp.set_defaults(func=_cmd_fingerprints)
 
 
 def _add_benchmark_run_options(parser: argparse.ArgumentParser) -> None:

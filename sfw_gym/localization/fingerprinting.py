@@ -3,8 +3,9 @@
 Methods (:data:`METHODS`), each fit on a training :class:`~sfw_gym.datasets.Fingerprints` and
 queried one scan at a time:
 
-- ``1nn``, ``wknn``: the field's baselines: k-NN regression on raw RSSI (not heard → −105 dBm),
-  1 neighbour, or 5 weighted by inverse distance; building and floor by the same neighbours' vote.
+- ``1nn``, ``w3nn``, ``w5nn``: the field's baselines: k-NN regression on raw RSSI (not heard →
+  −105 dBm), 1 neighbour, or 3 or 5 weighted by inverse distance; building and floor by the same
+  neighbours' vote.
 - ``sorensen``: weighted 10-NN on the *powed* representation (((RSSI + 104) / 104)², not heard →
   0) with the Sørensen (Bray–Curtis) distance (Torres-Sospedra et al. 2015's best pair):
   building and floor by the neighbours' weighted vote, then the position from the neighbours in
@@ -159,7 +160,8 @@ class FloorMaps:
 
     gridmaps: GaussianGridmaps
     access_points: np.ndarray  # columns of the training data's access points
-    cells: np.ndarray  # (C, 2) centres of the cells near the survey
+    allowed: np.ndarray  # (h, w) the gridmaps' cells near the survey
+    cells: np.ndarray  # (C, 2) their centres
     mean: np.ndarray = field(repr=False)  # (C, L) at those cells
     variance: np.ndarray = field(repr=False)
 
@@ -203,10 +205,17 @@ class GridmapLocalizer:
         x1, y1 = fp.positions.max(0) + NEAR_SURVEY_M
         maps = GaussianGridmaps.from_model(model, (x0, y0, x1, y1), self.resolution_m)
         centres = maps.cell_centres()
-        near = cKDTree(binned.positions).query(centres, distance_upper_bound=NEAR_SURVEY_M)[0]
-        cells = centres[np.isfinite(near)]
-        mean, var = maps.lookup(cells)
-        return FloorMaps(maps, aps, cells, np.ascontiguousarray(mean), np.ascontiguousarray(var))
+        dist = cKDTree(binned.positions).query(centres, distance_upper_bound=NEAR_SURVEY_M)[0]
+        near = np.isfinite(dist)
+        mean, var = maps.lookup(centres[near])
+        return FloorMaps(
+            maps,
+            aps,
+            near.reshape(maps.shape),
+            centres[near],
+            np.ascontiguousarray(mean),
+            np.ascontiguousarray(var),
+        )
 
     def predict(self, test: Fingerprints) -> Prediction:
         start = time.perf_counter()
@@ -226,7 +235,8 @@ def _sorensen() -> KnnLocalizer:
 
 _FACTORIES = {
     "1nn": lambda: KnnLocalizer(1, False, "euclidean", raw_features),
-    "wknn": lambda: KnnLocalizer(5, True, "euclidean", raw_features),
+    "w3nn": lambda: KnnLocalizer(3, True, "euclidean", raw_features),
+    "w5nn": lambda: KnnLocalizer(5, True, "euclidean", raw_features),
     "sorensen": _sorensen,
     "gridmaps": GridmapLocalizer,
 }

@@ -1,0 +1,81 @@
+"""Tracking a walk with WiFi MCL on one floor's Gaussian gridmaps: global localisation from the
+first scan (Alg. 1, no prior), then odometry and scans; with a floorplan the particles live in
+its free space and a particle whose move crosses a wall (or ends outside the free space) dies."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from sfw_gym.localization.fingerprinting import FloorMaps
+from sfw_gym.localization.mcl import MclConfig, WifiMCL
+from sfw_gym.world.floorplan import Floorplan
+
+#: Particles per walk.
+TRACK_PARTICLES = 2000
+#: Draws of a global initialisation that land in a wall are drawn again at most this often.
+_INIT_REDRAWS = 20
+
+
+@dataclass(frozen=True)
+class WalledMCL:
+    """A :class:`WifiMCL` whose particles keep to a floorplan's free space."""
+
+    mcl: WifiMCL
+    plan: Floorplan | None
+
+    def _free(self, xy: np.ndarray) -> np.ndarray:
+        return np.ones(len(xy), bool) if self.plan is None else self.plan.is_free(xy)
+
+    def start(self, rssi_dbm: np.ndarray) -> None:
+        """Global localisation from one scan; draws in a wall are drawn again."""
+        self.mcl.global_init(rssi_dbm)
+        for _ in range(_INIT_REDRAWS):
+            stuck = ~self._free(self.mcl.particles[:, :2])
+            if not stuck.any():
+                break
+            self.mcl.particles[stuck] = self.mcl.sample_from_reading(rssi_dbm, int(stuck.sum()))
+
+    def step(self, increment: np.ndarray, rssi_dbm: np.ndarray) -> np.ndarray:
+        """Move by an odometry increment, kill what crossed a wall, weigh by the scan; the
+        estimate ``(x, y)``."""
+        before = self.mcl.particles[:, :2].copy()
+        self.mcl.predict(increment)
+        if self.plan is not None:
+            after = self.mcl.particles[:, :2]
+            dead = ~self.plan.is_free(after) | (self.plan.count_walls(before, after) > 0)
+            if dead.all():  # lost: start again from this scan
+                self.start(rssi_dbm)
+            else:
+                w = np.where(dead, 0.0, self.mcl.weights)
+                self.mcl.weights = w / w.sum()
+        self.mcl.update(rssi_dbm)
+        return self.mcl.estimate()[0][:2]
+
+
+def track_walk(
+    floor: FloorMaps,
+    rssi_dbm: np.ndarray,
+    increments: np.ndarray,
+    *,
+    plan: Floorplan | None = None,
+    particles: int = TRACK_PARTICLES,
+    rng: np.random.Generator | int | None = 0,
+) -> np.ndarray:
+    """Estimated positions ``(N, 2)`` along a walk: ``rssi_dbm`` ``(N, L)`` over the training
+    access points, ``increments`` ``(N - 1, 3)`` odometry (forward, lateral, turn) between scans."""
+    rssi = np.asarray(rssi_dbm, np.float64)[:, floor.access_points]
+    mcl = WifiMCL(
+        floor.gridmaps,
+        MclConfig(particles=particles),
+        np.random.default_rng(rng),
+        allowed=floor.allowed,
+    )
+    tracker = WalledMCL(mcl, plan)
+    tracker.start(rssi[0])
+    estimates = np.empty((len(rssi), 2))
+    estimates[0] = mcl.estimate()[0][:2]
+    for k, increment in enumerate(increments, start=1):
+        estimates[k] = tracker.step(increment, rssi[k])
+    return estimates
