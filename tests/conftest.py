@@ -9,7 +9,10 @@ from shapely.geometry import Polygon
 
 from sfw_gym.world.floorplan import Floorplan, floorplan_from_polygon
 
-HOUSEEXPO_DIR = Path(__file__).resolve().parents[1].parent / "shared" / "floorplans" / "houseexpo"
+SHARED_DIR = Path(__file__).resolve().parents[1].parent / "shared"
+HOUSEEXPO_DIR = SHARED_DIR / "floorplans" / "houseexpo"
+#: The real WiFi datasets (../shared/datasets/README.md); tests that need them skip without them.
+DATASETS_DIR = SHARED_DIR / "datasets"
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

@@ -28,20 +28,21 @@ from sfw_gym.localization.fingerprinting import (
     Prediction,
     make_localizer,
 )
-from sfw_gym.localization.tracking import TRACK_PARTICLES, track_walk
+from sfw_gym.localization.tracking import TRACK_PARTICLES, WALL_WEIGHT, track_walk
 from sfw_gym.world.floorplan import Floorplan
 
 
 @dataclass(frozen=True)
 class TrackSettings:
-    """``--track``: the synthetic odometry's noise, its seed, the particles and floorplans (by
-    floor; the key None: every floor)."""
+    """``--track``: the synthetic odometry's noise, its seed, the particles, floorplans (by
+    floor; the key None: every floor) and the weight a particle keeps when it crosses a wall."""
 
     translation_std: float = DRIFT_TRANSLATION_STD
     heading_std_rad: float = DRIFT_HEADING_STD_RAD
     seed: int = 0
     particles: int = TRACK_PARTICLES
     floorplans: Mapping[int | None, Floorplan] | None = None
+    wall_weight: float = WALL_WEIGHT
 
     def plan_for(self, floor: int | None) -> Floorplan | None:
         plans = self.floorplans or {}
@@ -135,16 +136,21 @@ def _track(
             rng=[settings.seed, walks],
         )
         plan = settings.plan_for(key % 1000 if per_scan.floor is not None else None)
+        walk = test.subset(rows)
         tracked[rows] = track_walk(
             maps.floors[key],
-            test.rssi_dbm[rows],
+            walk.rssi_dbm,
             increments,
             plan=plan,
             particles=settings.particles,
+            wall_weight=settings.wall_weight,
+            sensor=_sensor(localizer, walk, key),
             rng=[settings.seed, walks, 1],
         )
     info = {
         "tracked_walks": walks,
+        "sensor_model": "gridmaps" if isinstance(localizer, GridmapLocalizer) else "kernel",
+        "wall_weight": settings.wall_weight,
         "odometry": "synthetic: true positions plus noise",
         "odometry_translation_std": settings.translation_std,
         "odometry_heading_std_rad": settings.heading_std_rad,
@@ -154,6 +160,18 @@ def _track(
         "track_s": time.perf_counter() - start,
     }
     return tracked, info
+
+
+def _sensor(localizer, walk: Fingerprints, key: int):
+    """The tracker's sensor model: a k-NN method's kernel density (its neighbours' positions,
+    :meth:`KnnLocalizer.log_likelihood`), or None for the gridmaps' own."""
+    if isinstance(localizer, GridmapLocalizer):
+        return None
+
+    def log_likelihood(k: int, xy: np.ndarray) -> np.ndarray:
+        return localizer.log_likelihood(walk.subset([k]), key, xy)
+
+    return log_likelihood
 
 
 def write_evaluation(

@@ -30,6 +30,10 @@ class MclConfig(Config):
     resample_ess: float = setting(0.5, gt=0.0, le=1.0)  # resample below this share of P
     slow_rate: float = setting(0.01, ge=0.0, le=1.0)  # augmented MCL's long-term average
     fast_rate: float = setting(0.3, ge=0.0, le=1.0)  # … and short-term average
+    # the sensor model: "paper" (Eq. 12–13) or "scan" (scan_log_likelihood, with this variance
+    # of one scan's reading about the map, in normalised units²)
+    sensor: str = setting("paper", choices=("paper", "scan"))
+    scan_variance: float = setting(0.0, ge=0.0, le=1.0)
 
 
 def log_likelihood(z: np.ndarray, mean: np.ndarray, var: np.ndarray) -> np.ndarray:
@@ -41,6 +45,16 @@ def log_likelihood(z: np.ndarray, mean: np.ndarray, var: np.ndarray) -> np.ndarr
     lam = z / total
     var = np.maximum(var, 1e-9)
     return -0.5 * (((z - mean) ** 2 / var + np.log(var) + _LOG_2PI) @ lam)
+
+
+def scan_log_likelihood(
+    z: np.ndarray, mean: np.ndarray, var: np.ndarray, scan_variance: float
+) -> np.ndarray:
+    """Σ_j log N(z_j | M_j, V_j + σ_s²) over the APs heard (z_j > 0), each counted once: a map
+    fit on averaged samples predicts their mean, and one scan scatters about it by σ_s."""
+    heard = np.flatnonzero(z)
+    var = np.maximum(var[:, heard], 1e-9) + scan_variance
+    return -0.5 * ((z[heard] - mean[:, heard]) ** 2 / var + np.log(var) + _LOG_2PI).sum(1)
 
 
 def low_variance_indices(weights: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
@@ -96,7 +110,7 @@ class WifiMCL:
         z = normalise_rssi(rssi_dbm)
         centres = self.maps.cell_centres()
         mean, var = self.maps.lookup(centres)
-        log_l = log_likelihood(z, mean, var)
+        log_l = self._log_likelihood(z, mean, var)
         if self.allowed is not None:
             log_l = np.where(self.allowed, log_l, -np.inf)
         w = np.exp(log_l - log_l.max())
@@ -129,14 +143,16 @@ class WifiMCL:
         self.particles[:, 1] += s * lx + c * ly
         self.particles[:, 2] = wrap_angle(th + dth + et)
 
-    def update(self, rssi_dbm: np.ndarray) -> None:
-        """Weigh by one reading (Eq. 12–13), resample when the effective sample size drops, and
-        inject samples from the reading where the average likelihood collapsed (kidnapping)."""
+    def update(self, rssi_dbm: np.ndarray, log_l: np.ndarray | None = None) -> None:
+        """Weigh by one reading (Eq. 12–13, or ``log_l``: another sensor model's log-likelihood
+        of each particle), resample when the effective sample size drops, and inject samples
+        from the reading where the average likelihood collapsed (kidnapping)."""
         z = normalise_rssi(rssi_dbm)
         if z.sum() <= 0:
             return  # nothing heard: nothing learned
-        mean, var = self._predict(self.particles[:, :2])
-        log_l = log_likelihood(z, mean, var)
+        if log_l is None:
+            mean, var = self._predict(self.particles[:, :2])
+            log_l = self._log_likelihood(z, mean, var)
         if self.allowed is not None:
             row, col = self.maps.cells(self.particles[:, :2])
             log_l = np.where(self.allowed[row * self.maps.shape[1] + col], log_l, log_l - 50.0)
@@ -160,6 +176,11 @@ class WifiMCL:
             k = int(self.rng.binomial(n, min(inject, 0.5)))
             if k:
                 self.particles[:k] = self.sample_from_reading(rssi_dbm, k)
+
+    def _log_likelihood(self, z: np.ndarray, mean: np.ndarray, var: np.ndarray) -> np.ndarray:
+        if self.config.sensor == "scan":
+            return scan_log_likelihood(z, mean, var, self.config.scan_variance)
+        return log_likelihood(z, mean, var)
 
     def estimate(self) -> tuple[np.ndarray, float]:
         """The weighted mean pose ``(3,)`` and the particles' RMS distance from it (m)."""

@@ -4,7 +4,9 @@ its free space and a particle whose move crosses a wall (or ends outside the fre
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
@@ -14,6 +16,9 @@ from sfw_gym.world.floorplan import Floorplan
 
 #: Particles per walk.
 TRACK_PARTICLES = 2000
+#: The share of its weight a particle keeps when its move crosses a wall or ends in one: 0, the
+#: plan is the truth; above 0, it may be wrong (WiFine's walks cross its layouts' walls).
+WALL_WEIGHT = 0.0
 #: Draws of a global initialisation that land in a wall are drawn again at most this often.
 _INIT_REDRAWS = 20
 
@@ -24,6 +29,7 @@ class WalledMCL:
 
     mcl: WifiMCL
     plan: Floorplan | None
+    wall_weight: float = WALL_WEIGHT
 
     def _free(self, xy: np.ndarray) -> np.ndarray:
         return np.ones(len(xy), bool) if self.plan is None else self.plan.is_free(xy)
@@ -37,20 +43,22 @@ class WalledMCL:
                 break
             self.mcl.particles[stuck] = self.mcl.sample_from_reading(rssi_dbm, int(stuck.sum()))
 
-    def step(self, increment: np.ndarray, rssi_dbm: np.ndarray) -> np.ndarray:
-        """Move by an odometry increment, kill what crossed a wall, weigh by the scan; the
-        estimate ``(x, y)``."""
+    def step(self, increment: np.ndarray, rssi_dbm: np.ndarray, sensor=None) -> np.ndarray:
+        """Move by an odometry increment, kill what crossed a wall, weigh by the scan (by the
+        gridmaps, or ``sensor(xy)``: a log-likelihood per particle); the estimate ``(x, y)``."""
         before = self.mcl.particles[:, :2].copy()
         self.mcl.predict(increment)
         if self.plan is not None:
             after = self.mcl.particles[:, :2]
             dead = ~self.plan.is_free(after) | (self.plan.count_walls(before, after) > 0)
-            if dead.all():  # lost: start again from this scan
+            if dead.all() and self.wall_weight == 0:  # lost: start again from this scan
                 self.start(rssi_dbm)
             else:
-                w = np.where(dead, 0.0, self.mcl.weights)
-                self.mcl.weights = w / w.sum()
-        self.mcl.update(rssi_dbm)
+                w = np.where(dead, self.wall_weight * self.mcl.weights, self.mcl.weights)
+                total = w.sum()
+                self.mcl.weights = w / total if total > 0 else (~dead) / np.sum(~dead)
+        log_l = None if sensor is None else sensor(self.mcl.particles[:, :2])
+        self.mcl.update(rssi_dbm, log_l)
         return self.mcl.estimate()[0][:2]
 
 
@@ -61,6 +69,9 @@ def track_walk(
     *,
     plan: Floorplan | None = None,
     particles: int = TRACK_PARTICLES,
+    wall_weight: float = WALL_WEIGHT,
+    config: MclConfig | None = None,
+    sensor: Callable[[int, np.ndarray], np.ndarray] | None = None,
     rng: np.random.Generator | int | None = 0,
 ) -> np.ndarray:
     """Estimated positions ``(N, 2)`` along a walk: ``rssi_dbm`` ``(N, L)`` over the training
@@ -68,14 +79,15 @@ def track_walk(
     rssi = np.asarray(rssi_dbm, np.float64)[:, floor.access_points]
     mcl = WifiMCL(
         floor.gridmaps,
-        MclConfig(particles=particles),
+        config or MclConfig(particles=particles, sensor="scan", scan_variance=floor.scan_variance),
         np.random.default_rng(rng),
         allowed=floor.allowed,
     )
-    tracker = WalledMCL(mcl, plan)
+    tracker = WalledMCL(mcl, plan, wall_weight)
     tracker.start(rssi[0])
     estimates = np.empty((len(rssi), 2))
     estimates[0] = mcl.estimate()[0][:2]
     for k, increment in enumerate(increments, start=1):
-        estimates[k] = tracker.step(increment, rssi[k])
+        scan_sensor = None if sensor is None else partial(sensor, k)
+        estimates[k] = tracker.step(increment, rssi[k], scan_sensor)
     return estimates

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.conftest import DATASETS_DIR
 from sfw_gym.slam.radio_slam import RadioSlamConfig, heard_readings, odometry_sigmas_m
 from sfw_gym.slam.real_walks import (
     real_walk_config,
@@ -19,7 +20,7 @@ from sfw_gym.slam.real_walks import (
     wrong_closures,
 )
 
-WIFINE_TRAIN = Path(__file__).resolve().parents[2].parent / "shared/datasets/wifine/train"
+WIFINE_TRAIN = DATASETS_DIR / "wifine" / "train"
 
 
 def looping_walk(laps: int = 3, side_m: float = 24.0, step_m: float = 1.6):

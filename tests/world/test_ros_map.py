@@ -11,10 +11,11 @@ import numpy as np
 import pytest
 
 import sfw_gym  # noqa: F401  (registration)
+from tests.conftest import DATASETS_DIR
 from sfw_gym.core.errors import FloorplanError
 from sfw_gym.world import load_floorplan
 
-WIFINE_DIR = Path(__file__).resolve().parents[2].parent / "shared" / "datasets" / "wifine"
+WIFINE_DIR = DATASETS_DIR / "wifine"
 
 # width 5, height 4 (row 0 at the top); 255 white = free, 0 black = wall, 128 unknown (p = 0.498)
 IMAGE = np.array(
