@@ -45,7 +45,7 @@ RAW_NOT_HEARD_DBM = -105.0
 POWED_FLOOR_DBM, POWED_EXPONENT = -104.0, 2.0
 SORENSEN_K = 10
 #: Tracking's kernel sensor model (KnnLocalizer.log_likelihood).
-KERNEL_SIGMA_M, KERNEL_FLOOR, KERNEL_NEIGHBOURS = 1.5, 1e-3, 30
+KERNEL_SIGMA_M, KERNEL_FLOOR, KERNEL_NEIGHBOURS = 1.0, 1e-3, 30
 #: Gridmaps: cell size, the survey's averaging cell, how far from the survey cells are kept, and
 #: how often an access point must be heard on a floor to get a map there.
 GRID_RES_M = 1.0
