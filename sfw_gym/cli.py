@@ -910,7 +910,10 @@ def _add_fingerprints_parser(sub) -> None:
         "--split", default="train", choices=sorted(UJI_SPLITS), help="UJIIndoorLoc's split"
     )
     conv.add_argument(
-        "--not-heard", type=float, default=GENERIC_NOT_HEARD, help="csv: the value meaning not heard"
+        "--not-heard",
+        type=float,
+        default=GENERIC_NOT_HEARD,
+        help="csv: the value meaning not heard",
     )
     conv.add_argument("source", help="UJIIndoorLoc's zip, a WiFine CSV or folder, or a CSV")
     conv.add_argument("output", help="the generic CSV to write")

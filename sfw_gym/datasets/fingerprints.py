@@ -73,7 +73,9 @@ class Fingerprints:
     def _column(self, value, key: str, kind) -> np.ndarray:
         array = np.asarray(value) if kind is None else np.asarray(value, kind)
         if array.shape != (len(self),):
-            raise ConfigError(f"{self.name}: {key} has shape {array.shape}, expected ({len(self)},)")
+            raise ConfigError(
+                f"{self.name}: {key} has shape {array.shape}, expected ({len(self)},)"
+            )
         return array
 
     def __len__(self) -> int:
@@ -92,7 +94,7 @@ class Fingerprints:
         """``(N, L)`` readings with "not heard" replaced by ``not_heard_dbm``."""
         return np.where(np.isnan(self.rssi_dbm), not_heard_dbm, self.rssi_dbm)
 
-    def subset(self, rows: np.ndarray) -> Fingerprints:
+    def subset(self, rows: np.ndarray | list[int]) -> Fingerprints:
         """The scans picked by a boolean mask or an index array."""
         pick = np.asarray(rows)
 

@@ -4,6 +4,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from sfw_gym.core.angles import wrap_angle
@@ -40,7 +42,7 @@ def synthetic_odometry(
     *,
     translation_std: float = DRIFT_TRANSLATION_STD,
     heading_std_rad: float = DRIFT_HEADING_STD_RAD,
-    rng: np.random.Generator | int | None = 0,
+    rng: np.random.Generator | int | Sequence[int] | None = 0,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Odometry along a walk: ``(increments (N-1, 3), poses (N, 3))``. Each increment is the
     true motion between consecutive :func:`walk_poses` in the frame of the first (forward,

@@ -39,9 +39,7 @@ def read_csv(source: Source, *, not_heard: float = GENERIC_NOT_HEARD) -> Fingerp
     if not aps:
         raise ConfigError(f"{name}: no access point columns (only {header})")
     frame = _parse(name, io.StringIO(text), {"trajectory": str})
-    return _fingerprints(
-        name, frame, aps, not_heard, {k: k for k in META_COLUMNS if k in header}
-    )
+    return _fingerprints(name, frame, aps, not_heard, {k: k for k in META_COLUMNS if k in header})
 
 
 def read_ujiindoorloc(source: str | os.PathLike[str], split: str = "train") -> Fingerprints:

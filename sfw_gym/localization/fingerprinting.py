@@ -26,6 +26,7 @@ real data").
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -121,7 +122,7 @@ class KnnLocalizer:
         key = np.empty(len(test), np.int64)
         for i in range(len(test)):
             votes: dict[int, float] = {}
-            for kk, ww in zip(keys[i], w[i]):
+            for kk, ww in zip(keys[i], w[i], strict=True):
                 votes[int(kk)] = votes.get(int(kk), 0.0) + float(ww)
             key[i] = max(votes, key=votes.__getitem__)
         return key, idx, w
@@ -205,7 +206,7 @@ class GridmapLocalizer:
         if not resolution_m > 0:
             raise ConfigError(f"resolution_m must be > 0, got {resolution_m!r}")
         self.resolution_m = resolution_m
-        self.chooser = make_localizer("sorensen")
+        self.chooser = _sorensen()
 
     def fit(self, train: Fingerprints) -> GridmapLocalizer:
         self.train = train
@@ -260,7 +261,7 @@ def _sorensen() -> KnnLocalizer:
     return KnnLocalizer(SORENSEN_K, True, "braycurtis", powed_features)
 
 
-_FACTORIES = {
+_FACTORIES: dict[str, Callable[[], KnnLocalizer | GridmapLocalizer]] = {
     "1nn": lambda: KnnLocalizer(1, False, "euclidean", raw_features),
     "w3nn": lambda: KnnLocalizer(3, True, "euclidean", raw_features),
     "w5nn": lambda: KnnLocalizer(5, True, "euclidean", raw_features),
@@ -272,7 +273,7 @@ METHODS = tuple(_FACTORIES)
 DEFAULT_METHOD = "sorensen"
 
 
-def make_localizer(method: str):
+def make_localizer(method: str) -> KnnLocalizer | GridmapLocalizer:
     """A fresh, unfitted localiser of ``method`` (one of :data:`METHODS`)."""
     if method not in _FACTORIES:
         raise ConfigError(f"unknown method {method!r}; choose one of {list(METHODS)}")

@@ -4,7 +4,7 @@ its free space and a particle whose move crosses a wall (or ends outside the fre
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import partial
 
@@ -76,7 +76,7 @@ def track_walk(
     wall_weight: float = WALL_WEIGHT,
     config: MclConfig | None = None,
     sensor: Callable[[int, np.ndarray], np.ndarray] | None = None,
-    rng: np.random.Generator | int | None = 0,
+    rng: np.random.Generator | int | Sequence[int] | None = 0,
 ) -> np.ndarray:
     """Estimated positions ``(N, 2)`` along a walk: ``rssi_dbm`` ``(N, L)`` over the training
     access points, ``increments`` ``(N - 1, 3)`` odometry (forward, lateral, turn) between scans."""

@@ -23,7 +23,7 @@ def files(tmp_path_factory) -> dict[str, Path]:
     survey(noise_db=3.0).to_csv(root / "train.csv")
     rng = np.random.default_rng(5)
     xy = np.column_stack([np.arange(2.0, 18.0, 0.8), np.full(20, 3.0)])
-    walks = [(xy, 0, "w1"), (xy[::-1] + [0, 5], 1, "w2")]
+    walks = [(xy, 0, "w1"), (xy[::-1] + np.array([0.0, 5.0]), 1, "w2")]
     test = Fingerprints(
         np.concatenate([w[0] for w in walks]),
         np.concatenate([radio(w[0], w[1], 0, 3.0, rng) for w in walks]),

@@ -128,7 +128,7 @@ def test_ujiindoorloc_errors(tmp_path: Path) -> None:
         read_ujiindoorloc(write(tmp_path / "trainingData.csv", "WAP001,X\n1,2\n"))
     with zipfile.ZipFile(tmp_path / "other.zip", "w") as archive:
         archive.writestr("readme.txt", "hello")
-    with pytest.raises(ConfigError, match="no trainingData.csv inside"):
+    with pytest.raises(ConfigError, match=r"no trainingData\.csv inside"):
         read_ujiindoorloc(tmp_path / "other.zip")
 
 

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 import sfw_gym  # noqa: F401  (registration)
-from tests.conftest import DATASETS_DIR
 from sfw_gym.core.errors import FloorplanError
 from sfw_gym.world import load_floorplan
+from tests.conftest import DATASETS_DIR
 
 WIFINE_DIR = DATASETS_DIR / "wifine"
 
