@@ -107,10 +107,9 @@ class WifiMCL:
     def sample_from_reading(self, rssi_dbm: np.ndarray, n: int) -> np.ndarray:
         """Alg. 1: ``n`` poses from the cells' likelihoods of ``rssi_dbm``, uniform within a
         cell, any heading."""
-        z = normalise_rssi(rssi_dbm)
         centres = self.maps.cell_centres()
         mean, var = self.maps.lookup(centres)
-        log_l = self._log_likelihood(z, mean, var)
+        log_l = self._log_likelihood(normalise_rssi(rssi_dbm), mean, var)
         if self.allowed is not None:
             log_l = np.where(self.allowed, log_l, -np.inf)
         w = np.exp(log_l - log_l.max())
@@ -143,14 +142,17 @@ class WifiMCL:
         self.particles[:, 1] += s * lx + c * ly
         self.particles[:, 2] = wrap_angle(th + dth + et)
 
-    def update(self, rssi_dbm: np.ndarray, log_l: np.ndarray | None = None) -> None:
-        """Weigh by one reading (Eq. 12–13, or ``log_l``: another sensor model's log-likelihood
-        of each particle), resample when the effective sample size drops, and inject samples
-        from the reading where the average likelihood collapsed (kidnapping)."""
+    def update(self, rssi_dbm: np.ndarray, sensor=None) -> None:
+        """Weigh by one reading (Eq. 12–13, or ``sensor(xy)``: another sensor model's
+        log-likelihood at each particle), resample when the effective sample size drops, and
+        inject samples from the reading's gridmap likelihood where the average likelihood
+        collapsed (kidnapping)."""
         z = normalise_rssi(rssi_dbm)
         if z.sum() <= 0:
             return  # nothing heard: nothing learned
-        if log_l is None:
+        if sensor is not None:
+            log_l = sensor(self.particles[:, :2])
+        else:
             mean, var = self._predict(self.particles[:, :2])
             log_l = self._log_likelihood(z, mean, var)
         if self.allowed is not None:

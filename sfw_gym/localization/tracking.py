@@ -39,7 +39,7 @@ class WalledMCL:
         return np.ones(len(xy), bool) if self.plan is None else self.plan.is_free(xy)
 
     def start(self, rssi_dbm: np.ndarray) -> None:
-        """Global localisation from one scan; draws in a wall are drawn again."""
+        """Global localisation from one scan (Alg. 1); draws in a wall are drawn again."""
         self.mcl.global_init(rssi_dbm)
         for _ in range(_INIT_REDRAWS):
             stuck = ~self._free(self.mcl.particles[:, :2])
@@ -61,8 +61,7 @@ class WalledMCL:
                 w = np.where(dead, self.wall_weight * self.mcl.weights, self.mcl.weights)
                 total = w.sum()
                 self.mcl.weights = w / total if total > 0 else (~dead) / np.sum(~dead)
-        log_l = None if sensor is None else sensor(self.mcl.particles[:, :2])
-        self.mcl.update(rssi_dbm, log_l)
+        self.mcl.update(rssi_dbm, sensor)
         return self.mcl.estimate()[0][:2]
 
 
