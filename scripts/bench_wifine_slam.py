@@ -46,7 +46,15 @@ def main() -> None:
         "--levels", type=level, nargs="+", default=[(0.05, 0.02), (0.10, 0.04)],
         help="noise levels TRANSLATION_STD:HEADING_STD_RAD",
     )  # fmt: skip
+    parser.add_argument(
+        "--set", nargs="*", default=[], metavar="FIELD=VALUE",
+        help="override REAL_WALK_SETTINGS (tuning), e.g. heading_snap_deg=180",
+    )  # fmt: skip
     args = parser.parse_args()
+    overrides = {
+        k: int(v) if v.lstrip("-").isdigit() else float(v)
+        for k, v in (item.split("=") for item in args.set)
+    }
 
     data = read_wifine(Path(args.wifine) / args.split)
     labels = sorted(label for label, _ in data.walks())
@@ -55,12 +63,12 @@ def main() -> None:
             labels[k] for k in np.linspace(0, len(labels) - 1, args.walks).round().astype(int)
         ]
     print(f"{len(labels)} {args.split} walks of {args.wifine}, seeds {args.seeds}")
-    print(f"settings: {REAL_WALK_SETTINGS}")
+    print(f"settings: {REAL_WALK_SETTINGS | overrides}")
     print(
         f"wrong closure: off the true distance by > {WRONG_SIGMAS:g} sigma or > {WRONG_ERROR_M:g} m"
     )
     for translation, heading in args.levels:
-        config = real_walk_config(translation, heading)
+        config = real_walk_config(translation, heading, **overrides)
         start = time.perf_counter()
         runs = [
             r
@@ -82,6 +90,10 @@ def main() -> None:
         true_m = np.concatenate([r.closure_true_m for r in runs])
         error = np.abs(np.concatenate([r.closure_true_m - r.closure_distance_m for r in runs]))
         bad = np.concatenate([r.wrong for r in runs])
+        lines = sum(r.n_corridor for r in runs)
+        wrong_lines = sum(r.n_wrong_corridor for r in runs)
+        turns = sum(r.n_turns for r in runs)
+        wrong_turns = sum(r.n_wrong_turns for r in runs)
         print(f"\n### odometry noise {translation:g} per m, {heading:g} rad per step")
         print(
             f"{len(runs)} runs ({len(labels)} walks x {len(args.seeds)} seeds), {seconds:.0f} s\n"
@@ -93,10 +105,25 @@ def main() -> None:
         print("|---|---|---|---|---|---|---|")
         print(
             f"| {len(labels)} x {len(args.seeds)} | {odo.mean():.2f} / {np.median(odo):.2f} | "
-            f"{slam.mean():.2f} / {np.median(slam):.2f} | **{slam.mean() / odo.mean():.2f}** | "
+            f"{slam.mean():.2f} / {np.median(slam):.2f} | **{slam.mean() / odo.mean():.3f}** | "
             f"{np.mean(slam < odo):.0%} | {closures.mean():.1f} | "
             f"{wrong.sum()} of {closures.sum()} ({wrong.sum() / max(closures.sum(), 1):.1%}) |"
         )
+        if lines:
+            lateral = np.concatenate(
+                [r.corridor_true_m[r.corridor] for r in runs if r.corridor is not None]
+            )
+            print(
+                f"\ncorridor closures: {lines} ({lines / len(runs):.1f} per walk), true lateral "
+                f"offset median {np.median(lateral):.2f} m, p90 {np.percentile(lateral, 90):.2f} "
+                f"m; wrong (off the line by > 3 sigma or > 3 m) {wrong_lines} "
+                f"({wrong_lines / lines:.1%})"
+            )
+        if turns:
+            print(
+                f"\nheading closures: {turns} ({turns / len(runs):.1f} per walk), wrong turn "
+                f"(off the true one by > 45 deg) {wrong_turns} ({wrong_turns / turns:.1%})"
+            )
         if len(true_m):
             print(
                 f"\nclosures: true distance median {np.median(true_m):.1f} m, p90 "

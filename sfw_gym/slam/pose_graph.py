@@ -1,6 +1,7 @@
-"""An SE(2) pose graph (the paper's Eq. 1): odometry edges (relative poses) and range edges
-(radio loop closures: a distance and its variance), optimised by a sparse Levenberg–Marquardt
-with a robust kernel on the range edges (iteratively reweighted), so that a false closure pulls
+"""An SE(2) pose graph (the paper's Eq. 1): odometry edges (relative poses), range edges
+(radio loop closures: a distance and its variance), and rotation and lateral edges (a closure's
+turn; a pose on the line along another's heading), optimised by a sparse Levenberg–Marquardt
+with a robust kernel on the closure edges (iteratively reweighted), so that a false closure pulls
 with a bounded force instead of bending the trajectory."""
 
 from __future__ import annotations
@@ -64,6 +65,8 @@ class PoseGraph:
     robust_scale: float = 2.0
     _odo: list[tuple[float, ...]] = field(default_factory=list)
     _rng: list[tuple[float, ...]] = field(default_factory=list)
+    _rot: list[tuple[float, ...]] = field(default_factory=list)
+    _lat: list[tuple[float, ...]] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         if self.robust not in ROBUST_KERNELS:
@@ -85,16 +88,39 @@ class PoseGraph:
             raise ConfigError(f"range edge ({i}, {j}): sigma_m must be > 0, got {sigma_m!r}")
         self._rng.append((float(i), float(j), float(distance_m), float(sigma_m)))
 
+    def add_rotation(
+        self, i: int, j: int, dtheta: float, sigma_rad: float, robust_scale: float | None = None
+    ) -> None:
+        """Pose ``j``'s heading is pose ``i``'s plus ``dtheta`` (a heading closure), under the
+        robust kernel at ``robust_scale`` of its sigmas (None: the graph's)."""
+        if not sigma_rad > 0:
+            raise ConfigError(f"rotation edge ({i}, {j}): sigma_rad must be > 0, got {sigma_rad!r}")
+        scale = self.robust_scale if robust_scale is None else robust_scale
+        self._rot.append((float(i), float(j), float(dtheta), float(sigma_rad), float(scale)))
+
+    def add_lateral(
+        self, i: int, j: int, offset_m: float, sigma_m: float, robust_scale: float | None = None
+    ) -> None:
+        """Pose ``j`` lies ``offset_m`` to the left of the line through pose ``i`` along its
+        heading (a corridor closure: 0 where both walk the same corridor; the position along it
+        is left free), under the robust kernel at ``robust_scale`` of its sigmas (None: the
+        graph's)."""
+        if not sigma_m > 0:
+            raise ConfigError(f"lateral edge ({i}, {j}): sigma_m must be > 0, got {sigma_m!r}")
+        scale = self.robust_scale if robust_scale is None else robust_scale
+        self._lat.append((float(i), float(j), float(offset_m), float(sigma_m), float(scale)))
+
     # -- the least-squares problem ----------------------------------------------------------------
     def _linearize(
         self,
         x: np.ndarray,
         anchor: np.ndarray,
         robust_weights: np.ndarray | None,
-        edges: tuple[np.ndarray, np.ndarray],
+        edges: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
     ) -> tuple[np.ndarray, sp.csr_matrix, np.ndarray]:
-        """Whitened residuals, their sparse Jacobian, and the range edges' whitened errors."""
-        odo, rng = edges
+        """Whitened residuals, their sparse Jacobian, and the range, rotation then lateral
+        edges' whitened errors (``robust_weights``: one per such edge, in that order)."""
+        odo, rng, rot, lat = edges
         # the first pose is held where it starts (the gauge)
         prior_w = 1e6
         res = [prior_w * np.r_[x[0, :2] - anchor[:2], wrap_angle(x[0, 2] - anchor[2])]]
@@ -134,7 +160,9 @@ class PoseGraph:
             length = np.maximum(np.linalg.norm(d, axis=1), 1e-9)
             u = d / length[:, None]
             errors = (length - e[:, 2]) / e[:, 3]
-            w = (1.0 / e[:, 3]) * (np.sqrt(robust_weights) if robust_weights is not None else 1.0)
+            w = (1.0 / e[:, 3]) * (
+                np.sqrt(robust_weights[: len(e)]) if robust_weights is not None else 1.0
+            )
             res.append(errors * (w * e[:, 3]))
             k = n_res + np.arange(len(e))
             for pose, sign in ((i, -1.0), (j, 1.0)):
@@ -143,6 +171,42 @@ class PoseGraph:
                     cols.append(3 * pose + var)
                     vals.append(sign * u[:, var] * w)
             n_res += len(e)
+        if len(rot):
+            e = rot
+            i, j = e[:, 0].astype(int), e[:, 1].astype(int)
+            rot_errors = wrap_angle(x[j, 2] - x[i, 2] - e[:, 2]) / e[:, 3]
+            mine = slice(len(rng), len(rng) + len(rot))
+            w = (1.0 / e[:, 3]) * (
+                np.sqrt(robust_weights[mine]) if robust_weights is not None else 1.0
+            )
+            res.append(rot_errors * (w * e[:, 3]))
+            k = n_res + np.arange(len(e))
+            rows += [k, k]
+            cols += [3 * i + 2, 3 * j + 2]
+            vals += [-w * np.ones(len(e)), w * np.ones(len(e))]
+            n_res += len(e)
+            errors = np.concatenate([errors, rot_errors])
+        if len(lat):
+            e = lat
+            i, j = e[:, 0].astype(int), e[:, 1].astype(int)
+            d = x[j, :2] - x[i, :2]
+            c, s = np.cos(x[i, 2]), np.sin(x[i, 2])
+            lat_errors = (-s * d[:, 0] + c * d[:, 1] - e[:, 2]) / e[:, 3]
+            start = len(rng) + len(rot)
+            w = (1.0 / e[:, 3]) * (
+                np.sqrt(robust_weights[start:]) if robust_weights is not None else 1.0
+            )
+            res.append(lat_errors * (w * e[:, 3]))
+            k = n_res + np.arange(len(e))
+            for pose, var, val in (
+                (i, 0, s * w), (i, 1, -c * w), (i, 2, (-c * d[:, 0] - s * d[:, 1]) * w),
+                (j, 0, -s * w), (j, 1, c * w),
+            ):  # fmt: skip
+                rows.append(k)
+                cols.append(3 * pose + var)
+                vals.append(val)
+            n_res += len(e)
+            errors = np.concatenate([errors, lat_errors])
         jac = sp.csr_matrix(
             (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
             shape=(n_res, 3 * self.n_poses),
@@ -150,7 +214,13 @@ class PoseGraph:
         return np.concatenate(res), jac, errors
 
     def _robust_weights(self, errors: np.ndarray) -> np.ndarray:
-        k, a = self.robust_scale, np.abs(errors)
+        """Each range, rotation then lateral edge's IRLS weight from its whitened error."""
+        k = np.r_[
+            np.full(len(self._rng), float(self.robust_scale)),
+            [e[4] for e in self._rot],
+            [e[4] for e in self._lat],
+        ]
+        a = np.abs(errors)
         if self.robust == "huber":
             return np.where(a <= k, 1.0, k / np.maximum(a, 1e-12))
         if self.robust == "cauchy":
@@ -169,7 +239,12 @@ class PoseGraph:
         cost by less than ``relative_decrease`` of it."""
         x = np.array(poses, np.float64).reshape(self.n_poses, 3)
         anchor = x[0].copy()
-        edges = (np.array(self._odo).reshape(-1, 7), np.array(self._rng).reshape(-1, 4))
+        edges = (
+            np.array(self._odo).reshape(-1, 7),
+            np.array(self._rng).reshape(-1, 4),
+            np.array(self._rot).reshape(-1, 5),
+            np.array(self._lat).reshape(-1, 5),
+        )
         lam, nu = 1e-3, 2.0  # damping, and its growth after a rejected step (Nielsen)
         _, _, errors = self._linearize(x, anchor, None, edges)
         weights = self._robust_weights(errors)

@@ -14,6 +14,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from sfw_gym.core.angles import wrap_angle
 from sfw_gym.core.config import Config, setting
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.slam.fingerprints import closure_candidates, kernel_similarity
@@ -52,6 +53,25 @@ class RadioSlamConfig(Config):
     # Levenberg–Marquardt stops once a step lowers the cost by less than this fraction of it
     stop_decrease: float = setting(1e-4, gt=0.0, lt=1.0)
     keyframe_every: int = setting(5, integer=True, ge=1)  # the graph's nodes: every k-th pose
+    # heading closures beside each range closure: scans taken walking (heading = the direction
+    # of motion) at the same place of a rectilinear building face along the same corridor, the
+    # same or the opposite way or across: the two poses' odometry turn snapped to the nearest
+    # multiple of this many degrees (0: none) becomes a rotation edge …
+    heading_snap_deg: float = setting(0.0, ge=0.0, le=180.0)
+    heading_sigma_rad: float = setting(0.15, gt=0.0)  # … of this standard deviation …
+    # … where the odometry's turn lies within this of the multiple (else no heading closure)
+    heading_max_off_rad: float = setting(math.pi / 4, gt=0.0)
+    # the direction snapped: 0, each pose's heading; w > 0, the odometry's direction of travel
+    # from w poses before to w after (the corridor's, less the sway of single steps)
+    heading_window: int = setting(0, integer=True, ge=0)
+    heading_robust_scale: float = setting(0.5, gt=0.0)  # the kernel's scale on them, in sigmas
+    # corridor closures beside each range closure whose two directions of travel (as above) are
+    # within corridor_max_turn_rad of the same or the opposite: each pose lies on the line
+    # through the other along its heading (two lateral edges), within this standard deviation
+    # (0: none); the position along the corridor is left to the range edge
+    corridor_sigma_m: float = setting(0.0, ge=0.0)
+    corridor_max_turn_rad: float = setting(0.3, gt=0.0, le=math.pi / 2)
+    corridor_robust_scale: float = setting(0.5, gt=0.0)  # the kernel's scale on them, in sigmas
     solve_every: int = setting(100, integer=True, ge=1)  # online (the env): poses between solves
 
 
@@ -64,6 +84,10 @@ class RadioSlamResult:
     closures: np.ndarray
     closure_distance_m: np.ndarray
     closure_sigma_m: np.ndarray
+    # the turn (rad) each closure's heading edge asked for, NaN where it had none or dropped it
+    closure_turn_rad: np.ndarray | None = None
+    # which closures kept a corridor closure (None where they are off)
+    closure_corridor: np.ndarray | None = None
 
 
 def keyframes(n: int, every: int) -> np.ndarray:
@@ -132,8 +156,18 @@ def radio_slam(
     node[keys] = np.arange(len(keys))
     start = (odo if initial is None else np.asarray(initial, np.float64))[keys]
     sigma_xy = odometry_sigmas_m(odo, keys, cfg)
+    direction = travel_directions(odo, cfg.heading_window)
+    # the snap acts on the directions of travel; the edge asks for the headings' turn
+    # that makes them a multiple apart
+    course = direction[pairs[:, 1]] - direction[pairs[:, 0]]
+    turn, turn_ok = snapped_turns(course, cfg)
+    turn = wrap_angle(turn + odo[pairs[:, 1], 2] - odo[pairs[:, 0], 2] - course)
+    parallel = np.abs(wrap_angle(2.0 * course)) <= 2.0 * cfg.corridor_max_turn_rad
+    corridor = parallel & (cfg.corridor_sigma_m > 0)
 
-    def solve(use: np.ndarray, start: np.ndarray) -> np.ndarray:
+    def solve(
+        use: np.ndarray, start: np.ndarray, use_turn: np.ndarray, use_line: np.ndarray
+    ) -> np.ndarray:
         graph = PoseGraph(len(keys), robust=cfg.robust, robust_scale=cfg.robust_scale)
         for k, (a, b) in enumerate(zip(keys[:-1].tolist(), keys[1:].tolist(), strict=True)):
             graph.add_odometry(
@@ -147,17 +181,67 @@ def radio_slam(
             node[pairs[use]].tolist(), mean[use].tolist(), sigma[use].tolist(), strict=True
         ):
             graph.add_range(i, j, m, sd)
+        for i, j, t in zip(*node[pairs[use_turn]].T.tolist(), turn[use_turn].tolist(), strict=True):
+            graph.add_rotation(i, j, t, cfg.heading_sigma_rad, cfg.heading_robust_scale)
+        for i, j in node[pairs[use_line]].tolist():
+            graph.add_lateral(i, j, 0.0, cfg.corridor_sigma_m, cfg.corridor_robust_scale)
+            graph.add_lateral(j, i, 0.0, cfg.corridor_sigma_m, cfg.corridor_robust_scale)
         return graph.optimize(start, relative_decrease=cfg.stop_decrease)
 
     use = np.ones(len(pairs), bool)
-    solved = solve(use, start)
+    use_turn, use_line = turn_ok.copy(), corridor.copy()
+    solved = solve(use, start, use_turn, use_line)
     if cfg.outlier_sigma and len(pairs):  # drop the closures the solution disagrees with
-        use = consistent_closures(solved[node[pairs]], mean, sigma, cfg.outlier_sigma)
-        if not use.all():
-            solved = solve(use, solved)
+        ends = solved[node[pairs]]
+        use = consistent_closures(ends, mean, sigma, cfg.outlier_sigma)
+        off = np.abs(wrap_angle(ends[:, 1, 2] - ends[:, 0, 2] - turn))
+        use_turn = turn_ok & use & (off <= cfg.outlier_sigma * cfg.heading_sigma_rad)
+        lateral = np.maximum(
+            lateral_offsets(ends[:, 0], ends[:, 1]), lateral_offsets(ends[:, 1], ends[:, 0])
+        )
+        use_line = corridor & use & (lateral <= cfg.outlier_sigma * cfg.corridor_sigma_m)
+        if not (use.all() and (use_turn == turn_ok).all() and (use_line == corridor).all()):
+            solved = solve(use, solved, use_turn, use_line)
     anchor = keys[np.searchsorted(keys, np.arange(n), side="right") - 1]
     poses = chain(solved[node[anchor]], odo[anchor], odo)
-    return RadioSlamResult(poses, pairs[use], mean[use], sigma[use])
+    turns = np.where(use_turn, turn, np.nan)[use] if cfg.heading_snap_deg else None
+    lines = use_line[use] if cfg.corridor_sigma_m else None
+    return RadioSlamResult(poses, pairs[use], mean[use], sigma[use], turns, lines)
+
+
+def lateral_offsets(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """How far poses ``b`` ``(C, 3)`` lie off the lines through poses ``a`` along their headings
+    (m, unsigned)."""
+    c, s = np.cos(a[:, 2]), np.sin(a[:, 2])
+    d = b[:, :2] - a[:, :2]
+    return np.abs(-s * d[:, 0] + c * d[:, 1])
+
+
+def travel_directions(odometry: np.ndarray, window: int) -> np.ndarray:
+    """Each pose's direction of travel ``(N,)`` (rad): its heading where ``window`` is 0, else
+    the direction of the odometry's displacement from ``window`` poses before it to ``window``
+    after (clipped at the ends; the heading where that displacement is under 1 cm)."""
+    odo = np.asarray(odometry, np.float64)
+    if not window:
+        return odo[:, 2].copy()
+    k = np.arange(len(odo))
+    d = odo[np.minimum(k + window, len(odo) - 1), :2] - odo[np.maximum(k - window, 0), :2]
+    moved = np.hypot(d[:, 0], d[:, 1]) >= 0.01
+    return np.where(moved, np.arctan2(d[:, 1], d[:, 0]), odo[:, 2])
+
+
+def snapped_turns(
+    odometry_turn: np.ndarray, config: RadioSlamConfig
+) -> tuple[np.ndarray, np.ndarray]:
+    """Heading closures: each odometry turn ``(C,)`` (rad) snapped to the nearest multiple of
+    ``config.heading_snap_deg``, and whether to use it (the snap is on, and the turn lies within
+    ``config.heading_max_off_rad`` of that multiple)."""
+    raw = wrap_angle(np.asarray(odometry_turn, np.float64))
+    if not config.heading_snap_deg:
+        return raw, np.zeros(raw.shape, bool)
+    unit = math.radians(config.heading_snap_deg)
+    turn = wrap_angle(np.round(raw / unit) * unit)
+    return turn, np.abs(wrap_angle(raw - turn)) <= config.heading_max_off_rad
 
 
 def odometry_sigmas_m(

@@ -10,6 +10,7 @@ its two scans (:func:`wrong_closures`).
 
 from __future__ import annotations
 
+import math
 import zlib
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
@@ -17,21 +18,27 @@ from typing import Any
 
 import numpy as np
 
+from sfw_gym.core.angles import wrap_angle
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.datasets.fingerprints import Fingerprints
 from sfw_gym.datasets.odometry import (
     DRIFT_HEADING_STD_RAD,
     DRIFT_TRANSLATION_STD,
     synthetic_odometry,
+    walk_poses,
 )
 from sfw_gym.slam.metrics import absolute_trajectory_error
-from sfw_gym.slam.radio_slam import RadioSlamConfig, radio_slam
+from sfw_gym.slam.radio_slam import RadioSlamConfig, lateral_offsets, radio_slam
 
 #: A closure is wrong when its distance estimate misses the true one by more than this many of
 #: its own standard deviations …
 WRONG_SIGMAS = 3.0
 #: … or by more than this many metres, whichever is smaller.
 WRONG_ERROR_M = 3.0
+
+#: A heading closure is wrong when the turn it asks for misses the true one (between the two
+#: scans' directions of motion) by more than this: it picked the wrong multiple of 90°.
+WRONG_TURN_RAD = math.pi / 4
 
 #: Radio SLAM's settings for scans a few seconds (~1.7 m) apart, chosen on WiFine train walks
 #: (BENCHMARKS.md, "Radio SLAM on real WiFine scans"); the odometry's sigmas come from the noise
@@ -47,6 +54,12 @@ REAL_WALK_SETTINGS: dict[str, Any] = {
     "radius_db_per_ap": 4.0,
     "min_sigma_m": 0.5,
     "outlier_sigma": 2.0,
+    # corridor closures: a closure's two scans walked the same or opposite way (within 40°)
+    # lie each on the other's line of travel, ± 1.5 m, the kernel at 2 sigmas (heading closures,
+    # heading_snap_deg, were tried and are off: BENCHMARKS.md says why)
+    "corridor_sigma_m": 1.5,
+    "corridor_max_turn_rad": 0.7,
+    "corridor_robust_scale": 2.0,
 }
 
 
@@ -99,6 +112,33 @@ class WalkSlamResult:
     closure_sigma_m: np.ndarray
     closure_true_m: np.ndarray
     wrong: np.ndarray
+    # heading closures: the turn each closure asked for (NaN: none), the true turn between its
+    # scans' directions of motion, and which asked for the wrong one (WRONG_TURN_RAD)
+    closure_turn_rad: np.ndarray | None = None
+    closure_true_turn_rad: np.ndarray | None = None
+    wrong_turn: np.ndarray | None = None
+    # corridor closures: which closures kept one (None: off), the true lateral offset between
+    # their scans (the larger of each off the other's true line of travel, m), which are wrong
+    # (off the line by more than 3 of their sigmas or 3 m, as wrong_closures)
+    corridor: np.ndarray | None = None
+    corridor_true_m: np.ndarray | None = None
+    wrong_corridor: np.ndarray | None = None
+
+    @property
+    def n_corridor(self) -> int:
+        return 0 if self.corridor is None else int(self.corridor.sum())
+
+    @property
+    def n_wrong_corridor(self) -> int:
+        return 0 if self.wrong_corridor is None else int(self.wrong_corridor.sum())
+
+    @property
+    def n_turns(self) -> int:
+        return 0 if self.closure_turn_rad is None else int(np.isfinite(self.closure_turn_rad).sum())
+
+    @property
+    def n_wrong_turns(self) -> int:
+        return 0 if self.wrong_turn is None else int(self.wrong_turn.sum())
 
     @property
     def n_closures(self) -> int:
@@ -136,6 +176,23 @@ def slam_on_walk(
     result = radio_slam(odometry, rssi, cfg)
     pairs = np.asarray(result.closures, np.int64).reshape(-1, 2)
     true_m = np.linalg.norm(xy[pairs[:, 1]] - xy[pairs[:, 0]], axis=1)
+    heading = walk_poses(xy)[:, 2]  # the true directions of motion: to judge, not to solve
+    true_turn = wrap_angle(heading[pairs[:, 1]] - heading[pairs[:, 0]])
+    turn = result.closure_turn_rad
+    if turn is None:
+        turn = np.full(len(pairs), np.nan)
+    wrong_turn = np.isfinite(turn) & (
+        np.abs(wrap_angle(true_turn - np.nan_to_num(turn))) > WRONG_TURN_RAD
+    )
+    true_poses = walk_poses(xy)
+    a, b = true_poses[pairs[:, 0]], true_poses[pairs[:, 1]]
+    corridor_true = np.maximum(lateral_offsets(a, b), lateral_offsets(b, a))
+    corridor = result.closure_corridor
+    wrong_corridor = None
+    if corridor is not None:
+        wrong_corridor = corridor & wrong_closures(
+            corridor_true, np.zeros(len(pairs)), np.full(len(pairs), cfg.corridor_sigma_m)
+        )
     return WalkSlamResult(
         label=label,
         n_scans=len(xy),
@@ -147,6 +204,12 @@ def slam_on_walk(
         closure_sigma_m=np.asarray(result.closure_sigma_m, np.float64),
         closure_true_m=true_m,
         wrong=wrong_closures(true_m, result.closure_distance_m, result.closure_sigma_m),
+        closure_turn_rad=turn,
+        closure_true_turn_rad=true_turn,
+        wrong_turn=wrong_turn,
+        corridor=corridor,
+        corridor_true_m=corridor_true,
+        wrong_corridor=wrong_corridor,
     )
 
 
@@ -188,6 +251,7 @@ __all__ = [
     "REAL_WALK_SETTINGS",
     "WRONG_ERROR_M",
     "WRONG_SIGMAS",
+    "WRONG_TURN_RAD",
     "WalkSlamResult",
     "real_walk_config",
     "slam_on_walk",
