@@ -36,7 +36,7 @@ def wifine_plans(layouts: Path, folder: Path) -> dict[int | None, object]:
     plans: dict[int | None, object] = {}
     for floor, name in WIFINE_FLOORS.items():
         yaml = folder / f"floor_{name}.yaml"
-        yaml.write_text(ROS_YAML.format(image=layouts / f"Floor_{name}_10cm.png"))
+        yaml.write_text(ROS_YAML.format(image=layouts.resolve() / f"Floor_{name}_10cm.png"))
         plans[floor] = load_floorplan(yaml)
     return plans
 
@@ -99,8 +99,9 @@ def wifine_table(root: Path, plans: dict, out: Path) -> tuple[list[str], dict]:
     return rows, tracks
 
 
-def figure(plans: dict, columns: dict, path: Path, walks: int = 2) -> None:
-    """A few tracked walks per floor over the plan's free space."""
+def figure(layouts: Path, columns: dict, path: Path, walks: int = 2) -> None:
+    """A few tracked walks per floor over the layout image (0.1 m a pixel, origin bottom-left)."""
+    import imageio.v3 as iio
     import matplotlib
 
     matplotlib.use("Agg")
@@ -109,9 +110,9 @@ def figure(plans: dict, columns: dict, path: Path, walks: int = 2) -> None:
     fig, axes = plt.subplots(1, 3, figsize=(18, 4.6))
     labels = np.asarray(columns["trajectory"])
     for ax, (floor, name) in zip(axes, WIFINE_FLOORS.items(), strict=True):
-        plan = plans[floor]
-        for ring in [plan.free_space.exterior, *plan.free_space.interiors]:
-            ax.fill(*ring.xy, color="0.85" if ring is plan.free_space.exterior else "white", lw=0)
+        image = iio.imread(layouts / f"Floor_{name}_10cm.png")
+        height, width = image.shape[:2]
+        ax.imshow(image, extent=(0, width / 10, 0, height / 10), alpha=0.35)
         on_floor = [
             w for w in dict.fromkeys(labels) if np.all(columns["floor_true"][labels == w] == floor)
         ]
@@ -171,7 +172,8 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         plans = wifine_plans(args.datasets / "wifine" / "floor_layouts", Path(tmp))
         rows, tracks = wifine_table(args.datasets, plans, args.out)
-        figure(plans, tracks["sorensen, tracked, layout, a crossing keeps 10 %"], args.figure)
+        layouts = args.datasets / "wifine" / "floor_layouts"
+        figure(layouts, tracks["sorensen, tracked, layout, a crossing keeps 10 %"], args.figure)
     lines += ["WiFine train → val, mean error (m) per floor", "", *rows]
     (args.out / "tables.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
