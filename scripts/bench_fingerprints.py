@@ -99,6 +99,19 @@ def wifine_table(root: Path, plans: dict, out: Path) -> tuple[list[str], dict]:
     return rows, tracks
 
 
+#: What the figure draws of each walk: truth, each scan's own estimate, the track.
+TRACES = (
+    ("x_true", "y_true", {"color": "k", "lw": 1}, "truth"),
+    (
+        "per_scan_x",
+        "per_scan_y",
+        {"color": "tab:orange", "ls": "", "marker": ".", "ms": 3},
+        "per scan",
+    ),
+    ("x", "y", {"color": "tab:blue", "lw": 1.2}, "tracked"),
+)
+
+
 def figure(layouts: Path, columns: dict, path: Path, walks: int = 2) -> None:
     """A few tracked walks per floor over the layout image (0.1 m a pixel, origin bottom-left)."""
     import imageio.v3 as iio
@@ -119,29 +132,10 @@ def figure(layouts: Path, columns: dict, path: Path, walks: int = 2) -> None:
         for k, walk in enumerate(on_floor[:walks]):
             rows = np.flatnonzero(labels == walk)
             rows = rows[np.argsort(columns["t"][rows])]
-            ax.plot(
-                columns["x_true"][rows],
-                columns["y_true"][rows],
-                "k-",
-                lw=1,
-                label="truth" if k == 0 else None,
-            )
-            ax.plot(
-                columns["per_scan_x"][rows],
-                columns["per_scan_y"][rows],
-                ".",
-                color="tab:orange",
-                ms=3,
-                label="per scan" if k == 0 else None,
-            )
-            ax.plot(
-                columns["x"][rows],
-                columns["y"][rows],
-                "-",
-                color="tab:blue",
-                lw=1.2,
-                label="tracked" if k == 0 else None,
-            )
+            for x, y, style, label in TRACES:
+                ax.plot(
+                    columns[x][rows], columns[y][rows], **style, label=label if k == 0 else None
+                )
         ax.set_title(f"floor {name}")
         ax.set_aspect("equal")
         ax.axis("off")

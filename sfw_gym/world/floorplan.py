@@ -18,6 +18,7 @@ from shapely.validation import explain_validity
 from sfw_gym.core.atomic import write_text_atomic
 from sfw_gym.core.constants import BULK_VERTICES, U8_FREE, U8_UNKNOWN, U8_WALL
 from sfw_gym.core.errors import FloorplanError
+from sfw_gym.world.ros_map import ROS_MAP_SUFFIXES, ros_map_free_space
 from sfw_gym.world.wall_crossing import DEFAULT_MIN_PIECE_M, cross_walls, cross_walls_parallel
 
 #: Wall materials that a floorplan may name; a radio preset maps each to a loss in dB.
@@ -226,11 +227,13 @@ def load_floorplan(source: str | os.PathLike[str] | Mapping[str, Any]) -> Floorp
     if isinstance(source, Mapping):
         where, data = "<dict>", source
     else:
-        from sfw_gym.world.ros_map import ROS_MAP_SUFFIXES, load_ros_map
-
-        if Path(source).suffix.lower() in ROS_MAP_SUFFIXES:
-            return load_ros_map(source)
         where = str(source) if str(source).isprintable() else repr(str(source))
+        if Path(source).suffix.lower() in ROS_MAP_SUFFIXES:
+            free_space = ros_map_free_space(source, MAX_FILE_BYTES)
+            try:
+                return floorplan_from_polygon(free_space, name=Path(source).stem)
+            except FloorplanError as exc:
+                raise FloorplanError(f"{where}: {exc}") from None
         try:
             size = Path(source).stat().st_size
             if size > MAX_FILE_BYTES:

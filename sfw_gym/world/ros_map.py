@@ -26,7 +26,6 @@ from scipy import ndimage
 from shapely.geometry import Polygon
 
 from sfw_gym.core.errors import FloorplanError
-from sfw_gym.world.floorplan import MAX_FILE_BYTES, Floorplan, floorplan_from_polygon
 
 #: The suffixes that mark a floorplan file as a ROS map's YAML.
 ROS_MAP_SUFFIXES = (".yaml", ".yml")
@@ -36,15 +35,16 @@ REQUIRED_KEYS = ("image", "resolution", "origin", "negate", "occupied_thresh", "
 MODES = ("trinary", "scale")
 
 
-def load_ros_map(path: str | os.PathLike[str]) -> Floorplan:
-    """The floorplan of a ROS map_server map (its YAML file; see the module doc).
+def ros_map_free_space(path: str | os.PathLike[str], max_bytes: int) -> Polygon:
+    """The free space (metres) of a ROS map_server map (its YAML file, at most ``max_bytes``;
+    see the module doc); :func:`sfw_gym.world.floorplan.load_floorplan` makes it a plan.
 
     Raises:
         FloorplanError: one line naming the file and the problem.
     """
     where = str(path) if str(path).isprintable() else repr(str(path))
     try:
-        return _load(Path(path))
+        return _load(Path(path), max_bytes)
     except FloorplanError as exc:
         raise FloorplanError(f"{where}: {exc}") from None
 
@@ -74,13 +74,13 @@ def largest_free_polygon(free: np.ndarray) -> Polygon:
     return Polygon(xy[0], xy[1:])
 
 
-def _load(path: Path) -> Floorplan:
+def _load(path: Path, max_bytes: int) -> Polygon:
     import yaml
 
     try:
         size = path.stat().st_size
-        if size > MAX_FILE_BYTES:
-            raise FloorplanError(f"{size:,} bytes, over the {MAX_FILE_BYTES:,} a map YAML may have")
+        if size > max_bytes:
+            raise FloorplanError(f"{size:,} bytes, over the {max_bytes:,} a map YAML may have")
         data = yaml.safe_load(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, ValueError) as exc:  # ValueError: a NUL in the name
         raise FloorplanError(f"cannot read the map YAML: {exc}") from None
@@ -119,11 +119,10 @@ def _load(path: Path) -> Floorplan:
     gray = _read_gray(path.parent / image)  # an absolute image path replaces the folder
     pixels = largest_free_polygon(free_pixels(gray, bool(negate), free_t))
     # pixel units -> metres about the origin: (x, y) * resolution + origin
-    free_space = Polygon(
+    return Polygon(
         np.asarray(pixels.exterior.coords) * resolution + (ox, oy),
         [np.asarray(r.coords) * resolution + (ox, oy) for r in pixels.interiors],
     )
-    return floorplan_from_polygon(free_space, name=path.stem)
 
 
 def _number(value: Any, what: str) -> float:
