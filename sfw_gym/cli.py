@@ -259,6 +259,7 @@ def _cmd_fingerprints(args: argparse.Namespace) -> int:
             seed=args.seed,
             particles=args.particles,
             floorplans=plans,
+            wall_weight=args.wall_weight,
         )
     elif args.floorplan:
         raise ConfigError("--floorplan: only used with --track")
@@ -853,7 +854,7 @@ def _add_fingerprints_parser(sub) -> None:
     from sfw_gym.datasets import DRIFT_HEADING_STD_RAD, DRIFT_TRANSLATION_STD
     from sfw_gym.datasets.readers import GENERIC_NOT_HEARD, UJI_SPLITS
     from sfw_gym.localization.fingerprinting import DEFAULT_METHOD, METHODS
-    from sfw_gym.localization.tracking import TRACK_PARTICLES
+    from sfw_gym.localization.tracking import TRACK_PARTICLES, WALL_WEIGHT
 
     fp = sub.add_parser(
         "fingerprints",
@@ -887,6 +888,13 @@ def _add_fingerprints_parser(sub) -> None:
         metavar="[FLOOR=]PLAN",
         help="with --track: particles keep to this plan's free space (a ROS map .yaml or a "
         "plan JSON); FLOOR=PLAN for one floor, repeatable",
+    )
+    ev.add_argument(
+        "--wall-weight",
+        type=checked(float, lambda v: 0 <= v <= 1, "a number in [0, 1]"),
+        default=WALL_WEIGHT,
+        help="with --floorplan: the share of its weight a particle keeps when it crosses a wall "
+        "(0: walls are uncrossable; above 0 where the plan may be wrong)",
     )
     ev.add_argument(
         "--odometry-translation-std",

@@ -10,6 +10,7 @@ from functools import partial
 
 import numpy as np
 
+from sfw_gym.core.errors import ConfigError
 from sfw_gym.localization.fingerprinting import FloorMaps
 from sfw_gym.localization.mcl import MclConfig, WifiMCL
 from sfw_gym.world.floorplan import Floorplan
@@ -78,8 +79,16 @@ def track_walk(
     rng: np.random.Generator | int | Sequence[int] | None = 0,
 ) -> np.ndarray:
     """Estimated positions ``(N, 2)`` along a walk: ``rssi_dbm`` ``(N, L)`` over the training
-    access points, ``increments`` ``(N - 1, 3)`` odometry (forward, lateral, turn) between scans."""
+    access points, ``increments`` ``(N - 1, 3)`` odometry (forward, lateral, turn) between scans;
+    ``plan``: walls the particles may not cross (a crossing keeps ``wall_weight`` of a particle's
+    weight); ``sensor(k, xy)``: scan k's log-likelihood at positions ``xy`` (default: the
+    gridmaps')."""
     rssi = np.asarray(rssi_dbm, np.float64)[:, floor.access_points]
+    if np.shape(increments) != (len(rssi) - 1, 3):
+        raise ConfigError(
+            f"a walk of {len(rssi)} scans needs ({len(rssi) - 1}, 3) odometry increments, "
+            f"got {np.shape(increments)}"
+        )
     mcl = WifiMCL(
         floor.gridmaps,
         config

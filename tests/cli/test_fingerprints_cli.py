@@ -78,8 +78,9 @@ def test_track_with_a_floorplan(files, tmp_path: Path) -> None:
     plan_path = plan.save(tmp_path / "plan.json")
     argv = ["fingerprints", "evaluate", "--train", str(files["train"]), "--test"]
     argv += [str(files["test"]), "--out", str(tmp_path / "o"), "--track", "--particles", "300"]
-    assert main([*argv, "--floorplan", f"0={plan_path}"]) == 0
-    assert json.loads((tmp_path / "o" / "metrics.json").read_text())["with_floorplan"]
+    assert main([*argv, "--floorplan", f"0={plan_path}", "--wall-weight", "0.1"]) == 0
+    metrics = json.loads((tmp_path / "o" / "metrics.json").read_text())
+    assert metrics["with_floorplan"] and metrics["wall_weight"] == 0.1
 
 
 def test_floorplan_option_takes_a_path_or_floor_and_path() -> None:

@@ -133,6 +133,12 @@ def test_tracking_a_noisy_walk_beats_locating_each_scan(method: str) -> None:
     assert np.mean(np.concatenate(tracked)) < 0.8 * np.mean(np.concatenate(per_scan))
 
 
+def test_odometry_must_match_the_walk(train: Fingerprints) -> None:
+    maps = make_localizer("gridmaps").fit(train).floors[0]
+    with pytest.raises(ConfigError, match=r"a walk of 3 scans needs \(2, 3\) odometry"):
+        track_walk(maps, train.rssi_dbm[:3], np.zeros((3, 3)))
+
+
 def test_particles_that_cross_a_wall_die_or_keep_the_stated_weight(train: Fingerprints) -> None:
     # two rooms split by a wall at x = 5 with a doorway at y > 4: particles at y = 2 moving
     # 2 m in +x from x = 4 cross it, those at x = 1 do not
