@@ -7,6 +7,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
+from sfw_gym.datasets import read_csv
 from sfw_gym.mapping.offline import map_log, read_rssi_log
 from tests.fuzz.conftest import outcome
 
@@ -50,3 +51,31 @@ def test_rssi_logs(tmp_path_factory, bom, log_text, newline):
         assert res.mapper.n_updates == 2 * log.n_samples  # forward, then reversed
 
     outcome("RSSI CSV", read_and_map, names="log.csv")
+
+
+FINGERPRINT_HEADERS = ["x,y,ap1,ap2", "x,y,floor,trajectory,t,ap1", "x,y,x", "y,ap1", "x,y", ""]
+
+
+@st.composite
+def surveys(draw) -> tuple[str, list[list[str]]]:
+    """A header and rows, most as wide as the header, of mostly numeric cells."""
+    header = draw(st.sampled_from(FINGERPRINT_HEADERS))
+    width = max(1, len(header.split(",")))
+    row = st.lists(cells, min_size=width, max_size=width) | st.lists(cells, max_size=7)
+    return header, draw(st.lists(row, max_size=10))
+
+
+@given(surveys())
+def test_fingerprint_csvs(tmp_path_factory, survey):
+    """Any text through the generic fingerprint reader: finite positions and readings (NaN: not
+    heard), or one clean error naming the file."""
+    header, rows = survey
+    path = tmp_path_factory.mktemp("fp") / "survey.csv"
+    path.write_text("\n".join([header, *(",".join(r) for r in rows)]) + "\n", encoding="utf-8")
+
+    def read() -> None:
+        fp = read_csv(path)
+        assert np.isfinite(fp.positions).all() and not np.isinf(fp.rssi_dbm).any()
+        assert len(fp) == len(fp.rssi_dbm) > 0
+
+    outcome("fingerprint CSV", read, names="survey.csv")
