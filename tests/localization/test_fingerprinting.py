@@ -12,7 +12,7 @@ from sfw_gym.localization.fingerprinting import METHODS, make_localizer
 from sfw_gym.localization.mcl import MclConfig, WifiMCL
 from sfw_gym.localization.tracking import WalledMCL, track_walk
 from sfw_gym.world.floorplan import floorplan_from_polygon
-from tests.conftest import two_rooms_polygon
+from tests.conftest import DATASETS_DIR, two_rooms_polygon
 
 APS = np.array([[0.0, 0.0], [20.0, 0.0], [0.0, 12.0], [20.0, 12.0], [10.0, 6.0], [5.0, 10.0]])
 
@@ -151,3 +151,18 @@ def test_particles_that_cross_a_wall_die_or_keep_the_stated_weight(train: Finger
         walled.step(np.array([2.0, 0.0, 0.0]), np.full(len(maps.access_points), np.nan))
         assert mcl.particles[:, 0] == pytest.approx([6.0, 3.0], abs=0.01)
         assert mcl.weights[0] / mcl.weights[1] == pytest.approx(expected, abs=1e-3)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not (DATASETS_DIR / "ujiindoorloc").is_dir(), reason="../shared absent")
+def test_the_default_meets_the_bar_on_ujiindoorloc_validation() -> None:
+    """Issue 38's bar, on the real data: mean ≤ 7.0 m, floor ≥ 93 %, building ≥ 99.5 %."""
+    from sfw_gym.datasets import read_ujiindoorloc
+    from sfw_gym.localization.fingerprinting import DEFAULT_METHOD
+
+    zip_path = DATASETS_DIR / "ujiindoorloc" / "UJIIndoorLoc.zip"
+    train, test = read_ujiindoorloc(zip_path), read_ujiindoorloc(zip_path, "validation")
+    p = make_localizer(DEFAULT_METHOD).fit(train).predict(test.aligned_to(train.access_points))
+    assert np.hypot(*(p.positions - test.positions).T).mean() <= 7.0
+    assert np.mean(p.floor == test.floor) >= 0.93
+    assert np.mean(p.building == test.building) >= 0.995
