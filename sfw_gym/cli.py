@@ -540,7 +540,9 @@ def build_parser() -> argparse.ArgumentParser:
     source.add_argument(
         "--seed", type=seed_int, default=0, help="procedural floorplan seed (default 0)"
     )
-    source.add_argument("--floorplan", help="a HouseExpo or sfw_gym JSON floorplan file")
+    source.add_argument(
+        "--floorplan", help="a floorplan file: HouseExpo or sfw_gym JSON, or a ROS map YAML"
+    )
     world.add_argument("--routers", default="2", help="a count, or positions 'x1,y1;x2,y2'")
     world.add_argument("--preset", choices=PRESETS, default="default", help="radio preset")
     world.add_argument("--band", choices=list(BANDS), default="2.4", help="GHz (default 2.4)")

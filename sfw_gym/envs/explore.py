@@ -81,30 +81,29 @@ class SfWExploreEnv(gym.Env):
     ``gym.make(..., max_episode_steps=N)`` still works but truncates from outside, without it.
 
     ## Arguments
-    ``gym.make("SfW-Explore-v0", **kwargs)`` with, all JSON-serialisable:
-    ``action_type`` ("continuous" | "discrete"), ``floorplan`` (None: procedural each episode; an
-    int: that generator seed every episode; a path: a HouseExpo or sfw_gym JSON file; a folder:
-    one of its JSON files each episode), ``generator`` (dict of `generate_floorplan` params),
-    ``n_routers`` (2), ``radio_preset`` ("default" | "thick" | "residential"), ``radio_band``
-    ("2.4" | "5"), ``radio`` / ``robot`` / ``mapper`` (dicts of RadioConfig / RobotConfig /
-    MapperConfig overrides), ``resolution_m`` (0.1), ``map_px`` (64), ``crop_px`` (48),
-    ``coverage_target`` (0.95), ``collision_penalty`` (0.1), ``reward_scale`` (0.01),
-    ``max_steps`` (3000), ``steps_per_m2`` (None: the budget is ``max_steps``; a number: the
-    budget is ``min(max_steps, ceil(steps_per_m2 × free area))``), ``n_background_aps`` (0:
-    access points beyond the routers, half in the building and half in its neighbourhood, whose
-    RSSI the robot hears as a fingerprint: ``obs["fingerprint"]``, ``obs["fingerprint_heard"]``
-    and ``info["fingerprint"]``; Radio SLAM's input), ``pose_source`` ("odometry": the robot maps
-    where its odometry says it is; "radio_slam": odometry corrected by radio loop closures
-    between background-AP fingerprints, solved every ``slam["solve_every"]`` steps, the map
-    rebuilt along each correction; "radio_lidar": Radio+LiDAR SLAM, the same with LiDAR scan
-    matching; "true": the true pose), ``slam`` (dict of `RadioSlamConfig` overrides; the
-    odometry weights default to the robot's noise model), ``lidar`` (None: no LiDAR, the
-    default; a dict of `LidarConfig` overrides, ``{}`` for the defaults: a simulated 2-D LiDAR,
-    ``obs["lidar"]`` and ``info["lidar_ranges"]``), ``render_mode`` (None |
-    "rgb_array" | "human"), ``render_size`` ((960, 480): every frame is ``width × height``, the
-    plan letterboxed into it, so video writers work across plans; None: the plan's own size).
-    ``reset(options=…)``: ``floorplan`` (a Floorplan, a path or a generator seed), ``routers``
-    (positions (R, 2) or a count ≤ n_routers), ``start_pose`` ((x, y, θ)).
+    ``gym.make("SfW-Explore-v0", **kwargs)`` with, all JSON-serialisable: ``action_type``
+    ("continuous" | "discrete"), ``floorplan`` (None: procedural each episode; an int: that
+    generator seed every episode; a path: a HouseExpo or sfw_gym JSON file or a ROS map YAML; a
+    folder: one of its JSON files each episode), ``generator`` (dict of `generate_floorplan`
+    params), ``n_routers`` (2), ``radio_preset`` ("default" | "thick" | "residential"),
+    ``radio_band`` ("2.4" | "5"), ``radio`` / ``robot`` / ``mapper`` (dicts of RadioConfig /
+    RobotConfig / MapperConfig overrides), ``resolution_m`` (0.1), ``map_px`` (64), ``crop_px``
+    (48), ``coverage_target`` (0.95), ``collision_penalty`` (0.1), ``reward_scale`` (0.01),
+    ``max_steps`` (3000), ``steps_per_m2`` (None: the budget is ``max_steps``; a number: the budget
+    is ``min(max_steps, ceil(steps_per_m2 × free area))``), ``n_background_aps`` (0: access points
+    beyond the routers, half in the building and half in its neighbourhood, whose RSSI the robot
+    hears as a fingerprint: ``obs["fingerprint"]``, ``obs["fingerprint_heard"]`` and
+    ``info["fingerprint"]``; Radio SLAM's input), ``pose_source`` ("odometry": the robot maps where
+    its odometry says it is; "radio_slam": odometry corrected by radio loop closures between
+    background-AP fingerprints, solved every ``slam["solve_every"]`` steps, the map rebuilt along
+    each correction; "radio_lidar": Radio+LiDAR SLAM, the same with LiDAR scan matching; "true": the
+    true pose), ``slam`` (dict of `RadioSlamConfig` overrides; the odometry weights default to the
+    robot's noise model), ``lidar`` (None: no LiDAR, the default; a dict of `LidarConfig` overrides,
+    ``{}`` for the defaults: a simulated 2-D LiDAR, ``obs["lidar"]`` and ``info["lidar_ranges"]``),
+    ``render_mode`` (None | "rgb_array" | "human"), ``render_size`` ((960, 480): every frame is
+    ``width × height``, the plan letterboxed into it, so video writers work across plans; None: the
+    plan's own size). ``reset(options=…)``: ``floorplan`` (a Floorplan, a path or a generator seed),
+    ``routers`` (positions (R, 2) or a count ≤ n_routers), ``start_pose`` ((x, y, θ)).
 
     ## Version History
     - v0: initial release.
