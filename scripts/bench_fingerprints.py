@@ -18,27 +18,18 @@ from pathlib import Path
 
 import numpy as np
 
-from sfw_gym.datasets import read_ujiindoorloc, read_wifine
+from sfw_gym.datasets import WIFINE_FLOORS, read_ujiindoorloc, read_wifine, write_wifine_maps
 from sfw_gym.evaluation.fingerprints import TrackSettings, evaluate
 from sfw_gym.world.floorplan import load_floorplan
 
 ROOT = Path(__file__).resolve().parents[1]
 UJI_METHODS = ("1nn", "w3nn", "w5nn", "sorensen", "gridmaps")
 WIFINE_METHODS = ("1nn", "w3nn", "sorensen", "gridmaps")
-#: WiFine's floorIDs and their layout images (../shared/datasets/README.md).
-WIFINE_FLOORS = {0: 4, 1: 5, 2: 6}
-ROS_YAML = "image: {image}\nresolution: 0.1\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
-ROS_YAML += "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
 
 
 def wifine_plans(layouts: Path, folder: Path) -> dict[int | None, object]:
-    """The three floors as ROS maps: a YAML beside a copy-free reference to each image."""
-    plans: dict[int | None, object] = {}
-    for floor, name in WIFINE_FLOORS.items():
-        yaml = folder / f"floor_{name}.yaml"
-        yaml.write_text(ROS_YAML.format(image=layouts.resolve() / f"Floor_{name}_10cm.png"))
-        plans[floor] = load_floorplan(yaml)
-    return plans
+    """The three floors' plans, keyed by floorID, through ROS map YAMLs written in ``folder``."""
+    return {k: load_floorplan(path) for k, path in write_wifine_maps(layouts, folder).items()}
 
 
 def uji_table(root: Path) -> list[str]:

@@ -22,32 +22,13 @@ from pathlib import Path
 import imageio.v3 as iio
 import numpy as np
 
+from sfw_gym.datasets import WIFINE_FLOORS, write_wifine_maps
 from sfw_gym.evaluation import evaluate
 from sfw_gym.world import load_floorplan
 
 REPO = Path(__file__).resolve().parents[1]
-FLOORS = (4, 5, 6)
 AGENTS = ("frontier", "cross-pass", "regions-ppo")
 ENV_ID = "SfW-Explore-v0"
-#: A ROS map_server YAML for a WiFine layout (black walls, white free space).
-MAP_YAML = """image: {image}
-resolution: 0.1
-origin: [0.0, 0.0, 0.0]
-negate: 0
-occupied_thresh: 0.65
-free_thresh: 0.196
-"""
-
-
-def write_maps(wifine: Path, folder: Path) -> dict[int, Path]:
-    """A map YAML per floor in ``folder``, each naming its layout by absolute path."""
-    folder.mkdir(parents=True, exist_ok=True)
-    maps = {}
-    for floor in FLOORS:
-        image = (wifine / "floor_layouts" / f"Floor_{floor}_10cm.png").resolve()
-        maps[floor] = folder / f"wifine_floor_{floor}.yaml"
-        maps[floor].write_text(MAP_YAML.format(image=image))
-    return maps
 
 
 def stack_figures(paths: list[Path], out: Path) -> Path:
@@ -76,13 +57,14 @@ def main() -> None:
     p.add_argument("--figure", type=Path, default=REPO / "docs" / "figures" / "wifine_explore.png")
     p.add_argument("--workers", type=int, default=1, help="worker processes (1: this one)")
     args = p.parse_args()
-    maps = write_maps(args.wifine, args.out / "maps")
+    maps = write_wifine_maps(args.wifine / "floor_layouts", args.out / "maps")
     lines = [
         "| floor | free area [m²] | agent | coverage | bits / m | path [m] | episode wall [s] |",
         "|---|---:|---|---:|---:|---:|---:|",
     ]
     figures = []
-    for floor, path in maps.items():
+    for floor_id, path in maps.items():
+        floor = WIFINE_FLOORS[floor_id]
         area = load_floorplan(path).area_m2
         start = time.perf_counter()
         result = evaluate(

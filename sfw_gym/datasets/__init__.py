@@ -17,6 +17,7 @@ from sfw_gym.datasets.readers import (
     read_csv,
     read_ujiindoorloc,
     read_wifine,
+    write_wifine_maps,
 )
 
 __all__ = [
@@ -31,4 +32,5 @@ __all__ = [
     "read_wifine",
     "synthetic_odometry",
     "walk_poses",
+    "write_wifine_maps",
 ]

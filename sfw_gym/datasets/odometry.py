@@ -27,13 +27,12 @@ def walk_poses(positions: np.ndarray) -> np.ndarray:
     moved = np.hypot(step[:, 0], step[:, 1]) > 1e-9
     heading = np.zeros(len(xy))
     if moved.any():
+        # each pose takes the last step that moved up to it (the first such step before any)
+        last_moved = np.maximum.accumulate(np.where(moved, np.arange(len(moved)), -1))
+        last_moved[last_moved < 0] = np.argmax(moved)
         angles = np.arctan2(step[:, 1], step[:, 0])
-        last = angles[np.argmax(moved)]
-        heading[0] = last
-        for k in range(1, len(xy)):
-            if moved[k - 1]:
-                last = angles[k - 1]
-            heading[k] = last
+        heading[0] = angles[np.argmax(moved)]
+        heading[1:] = angles[last_moved]
     return np.column_stack([xy, heading])
 
 

@@ -22,6 +22,17 @@ GENERIC_NOT_HEARD = 100.0
 UJI_NOT_HEARD = 100.0
 WIFINE_NOT_HEARD = -100.0
 UJI_SPLITS = {"train": "trainingData.csv", "validation": "validationData.csv"}
+#: WiFine's floorIDs → the building's floor numbers, as its layout images are named.
+WIFINE_FLOORS = {0: 4, 1: 5, 2: 6}
+#: A ROS map_server YAML for a WiFine layout: 0.1 m a pixel, origin at the bottom-left corner,
+#: black walls on white (../shared/datasets/README.md).
+WIFINE_MAP_YAML = """image: {image}
+resolution: 0.1
+origin: [0.0, 0.0, 0.0]
+negate: 0
+occupied_thresh: 0.65
+free_thresh: 0.196
+"""
 
 Source = str | os.PathLike[str] | IO[str] | IO[bytes]
 
@@ -98,6 +109,21 @@ def read_wifine(source: str | os.PathLike[str]) -> Fingerprints:
         walk = _fingerprints(name, frame, aps, WIFINE_NOT_HEARD, columns)
         parts.append(replace(walk, trajectory=np.full(len(walk), file.stem)))
     return concatenate(parts, name=str(path))
+
+
+def write_wifine_maps(
+    layouts: str | os.PathLike[str], folder: str | os.PathLike[str]
+) -> dict[int, Path]:
+    """A ROS map YAML per WiFine floor in ``folder``, each naming its layout image in
+    ``layouts`` (``Floor_{4,5,6}_10cm.png``) by absolute path; keyed by floorID."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    maps = {}
+    for floor_id, floor in WIFINE_FLOORS.items():
+        image = (Path(layouts) / f"Floor_{floor}_10cm.png").resolve()
+        maps[floor_id] = folder / f"wifine_floor_{floor}.yaml"
+        maps[floor_id].write_text(WIFINE_MAP_YAML.format(image=image), encoding="utf-8")
+    return maps
 
 
 def concatenate(parts: list[Fingerprints], name: str) -> Fingerprints:

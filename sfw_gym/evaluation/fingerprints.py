@@ -113,6 +113,12 @@ def _columns(test: Fingerprints, p: Prediction) -> dict[str, np.ndarray]:
     return columns
 
 
+def majority_key(building: np.ndarray, floor: np.ndarray) -> int:
+    """The (building, floor) key (building × 1000 + floor) that most of a walk's scans were
+    placed on: the walk is tracked there."""
+    return int(np.bincount(np.asarray(building) * 1000 + np.asarray(floor)).argmax())
+
+
 def _track(
     train: Fingerprints,
     test: Fingerprints,
@@ -128,7 +134,7 @@ def _track(
     start = time.perf_counter()
     walks = 0
     for walks, (_, rows) in enumerate(test.walks(), start=1):
-        key = int(np.bincount(building[rows] * 1000 + chosen[rows]).argmax())
+        key = majority_key(building[rows], chosen[rows])
         increments, _ = synthetic_odometry(
             test.positions[rows],
             translation_std=settings.translation_std,

@@ -119,13 +119,9 @@ class KnnLocalizer:
         dist, idx = self.neighbours(self.features(test))
         w = self._weights(dist)
         keys = self.key[idx]
-        key = np.empty(len(test), np.int64)
-        for i in range(len(test)):
-            votes: dict[int, float] = {}
-            for kk, ww in zip(keys[i], w[i], strict=True):
-                votes[int(kk)] = votes.get(int(kk), 0.0) + float(ww)
-            key[i] = max(votes, key=votes.__getitem__)
-        return key, idx, w
+        labels = np.unique(keys)
+        votes = np.stack([(w * (keys == label)).sum(1) for label in labels], axis=1)
+        return labels[np.argmax(votes, axis=1)], idx, w
 
     def log_likelihood(
         self, scan: Fingerprints, key: int, xy: np.ndarray, sigma_m: float = KERNEL_SIGMA_M

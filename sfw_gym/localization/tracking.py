@@ -66,6 +66,16 @@ class WalledMCL:
         return self.mcl.estimate()[0][:2]
 
 
+def tracking_config(floor: FloorMaps, particles: int = TRACK_PARTICLES) -> MclConfig:
+    """The filter's settings on ``floor``: the "scan" sensor model with the floor's scan
+    variance, inflated by :data:`SCAN_VARIANCE_INFLATION`."""
+    return MclConfig(
+        particles=particles,
+        sensor="scan",
+        scan_variance=floor.scan_variance * SCAN_VARIANCE_INFLATION,
+    )
+
+
 def track_walk(
     floor: FloorMaps,
     rssi_dbm: np.ndarray,
@@ -91,12 +101,7 @@ def track_walk(
         )
     mcl = WifiMCL(
         floor.gridmaps,
-        config
-        or MclConfig(
-            particles=particles,
-            sensor="scan",
-            scan_variance=floor.scan_variance * SCAN_VARIANCE_INFLATION,
-        ),
+        config or tracking_config(floor, particles),
         np.random.default_rng(rng),
         allowed=floor.allowed,
     )

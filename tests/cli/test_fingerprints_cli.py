@@ -11,6 +11,7 @@ import pytest
 
 from sfw_gym.cli import main, parse_floorplan_option
 from sfw_gym.datasets import Fingerprints, read_csv
+from sfw_gym.evaluation.fingerprints import majority_key
 from sfw_gym.world.floorplan import floorplan_from_polygon
 from tests.conftest import two_rooms_polygon
 from tests.localization.test_fingerprinting import AP_NAMES, radio, survey
@@ -118,3 +119,8 @@ def test_convert_writes_the_generic_csv(tmp_path, capsys) -> None:
     assert back.trajectory.tolist() == ["train_4_1"] and back.rssi_dbm[0, 1] == -61
     assert np.isnan(back.rssi_dbm[0, 0])
     assert "1 scans, 2 access points" in capsys.readouterr().out
+
+
+def test_a_walk_is_tracked_on_the_floor_most_of_its_scans_were_placed_on() -> None:
+    assert majority_key([1, 1, 1, 1], [0, 2, 2, 1]) == 1002
+    assert majority_key([0, 2, 2], [3, 3, 3]) == 2003

@@ -15,6 +15,10 @@ def test_walk_headings_follow_the_steps_and_hold_when_standing() -> None:
     poses = walk_poses(SQUARE)
     np.testing.assert_allclose(poses[:, 2], [0, 0, np.pi / 2, np.pi / 2, np.pi])
     assert walk_poses(np.zeros((3, 2)))[:, 2].tolist() == [0, 0, 0]
+    # standing at first: those scans take the first step's heading
+    np.testing.assert_allclose(
+        walk_poses(np.array([[0, 0], [0, 0], [0, 1.0]]))[:, 2], [np.pi / 2] * 3
+    )
 
 
 def test_without_noise_odometry_is_the_true_motion() -> None:

@@ -11,7 +11,13 @@ import numpy as np
 import pytest
 
 from sfw_gym.core.errors import ConfigError
-from sfw_gym.datasets import Fingerprints, read_csv, read_ujiindoorloc, read_wifine
+from sfw_gym.datasets import (
+    Fingerprints,
+    read_csv,
+    read_ujiindoorloc,
+    read_wifine,
+    write_wifine_maps,
+)
 from tests.conftest import DATASETS_DIR
 
 UJI_HEADER = (
@@ -190,3 +196,14 @@ def test_the_real_ujiindoorloc_and_wifine_load() -> None:
     assert set(uji.building.tolist()) == {0, 1, 2} and set(uji.floor.tolist()) == {0, 1, 2, 3, 4}
     val = read_wifine(DATASETS_DIR / "wifine" / "val")
     assert val.n_access_points == 436 and len(set(val.trajectory.tolist())) == 85
+
+
+def test_wifine_map_yamls_name_each_layout_in_the_documented_frame(tmp_path: Path) -> None:
+    import yaml
+
+    maps = write_wifine_maps(Path("layouts"), tmp_path / "maps")
+    assert sorted(maps) == [0, 1, 2]
+    spec = yaml.safe_load(maps[1].read_text())
+    assert spec["image"] == str(Path("layouts").resolve() / "Floor_5_10cm.png")
+    assert spec["resolution"] == 0.1 and spec["origin"] == [0.0, 0.0, 0.0]
+    assert spec["negate"] == 0 and spec["free_thresh"] < spec["occupied_thresh"]

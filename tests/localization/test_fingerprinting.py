@@ -3,14 +3,22 @@ walk, and particles that cannot cross a wall."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.datasets import Fingerprints, synthetic_odometry
 from sfw_gym.localization.fingerprinting import METHODS, make_localizer
-from sfw_gym.localization.mcl import MclConfig, WifiMCL
-from sfw_gym.localization.tracking import WalledMCL, track_walk
+from sfw_gym.localization.mcl import MclConfig, WifiMCL, scan_log_likelihood
+from sfw_gym.localization.survey import normalise_rssi
+from sfw_gym.localization.tracking import (
+    SCAN_VARIANCE_INFLATION,
+    WalledMCL,
+    track_walk,
+    tracking_config,
+)
 from sfw_gym.world.floorplan import floorplan_from_polygon
 from tests.conftest import DATASETS_DIR, two_rooms_polygon
 
@@ -81,6 +89,21 @@ def test_every_method_finds_building_floor_and_place_between_survey_points(
     errors = np.hypot(*(p.positions - xy).T)
     assert errors.mean() < 1.0, errors.mean()
     assert p.query_s_per_scan > 0
+
+
+def test_the_position_comes_from_the_neighbours_in_the_chosen_building() -> None:
+    # one AP; the query (-60 dBm) is nearest to building 1's scan (1.5 dB off), but building 0's
+    # two scans 2 dB off outvote it (0.5 + 0.5 > 0.67): the position is theirs alone
+    train = Fingerprints(
+        [[0.0, 0.0], [2.0, 0.0], [5.0, 0.0], [100.0, 0.0]],
+        [[-58.0], [-62.0], [-70.0], [-61.5]],
+        ("ap",),
+        building=[0, 0, 0, 1],
+    )
+    query = Fingerprints([[1.0, 0.0]], [[-60.0]], ("ap",), building=[0])
+    p = make_localizer("w3nn").fit(train).predict(query)
+    assert p.building.tolist() == [0]
+    np.testing.assert_allclose(p.positions, [[1.0, 0.0]])
 
 
 def test_unknown_method_is_refused() -> None:
@@ -166,3 +189,38 @@ def test_the_default_meets_the_bar_on_ujiindoorloc_validation() -> None:
     assert np.hypot(*(p.positions - test.positions).T).mean() <= 7.0
     assert np.mean(p.floor == test.floor) >= 0.93
     assert np.mean(p.building == test.building) >= 0.995
+
+
+def test_scan_likelihood_counts_each_heard_ap_once_with_the_scan_scatter() -> None:
+    z = np.array([0.5, 0.0])  # the second AP not heard: it weighs nothing
+    log_l = scan_log_likelihood(z, np.array([[0.4, 0.9]]), np.array([[0.01, 0.01]]), 0.03)
+    expected = -0.5 * (0.1**2 / 0.04 + np.log(0.04) + np.log(2 * np.pi))
+    np.testing.assert_allclose(log_l, [expected])
+
+
+def test_gridmaps_learn_one_scans_scatter_about_the_map() -> None:
+    """6 dB of noise per reading is (6 / 100)² = 0.0036 in normalised units; none: ~0."""
+    noisy = make_localizer("gridmaps").fit(survey(noise_db=6.0))
+    clean = make_localizer("gridmaps").fit(survey())
+    for floor in noisy.floors.values():
+        assert floor.scan_variance == pytest.approx(0.0036, rel=0.15)
+    for floor in clean.floors.values():
+        assert floor.scan_variance < 0.0005
+
+
+def test_the_scan_sensor_model_weighs_the_particles(train: Fingerprints) -> None:
+    """MclConfig(sensor="scan") weighs by scan_log_likelihood; tracking's config inflates the
+    floor's scan variance by SCAN_VARIANCE_INFLATION."""
+    floor = make_localizer("gridmaps").fit(survey(noise_db=6.0)).floors[0]
+    config = tracking_config(floor, particles=2)
+    assert config.scan_variance == floor.scan_variance * SCAN_VARIANCE_INFLATION
+    mcl = WifiMCL(floor.gridmaps, replace(config, resample_ess=1e-9, slow_rate=0, fast_rate=0))
+    mcl.particles = np.array([[5.5, 5.5, 0.0], [15.5, 2.5, 0.0]])
+    rssi = radio(np.array([[5.5, 5.5]]), 0, 0)[0][floor.access_points]
+    mcl.update(rssi)
+    mean, var = floor.gridmaps.lookup(mcl.particles[:, :2])
+    log_l = scan_log_likelihood(normalise_rssi(rssi), mean, var, config.scan_variance)
+    np.testing.assert_allclose(
+        mcl.weights, np.exp(log_l - log_l.max()) / np.exp(log_l - log_l.max()).sum()
+    )
+    assert mcl.weights[0] > mcl.weights[1]  # the particle where the scan was taken

@@ -12,6 +12,7 @@ import pytest
 
 import sfw_gym  # noqa: F401  (registration)
 from sfw_gym.core.errors import FloorplanError
+from sfw_gym.datasets import write_wifine_maps
 from sfw_gym.world import load_floorplan
 from tests.conftest import DATASETS_DIR
 
@@ -190,7 +191,7 @@ def test_wifine_floors_load_with_the_documented_frame(
     image = WIFINE_DIR / "floor_layouts" / f"Floor_{floor}_10cm.png"
     if not image.is_file():
         pytest.skip(f"WiFine not found at {WIFINE_DIR} (../shared is absent)")
-    plan = load_floorplan(write_map(tmp_path, image=str(image), resolution=0.1, origin=[0, 0, 0]))
+    plan = load_floorplan(write_wifine_maps(image.parent, tmp_path)[floor_id])
     xmin, ymin, xmax, ymax = plan.free_space.bounds
     assert 80 < xmax - xmin < 91 and 48 < ymax - ymin < 58
     files = sorted((WIFINE_DIR / "train").glob(f"train_{floor}_*.csv"))[::4]
