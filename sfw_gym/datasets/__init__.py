@@ -13,6 +13,7 @@ from sfw_gym.datasets.odometry import (
 )
 from sfw_gym.datasets.readers import (
     GENERIC_NOT_HEARD,
+    WIFINE_FLOORS,
     concatenate,
     read_csv,
     read_ujiindoorloc,
@@ -25,6 +26,7 @@ __all__ = [
     "DRIFT_TRANSLATION_STD",
     "GENERIC_NOT_HEARD",
     "META_COLUMNS",
+    "WIFINE_FLOORS",
     "Fingerprints",
     "concatenate",
     "read_csv",

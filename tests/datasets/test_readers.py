@@ -12,6 +12,7 @@ import pytest
 
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.datasets import (
+    WIFINE_FLOORS,
     Fingerprints,
     read_csv,
     read_ujiindoorloc,
@@ -202,7 +203,7 @@ def test_wifine_map_yamls_name_each_layout_in_the_documented_frame(tmp_path: Pat
     import yaml
 
     maps = write_wifine_maps(Path("layouts"), tmp_path / "maps")
-    assert sorted(maps) == [0, 1, 2]
+    assert sorted(maps) == sorted(WIFINE_FLOORS) == [0, 1, 2]
     spec = yaml.safe_load(maps[1].read_text())
     assert spec["image"] == str(Path("layouts").resolve() / "Floor_5_10cm.png")
     assert spec["resolution"] == 0.1 and spec["origin"] == [0.0, 0.0, 0.0]
