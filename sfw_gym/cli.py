@@ -821,9 +821,9 @@ def build_parser() -> argparse.ArgumentParser:
         "--vector-envs",
         type=positive_int,
         default=1,
-        help="N > 1: run the episodes on a gymnasium vector env of N sub-envs (worker processes; "
-        "the agents act on each sub-env's info['robot_view']) instead of --workers; the same "
-        "records (no GIFs)",
+        help="N > 1: run the episodes on the native vector env of N sub-envs, stepped together "
+        "in this process with one agent per sub-env, instead of --workers; the same records "
+        "(no GIFs)",
     )
     ev.add_argument("--gif", action="store_true", help="also write GIFs of the first episodes")
     ev.add_argument(

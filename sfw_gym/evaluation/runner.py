@@ -41,7 +41,7 @@ from sfw_gym.evaluation.plots import plot_curves, plot_trajectories
 from sfw_gym.evaluation.report import paired_markdown, results_csv, results_markdown
 from sfw_gym.evaluation.rollout import EpisodeSpec, run_episode, zone_band_unknown
 from sfw_gym.evaluation.stats import paired_differences, summarize
-from sfw_gym.evaluation.vector import run_vector
+from sfw_gym.evaluation.vector import check_native_vector_env, run_vector
 
 __all__ = [
     "BACKENDS",
@@ -60,8 +60,8 @@ def run_specs(
     specs: Sequence[EpisodeSpec], out: Path, executor: Executor, vector_envs: int = 1
 ) -> list[dict[str, Any]]:
     """Run the episodes not yet in ``OUT/episodes.jsonl`` (the checkpoint) on ``executor`` (or,
-    with ``vector_envs`` > 1, on a vector env of that many sub-envs, through the executor's
-    progress bar) and return every spec's record, in the order of ``specs``."""
+    with ``vector_envs`` > 1, on a vector env of that many sub-envs in this process, through
+    the executor's progress bar) and return every spec's record, in the order of ``specs``."""
     records = open_checkpoint(out)
     done = {r["key"] for r in records}
     todo = [s for s in specs if s.key not in done]
@@ -136,10 +136,10 @@ def evaluate(
         backend: ``"local"`` (worker processes) or ``"ray"`` (episodes as Ray tasks, at most
             ``workers`` at a time; a task whose worker dies runs again); the same records.
         address: Ray's address (``"auto"``: a running cluster); None starts a local Ray.
-        vector_envs: More than 1: run the episodes on a ``gymnasium.vector`` env of this many
-            sub-envs in worker processes instead (the agents act in this process on each
-            sub-env's ``info["robot_view"]``; :mod:`~sfw_gym.evaluation.vector`), with the
-            same records; ``workers`` and ``backend`` are then not used, and no GIFs.
+        vector_envs: More than 1: run the episodes on the native vector env of this many
+            sub-envs instead, stepped together in this process, one agent per sub-env acting
+            on its robot view (:mod:`~sfw_gym.evaluation.vector`), with the same records;
+            ``workers`` and ``backend`` are then not used, and no GIFs.
 
     Returns:
         ``{"rows": summary rows, "records": episode records, "files": written paths}``; with
@@ -179,6 +179,8 @@ def evaluate(
         gym.make(env_id, **(env_kwargs or {})).close()
     except (TypeError, ConfigError) as exc:
         raise ConfigError(f"--env-kwargs: {exc}") from None
+    if vector_envs > 1:
+        check_native_vector_env(env_id)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     plans = plan_files(floorplans)

@@ -1,45 +1,34 @@
-"""Episodes on a ``gymnasium.vector`` env (``sfw-gym evaluate --vector-envs N``): N sub-envs in
-worker processes, each taking the next episode when its own ends and reset with that episode's
-own seed and plan (autoreset disabled, ``reset_mask``); the agents act in this process on what the
-sub-envs return (``info["robot_view"]``, :class:`~sfw_gym.envs.RobotViewInInfo`). The records are
-the ones the single-env rollout gives (:class:`~sfw_gym.evaluation.rollout.EpisodeRecord`)."""
+"""Episodes on a vector env in this process (``sfw-gym evaluate --vector-envs N``).
+
+``gym.make_vec(id, num_envs=N)`` gives the native vector env (:class:`~sfw_gym.envs.vector.
+SfWVectorEnv`; every SfW id registers it, an id without one is refused). Its explore sub-envs
+step together in one compiled batch, the other env classes one by one. Each sub-env runs one episode
+after another: when one ends, its record is taken from the sub-env, and the sub-env is reset alone
+(``reset_mask``) with the next episode's seed and plan. That reset clears its pending autoreset.
+One agent per episode acts in this process. It is reset with its sub-env as in
+:func:`~sfw_gym.evaluation.rollout.run_episode`, so it holds only a
+:class:`~sfw_gym.agents.base.RobotViewHandle` (``robot_view()``, never the ground truth). The
+records are built by :class:`~sfw_gym.evaluation.rollout.EpisodeRecord`, so they are the
+sequential run's records.
+"""
 
 from __future__ import annotations
 
 import time
+from collections import deque
 from collections.abc import Generator, Sequence
 from dataclasses import dataclass
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import gymnasium as gym
 import numpy as np
-from gymnasium.vector import AsyncVectorEnv
 
 from sfw_gym.core.errors import ConfigError
+from sfw_gym.envs.explore import unwrap_sfw
 from sfw_gym.evaluation.rollout import EpisodeRecord, EpisodeSpec
 
-
-class _Unbatched:
-    """A sub-env's observation and info as it returned them (an opaque object, so that the
-    vector env hands it over as it is instead of batching its fields)."""
-
-    def __init__(self, obs: Any, info: dict[str, Any]) -> None:
-        self.obs, self.info = obs, info
-
-
-class StepInInfo(gym.Wrapper):
-    """Puts each reset's and step's ``(obs, info)`` into ``info["unbatched"]``: what the
-    sub-env returned, field for field (a vector env batches ``obs`` and ``info`` otherwise)."""
-
-    def reset(
-        self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[Any, dict[str, Any]]:
-        obs, info = self.env.reset(seed=seed, options=options)
-        return obs, {"unbatched": _Unbatched(obs, info)}
-
-    def step(self, action: Any) -> tuple[Any, Any, bool, bool, dict[str, Any]]:
-        obs, reward, terminated, truncated, info = self.env.step(action)
-        return obs, reward, terminated, truncated, {"unbatched": _Unbatched(obs, info)}
+if TYPE_CHECKING:
+    from sfw_gym.envs.vector import SfWVectorEnv
 
 
 @dataclass
@@ -47,37 +36,39 @@ class _Slot:
     """The episode a sub-env is running."""
 
     index: int
-    spec: EpisodeSpec
     agent: Any
     episode: EpisodeRecord
     obs: Any
-    info: dict[str, Any]
 
 
-def make_vector_env(spec: EpisodeSpec, num_envs: int) -> AsyncVectorEnv:
-    """``num_envs`` sub-envs of ``spec``'s env id and kwargs, each in a ``spawn``-ed process
-    (forking a process that has run numba's OpenMP kernels is unsafe), wrapped in
-    :class:`~sfw_gym.envs.RobotViewInInfo` and :class:`StepInInfo`, autoreset disabled."""
-    from gymnasium.vector import AutoresetMode
+def sub_env_row(batched: dict[str, Any], i: int) -> dict[str, Any]:
+    """Sub-env ``i``'s own dict out of a vector env's batched ``obs`` or ``info``: each key
+    whose ``_key`` mask marks it (an info; nested dicts likewise), or every key (an obs)."""
+    row = {}
+    for key, value in batched.items():
+        mask = batched.get(f"_{key}")
+        if mask is None and key.startswith("_") and key[1:] in batched:
+            continue  # a mask
+        if mask is None or mask[i]:
+            row[key] = sub_env_row(value, i) if isinstance(value, dict) else value[i]
+    return row
 
-    from sfw_gym.envs import RobotViewInInfo
 
-    vec = gym.make_vec(
-        spec.env_id,
-        num_envs=num_envs,
-        vectorization_mode="async",
-        vector_kwargs={"autoreset_mode": AutoresetMode.DISABLED, "context": "spawn"},
-        wrappers=[RobotViewInInfo, StepInInfo],
-        **spec.env_kwargs,
-    )
-    return cast(AsyncVectorEnv, vec)
+def check_native_vector_env(env_id: str) -> None:
+    """Raise a ConfigError unless ``env_id`` has a native vector env (a ``vector_entry_point``;
+    an unknown id raises gymnasium's NameNotFound)."""
+    if gym.spec(env_id).vector_entry_point is None:
+        raise ConfigError(
+            f"--vector-envs: {env_id} has no native vector env (every SfW id has one); "
+            "run it with --workers"
+        )
 
 
 def run_vector(
     specs: Sequence[EpisodeSpec], num_envs: int
 ) -> Generator[tuple[int, dict[str, Any]], None, None]:
-    """Run ``specs`` (one env id and kwargs, no GIFs) on a vector env of ``num_envs`` sub-envs;
-    yields ``(index in specs, record)`` as each episode ends."""
+    """Run ``specs`` (one env id and kwargs, no GIFs) on a vector env of ``num_envs``
+    sub-envs in this process; yields ``(index in specs, record)`` as each episode ends."""
     from sfw_gym.agents import make_agent
 
     if not specs:
@@ -89,62 +80,68 @@ def run_vector(
         if spec.gif_path:
             raise ConfigError("--vector-envs: GIFs are not recorded on a vector env (no --gif)")
     n = min(num_envs, len(specs))
-    queue = list(enumerate(specs))
-    vec = make_vector_env(first, n)
+    queue = deque(enumerate(specs))
+    check_native_vector_env(first.env_id)
+    vec = cast(
+        "SfWVectorEnv",
+        gym.make_vec(
+            first.env_id, num_envs=n, vectorization_mode="vector_entry_point", **first.env_kwargs
+        ),
+    )
     try:
-        vec.reset()  # every sub-env once, before the per-episode resets below
-        idle = vec.single_action_space.sample()  # what a sub-env with no episode left is sent
+        idle = _standing_action(vec.single_action_space)  # for a sub-env with no episode left
         slots: list[_Slot | None] = [None] * n
 
-        def reset(i: int, seed: int | None, floorplan: str | None) -> tuple[Any, dict[str, Any]]:
-            """Reset sub-env ``i`` alone with its episode's seed and plan."""
+        def start(i: int) -> None:
+            """Sub-env ``i`` takes the next episode (reset with its seed and plan), or idles."""
+            slots[i] = None
+            if not queue:
+                return
+            index, spec = queue.popleft()
+            begin = time.perf_counter()
             mask = np.zeros(n, np.bool_)
             mask[i] = True
             seeds: list[int | None] = [None] * n
-            seeds[i] = seed
+            seeds[i] = spec.seed
             options: dict[str, Any] = {"reset_mask": mask}
-            if floorplan:
-                options["floorplan"] = floorplan
-            _, infos = vec.reset(seed=seeds, options=options)
-            got = infos["unbatched"][i]
-            return got.obs, got.info
-
-        def start(i: int) -> None:
-            """Sub-env ``i`` takes the next episode, or idles on a throwaway one."""
-            if not queue:
-                slots[i] = None
-                reset(i, None, None)  # the vector env steps every sub-env
-                return
-            index, spec = queue.pop(0)
-            begin = time.perf_counter()
-            obs, info = reset(i, spec.seed, spec.floorplan)
+            if spec.floorplan:
+                options["floorplan"] = spec.floorplan
+            obs, infos = vec.reset(seed=seeds, options=options)
+            episode = EpisodeRecord(spec, sub_env_row(infos, i), begin)
             agent = make_agent(spec.agent, **spec.agent_params)
-            agent.reset(info=info, seed=spec.agent_reset_seed)
-            slots[i] = _Slot(index, spec, agent, EpisodeRecord(spec, info, begin), obs, info)
+            agent.reset(vec.envs[i], seed=spec.agent_reset_seed)
+            slots[i] = _Slot(index, agent, episode, sub_env_row(obs, i))
 
         for i in range(n):
             start(i)
         while any(slots):
-            actions = [idle if s is None else s.agent.act(s.obs, s.info) for s in slots]
-            _, _, terminated, truncated, infos = vec.step(np.stack(actions))
+            vec.envs  # noqa: B018 (writes the batched state back into the sub-envs: their views)
+            actions = [idle if s is None else s.agent.act(s.obs) for s in slots]
+            obs, _, terminated, truncated, infos = vec.step(np.stack(actions))
             for i, slot in enumerate(slots):
-                got = infos["unbatched"][i]
-                done = bool(terminated[i] or truncated[i])
                 if slot is None:
-                    if done:
-                        start(i)
                     continue
-                slot.obs, slot.info = got.obs, got.info
-                slot.episode.step(got.info, done)
+                done = bool(terminated[i] or truncated[i])
+                info = sub_env_row(infos, i)
+                slot.obs = sub_env_row(obs, i)
+                slot.episode.step(info, done)
                 if done:
-                    truth = vec.call("ground_truth")[i]
-                    belief = got.info["robot_view"].belief_u8
-                    yield (
-                        slot.index,
-                        slot.episode.finish(
-                            got.info, bool(terminated[i]), slot.agent, truth, belief
-                        ),
+                    sfw = unwrap_sfw(vec.envs[i])
+                    truth, belief = sfw.ground_truth(), sfw.robot_view().belief_u8
+                    record = slot.episode.finish(
+                        info, bool(terminated[i]), slot.agent, truth, belief
                     )
+                    yield slot.index, record
                     start(i)
     finally:
         vec.close()
+
+
+def _standing_action(space: gym.Space) -> Any:
+    """An action that keeps an idle sub-env's robot still (continuous) or turning on the spot
+    (discrete), so that it meets no walls."""
+    if isinstance(space, gym.spaces.Discrete):
+        from sfw_gym.core.constants import DISCRETE_ACTION_NAMES
+
+        return space.start + DISCRETE_ACTION_NAMES.index("turn_left")
+    return np.zeros(space.shape, space.dtype)

@@ -150,6 +150,21 @@ CASES = [
         id="evaluate-gif-episodes-negative",
     ),
     bad(
+        [*EVALUATE, "--vector-envs", "0"],
+        r"argument --vector-envs: .*'0'",
+        id="evaluate-vector-envs-0",
+    ),
+    bad(
+        [*EVALUATE, "--vector-envs", "two"],
+        r"argument --vector-envs: .*'two'",
+        id="evaluate-vector-envs-not-int",
+    ),
+    bad(
+        [*EVALUATE, "--vector-envs", "2", "--gif"],
+        r"--vector-envs .*not with --backend ray or --gif",
+        id="evaluate-vector-envs-gif",
+    ),
+    bad(
         [*EVALUATE, "--agents", "random,nope"],
         r"--agents: unknown agent\(s\) \['nope'\]",
         id="evaluate-agent-unknown",
