@@ -101,7 +101,11 @@ class FrontierSettings(AgentSettings):
         progress_timeout_steps: Steps without getting 5 cm closer to a goal before it is
             blacklisted.
         blacklist_radius_m: Frontier cells this close to a blacklisted goal are skipped.
-        replan_every_steps: Re-pick the goal at least this often, as the map changes.
+        replan_every_steps: Re-pick the goal at least this often, as the map changes
+            (explore_lite's ``planner_frequency``: its 0.33 Hz default is 15 of our 0.2 s steps).
+        replan_when_resolved: Also re-pick as soon as the frontier cell being driven to is
+            resolved (else the robot drives on to it until the next periodic replan or until it
+            arrives, as explore_lite does).
         search_radius_m: Each replan first searches paths up to this cost (m). The choice is
             kept only if no cluster beyond could have a higher utility (a cluster at least this
             far costs at least this much), so it is the goal a full search would pick; else the
@@ -140,6 +144,7 @@ class FrontierSettings(AgentSettings):
     progress_timeout_steps: int = setting(30, integer=True, ge=1)
     blacklist_radius_m: float = setting(0.3, ge=0.0)
     replan_every_steps: int = setting(5, integer=True, ge=1)
+    replan_when_resolved: bool = setting(True, choices=(True, False))
     search_radius_m: float = setting(4.0, gt=0.0)
     unknown_cost: float = setting_of(CandidateSettings, "unknown_cost")
     bump_exclusion_m: float = setting_of(CandidateSettings, "bump_exclusion_m")
@@ -290,7 +295,11 @@ class FrontierAgent(Agent):
             return True
         if self._since_plan >= self.settings.replan_every_steps or self._path_blocked(view):
             return True
-        return goal.kind == "frontier" and not self._still_unknown(view, goal.target)
+        return (
+            self.settings.replan_when_resolved
+            and goal.kind == "frontier"
+            and not self._still_unknown(view, goal.target)
+        )
 
     def _path_blocked(self, view: RobotView) -> bool:
         """Whether a cell of the current path has become a believed wall or a bump."""

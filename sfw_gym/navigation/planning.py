@@ -251,26 +251,35 @@ def _dijkstra_8(cost, r0, c0, cum, pred, limit, scale):  # pragma: no cover (com
     costs. The search stops at the first bucket beyond ``limit`` (cell units); cells not
     settled by then are set back to ``inf``. Costs come out multiplied by ``scale`` (the cell
     size: metres).
+
+    A bounded search touches only the cells within ``limit + 2`` steps of the start (every step
+    costs at least 1): only that window is scanned for the costs' range, and the clean-up visits
+    only the cells it pushed, so its cost grows with the cells searched, not with the grid.
     """
     h, w = cost.shape
     cum[:] = np.inf
     pred[:] = -1
     done = np.zeros(h * w, np.bool_)
     diagonal = math.sqrt(2.0)
+    reach = h + w if limit == np.inf else int(limit) + 3
+    r_lo, r_hi = max(r0 - reach, 0), min(r0 + reach + 1, h)
+    c_lo, c_hi = max(c0 - reach, 0), min(c0 + reach + 1, w)
     max_cost, min_cost = 1.0, np.inf
-    for r in range(h):
-        for c in range(w):
+    for r in range(r_lo, r_hi):
+        for c in range(c_lo, c_hi):
             if max_cost < cost[r, c] < np.inf:
                 max_cost = cost[r, c]
             min_cost = min(min_cost, cost[r, c])
     if min_cost < 1.0:
         return min_cost  # refused by cost_field
     n_buckets = int(max_cost * diagonal) + 2  # > the longest edge: the ring never wraps onto itself
+    n_cells = (r_hi - r_lo) * (c_hi - c_lo)
     head = np.full(n_buckets, -1, np.int64)  # per bucket, its newest entry
-    node = np.empty(8 * h * w + 1, np.int64)  # entries: the node and the bucket's next entry
-    below = np.empty(8 * h * w + 1, np.int64)
+    node = np.empty(8 * n_cells + 1, np.int64)  # entries: the node and the bucket's next entry
+    below = np.empty(8 * n_cells + 1, np.int64)
+    settled = np.empty(n_cells, np.int64)
     node[0], below[0], head[0] = r0 * w + c0, -1, 0
-    n_entries, pending, bucket = 1, 1, 0
+    n_entries, n_settled, pending, bucket = 1, 0, 1, 0
     cum[r0, c0] = 0.0
     while pending > 0 and bucket <= limit:
         e = head[bucket % n_buckets]
@@ -283,6 +292,8 @@ def _dijkstra_8(cost, r0, c0, cum, pred, limit, scale):  # pragma: no cover (com
         if done[i]:
             continue
         done[i] = True
+        settled[n_settled] = i
+        n_settled += 1
         r = i // w
         c = i - r * w
         d = cum[r, c]
@@ -309,12 +320,14 @@ def _dijkstra_8(cost, r0, c0, cum, pred, limit, scale):  # pragma: no cover (com
                     node[n_entries], below[n_entries], head[slot] = j, head[slot], n_entries
                     n_entries += 1
                     pending += 1
-    for k in range(h * w):
-        if done[k]:
-            cum.flat[k] *= scale
-        else:  # beyond the limit (or unreachable)
-            cum.flat[k] = np.inf
+    flat = cum.reshape(h * w)
+    for e in range(n_entries):  # every cell given a cost was pushed: unsettled ones go back
+        k = node[e]
+        if not done[k]:
+            flat[k] = np.inf
             pred[k] = -1
+    for e in range(n_settled):
+        flat[settled[e]] *= scale
     return min_cost
 
 
