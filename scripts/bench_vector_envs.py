@@ -2,14 +2,19 @@
 Gymnasium's ``SyncVectorEnv`` and ``AsyncVectorEnv``, each as a multiple of one env's steps/s
 measured in the same run; and P processes each stepping a native N-env batch at once (issue 33).
 
+With ``--rounds R`` it times only one env and the native N-env batch, alternately in R rounds,
+and prints the median of the per-round ratios (a neighbour's load hits both sides of a round).
+
     python scripts/bench_vector_envs.py --env SfW-Explore-v0 --num-envs 16 --steps 200
     python scripts/bench_vector_envs.py --floorplan ../shared/floorplans/houseexpo/PLAN.json
+    python scripts/bench_vector_envs.py --rounds 9 --steps 200
 """
 
 from __future__ import annotations
 
 import argparse
 import multiprocessing
+import statistics
 import time
 from typing import Any
 
@@ -45,6 +50,25 @@ def _native_rate(job: tuple[str, int, int, dict[str, Any], Any]) -> float:
     return env_steps_per_s(gym.make_vec(env_id, num_envs=n, **kwargs), steps, n)
 
 
+def native_rounds(env_id: str, n: int, steps: int, rounds: int, kwargs: dict[str, Any]) -> None:
+    """One env (``n * steps`` steps) and the native ``n``-env batch (``steps`` steps) timed
+    alternately; the per-round ratios' median."""
+    rates: dict[str, list[float]] = {"one env": [], f"{n} envs, native": []}
+    for _ in range(rounds):
+        rates["one env"].append(env_steps_per_s(gym.make(env_id, **kwargs), n * steps, 1))
+        vec = gym.make_vec(env_id, num_envs=n, **kwargs)
+        rates[f"{n} envs, native"].append(env_steps_per_s(vec, steps, n))
+    ratios = [b / a for a, b in zip(*rates.values(), strict=True)]
+    print(f"{env_id}: env steps/s, median of {rounds} alternating rounds")
+    for name, values in rates.items():
+        print(f"  {name:34s} {statistics.median(values):10,.0f}")
+    q = statistics.quantiles(ratios, n=4) if rounds > 1 else ratios * 3
+    print(
+        f"  {n} envs native / one env: median {statistics.median(ratios):.2f}x "
+        f"(quartiles {q[0]:.2f}-{q[-1]:.2f})"
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--env", default="SfW-Explore-v0")
@@ -52,9 +76,14 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=200, help="vector steps per measurement")
     parser.add_argument("--processes", type=int, default=2, help="processes of the last row")
     parser.add_argument("--floorplan", default=None, help="a plan file for every episode")
+    parser.add_argument("--rounds", type=int, default=0, help="only one env vs native, R rounds")
     args = parser.parse_args()
     n, kwargs = args.num_envs, {} if args.floorplan is None else {"floorplan": args.floorplan}
     env_steps_per_s(gym.make(args.env, **kwargs), 200, 1)  # warm-up: compiled kernels
+    if args.rounds:
+        env_steps_per_s(gym.make_vec(args.env, num_envs=n, **kwargs), 20, n)  # warm-up
+        native_rounds(args.env, n, args.steps, args.rounds, kwargs)
+        return
     one = env_steps_per_s(gym.make(args.env, **kwargs), args.steps, 1)
     rows = [("one env", one)]
     for mode in ("vector_entry_point", "sync"):

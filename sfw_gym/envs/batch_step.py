@@ -212,7 +212,7 @@ def sense_and_map(
         i = active[n]
         s, c = state[i], consts[i]
         _, radio, mapper, tracker, builder, history, scratch, normals = parts[i]
-        edges, edge_loss, routers, radio_params, tables, origin, spacing = radio
+        edges, edge_loss, wall_index, routers, radio_params, tables, origin, spacing = radio
         (routers_g, policy_all, extend, map_params, kest, feature, k_est, selected, dist_buf,
          raster, maps, track, ray, anchors) = mapper  # fmt: skip
         est_cls, truth_cls, near_wall, interior, found_by, offsets, counts = tracker
@@ -229,8 +229,8 @@ def sense_and_map(
         tx, ty, tt = s[X], s[Y], wrap_heading(s[A])
         pts[0, 0], pts[0, 1] = tx, ty
         _rssi_range(
-            edges, edge_loss, routers, pts, radio_params, tables, origin, spacing, mean_db,
-            true_k, 0, 1,
+            edges, edge_loss, wall_index, routers, pts, radio_params, tables, origin, spacing,
+            mean_db, true_k, 0, 1,
         )  # fmt: skip
         for r in range(n_routers):
             db = mean_db[0, r]
@@ -457,8 +457,9 @@ class BatchStepper:
         table, origin, spacing = radio._shadow_args
         parts = (
             _read_only(robot._walls),
-            (*map(_read_only, (radio.floorplan.edges, radio._edge_loss_db, radio.routers,
-                               radio._params, table, origin)), float(spacing)),
+            (*map(_read_only, (radio.floorplan.edges, radio._edge_loss_db)),
+             tuple(map(_read_only, radio._wall_index)),
+             *map(_read_only, (radio.routers, radio._params, table, origin)), float(spacing)),
             (mapper._routers_g, bool(mapper._policy_all), bool(mapper.config.extend_past_robot),
              mapper._params, _float_tuple(mapper._kest), ke._feature, ke._k, mapper._selected,
              mapper._dist, mapper._raster, mapper._maps, mapper._track, mapper._ray,

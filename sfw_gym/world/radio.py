@@ -20,7 +20,8 @@ from sfw_gym.core.config import Config, Range, setting
 from sfw_gym.core.constants import NOT_HEARD_DBM
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.world.floorplan import MATERIALS, Floorplan
-from sfw_gym.world.wall_crossing import DEFAULT_MIN_PIECE_M, _cross_one
+from sfw_gym.world.wall_crossing import DEFAULT_MIN_PIECE_M
+from sfw_gym.world.wall_index import DEFAULT_BUCKETS, build_wall_index, cross_from_router
 
 #: Above this many points, wall counting runs on all cores.
 _PARALLEL_MIN_POINTS = 256
@@ -186,17 +187,25 @@ def _bilinear(
 
 
 @njit(cache=True)
-def _rssi_range(edges, edge_loss, routers, pts, params, tables, origin, spacing, rssi, k, lo, hi):
-    """Mean RSSI and wall counts for points lo..hi: the whole model in one compiled loop."""
+def _rssi_range(
+    edges, edge_loss, index, routers, pts, params, tables, origin, spacing, rssi, k, lo, hi
+):
+    """Mean RSSI and wall counts for points lo..hi: the whole model in one compiled loop
+    (``index``: the walls' `wall_index` around the routers, and the edges 0..E-1)."""
     tx, pl0, ten_n, d0, cap, min_piece = params
+    starts, edge_ids, all_edges = index
     ts = np.empty(edges.shape[0] + 1)
     ids = np.empty(edges.shape[0] + 1, np.int64)
     shadow = _bilinear(tables, origin, spacing, pts[lo:hi])
     for m in range(lo, hi):
         for r in range(routers.shape[0]):
-            c, loss = _cross_one(
+            c, loss = cross_from_router(
                 edges,
                 edge_loss,
+                starts,
+                edge_ids,
+                all_edges,
+                r,
                 routers[r, 0],
                 routers[r, 1],
                 pts[m, 0],
@@ -211,17 +220,18 @@ def _rssi_range(edges, edge_loss, routers, pts, params, tables, origin, spacing,
 
 
 @njit(cache=True)
-def _rssi(edges, edge_loss, routers, pts, params, tables, origin, spacing):
+def _rssi(edges, edge_loss, index, routers, pts, params, tables, origin, spacing):
     rssi = np.empty((pts.shape[0], routers.shape[0]))
     k = np.empty((pts.shape[0], routers.shape[0]), np.int32)
     _rssi_range(
-        edges, edge_loss, routers, pts, params, tables, origin, spacing, rssi, k, 0, len(pts)
-    )
+        edges, edge_loss, index, routers, pts, params, tables, origin, spacing, rssi, k, 0,
+        len(pts),
+    )  # fmt: skip
     return rssi, k
 
 
 @njit(cache=True, parallel=True)
-def _rssi_parallel(edges, edge_loss, routers, pts, params, tables, origin, spacing):
+def _rssi_parallel(edges, edge_loss, index, routers, pts, params, tables, origin, spacing):
     m = pts.shape[0]
     rssi = np.empty((m, routers.shape[0]))
     k = np.empty((m, routers.shape[0]), np.int32)
@@ -230,6 +240,7 @@ def _rssi_parallel(edges, edge_loss, routers, pts, params, tables, origin, spaci
         _rssi_range(
             edges,
             edge_loss,
+            index,
             routers,
             pts,
             params,
@@ -272,6 +283,11 @@ class RadioModel:
             self.routers = np.asarray(routers, np.float64).reshape(-1, 2)
         self.rng = rng if rng is not None else np.random.default_rng()
         self._d0_loss_db = self.config.d0_loss_db
+        edges = floorplan.edges
+        self._wall_index = (
+            *build_wall_index(edges, self.routers, DEFAULT_BUCKETS),
+            np.arange(len(edges)),
+        )
         losses = self.config.wall_loss_db
         self._edge_loss_db = np.array([losses[m] for m in floorplan.edge_materials], np.float64)
         cfg = self.config
@@ -322,6 +338,7 @@ class RadioModel:
         return kernel(
             self.floorplan.edges,
             self._edge_loss_db,
+            self._wall_index,
             self.routers,
             pts,
             self._params,
@@ -352,8 +369,8 @@ class RadioModel:
             raise ConfigError(f"points must be finite (got {x!r}, {y!r})")
         pts = np.array(((x, y),))
         rssi, k = _rssi(
-            self.floorplan.edges, self._edge_loss_db, self.routers, pts, self._params,
-            *self._shadow_args,
+            self.floorplan.edges, self._edge_loss_db, self._wall_index, self.routers, pts,
+            self._params, *self._shadow_args,
         )  # fmt: skip
         return self._reading(rssi[0]), k[0]
 

@@ -22,6 +22,9 @@ from numba import njit, prange
 #: Outside pieces (and inside gaps) shorter than this are no walls (bevels 1 cm, walls ≥ 10 cm).
 DEFAULT_MIN_PIECE_M = 0.02
 _CHUNK = 512  # segments per parallel work item
+#: A piece's midpoint closer than this to the segment's start is checked against every edge
+#: (an index's edges near the line are only those this far along it; see `_walls_crossed`).
+NEAR_START_M = 2e-3
 
 
 @njit(cache=True, inline="always")
@@ -37,9 +40,11 @@ def _insert_sorted(ts: np.ndarray, ids: np.ndarray, n: int, t: float, edge: int)
 
 
 @njit(cache=True)
-def _on_boundary(edges: np.ndarray, x: float, y: float) -> bool:
-    """Whether (x, y) lies on an edge (within 1e-9 m): a segment running along a wall face."""
-    for e in range(edges.shape[0]):
+def _on_boundary(edges, near, lo, hi, x, y):
+    """Whether (x, y) lies on one of the edges ``near[lo:hi]`` (within 1e-9 m): a segment running
+    along a wall face."""
+    for j in range(lo, hi):
+        e = near[j]
         px = edges[e, 0]
         py = edges[e, 1]
         ex = edges[e, 2] - px
@@ -54,18 +59,18 @@ def _on_boundary(edges: np.ndarray, x: float, y: float) -> bool:
 
 
 @njit(cache=True)
-def _cross_one(
-    edges: np.ndarray,
-    edge_loss: np.ndarray,
-    ax: float,
-    ay: float,
-    bx: float,
-    by: float,
-    min_piece_m: float,
-    ts: np.ndarray,
-    ids: np.ndarray,
+def _walls_crossed(
+    edges, edge_loss, near, lo, hi, all_edges, ax, ay, bx, by, min_piece_m, ts, ids
 ) -> tuple[int, float]:
-    """Walls crossed by segment a→b and their summed loss (loss of each wall's entry edge)."""
+    """Walls crossed by segment a→b and their summed loss (loss of each wall's entry edge),
+    testing only the edges ``near[lo:hi]`` (ascending).
+
+    With every edge (``near = all_edges``) this is the brute force, `_cross_one`. A spatial
+    index (`sfw_gym.world.wall_index`) may pass fewer: every edge the supporting line crosses,
+    and every edge within 1e-9 m of the line farther than ``NEAR_START_M`` from a (the check
+    of a piece's midpoint closer to a tests ``all_edges``). The edges come in the brute force's
+    order and meet its arithmetic, so the result is the same bit for bit.
+    """
     dx = bx - ax
     dy = by - ay
     length2 = dx * dx + dy * dy
@@ -74,7 +79,8 @@ def _cross_one(
     length = np.sqrt(length2)
     n_before = 0  # crossings of the supporting line before a: their parity says if a is inside
     n = 0  # crossings with t in [0, 1], sorted
-    for e in range(edges.shape[0]):
+    for j in range(lo, hi):
+        e = near[j]
         px = edges[e, 0]
         py = edges[e, 1]
         qx = edges[e, 2]
@@ -104,16 +110,22 @@ def _cross_one(
             piece_start_m = start * length
             piece_end_m = end * length
             mid = 0.5 * (start + end)
-            if piece_end_m - piece_start_m >= min_piece_m and not _on_boundary(
-                edges, ax + mid * dx, ay + mid * dy
-            ):
-                if piece_start_m - last_wall_end >= min_piece_m:
-                    count += 1
-                    # The wall's material: the edge the segment entered by, else the one it left by.
-                    e = start_edge if start_edge >= 0 else (ids[i] if i < n else -1)
-                    if e >= 0:
-                        loss += edge_loss[e]
-                last_wall_end = piece_end_m
+            if piece_end_m - piece_start_m >= min_piece_m:
+                x = ax + mid * dx
+                y = ay + mid * dy
+                if mid * length < NEAR_START_M:
+                    on_face = _on_boundary(edges, all_edges, 0, all_edges.shape[0], x, y)
+                else:
+                    on_face = _on_boundary(edges, near, lo, hi, x, y)
+                if not on_face:
+                    if piece_start_m - last_wall_end >= min_piece_m:
+                        count += 1
+                        # The wall's material: the edge the segment entered by, else the one it
+                        # left by.
+                        e = start_edge if start_edge >= 0 else (ids[i] if i < n else -1)
+                        if e >= 0:
+                            loss += edge_loss[e]
+                    last_wall_end = piece_end_m
         if i < n:
             start = ts[i]
             start_edge = ids[i]
@@ -122,12 +134,22 @@ def _cross_one(
 
 
 @njit(cache=True)
+def _cross_one(edges, edge_loss, all_edges, ax, ay, bx, by, min_piece_m, ts, ids):
+    """The brute force: `_walls_crossed` testing every edge (``all_edges``: 0..E-1)."""
+    return _walls_crossed(
+        edges, edge_loss, all_edges, 0, all_edges.shape[0], all_edges, ax, ay, bx, by,
+        min_piece_m, ts, ids,
+    )  # fmt: skip
+
+
+@njit(cache=True)
 def _cross_range(edges, edge_loss, a, b, min_piece_m, counts, losses, lo, hi):
     ts = np.empty(edges.shape[0] + 1, dtype=np.float64)  # scratch, once per range
     ids = np.empty(edges.shape[0] + 1, dtype=np.int64)
+    all_edges = np.arange(edges.shape[0])
     for i in range(lo, hi):
         counts[i], losses[i] = _cross_one(
-            edges, edge_loss, a[i, 0], a[i, 1], b[i, 0], b[i, 1], min_piece_m, ts, ids
+            edges, edge_loss, all_edges, a[i, 0], a[i, 1], b[i, 0], b[i, 1], min_piece_m, ts, ids
         )
 
 
