@@ -20,9 +20,9 @@ serves every candidate.
 
 from __future__ import annotations
 
-import itertools
+import functools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -115,7 +115,7 @@ class CandidateGoals:
     source: np.ndarray
     features: np.ndarray
     valid: np.ndarray
-    clusters: tuple[np.ndarray, ...]
+    clusters: Sequence[np.ndarray]
     paths: CostField
     walled_off_rc: np.ndarray
 
@@ -472,10 +472,7 @@ class GoalFinder:
 
         With ``anchor_rc``, a frontier cluster's target is its cheapest cell counting also
         ``anchor_cost_per_m`` (path metres) per metre between the cell and the anchor."""
-        for given, known in ((sources, SOURCES), (features, FEATURES)):
-            unknown_names = set(given) - set(known)
-            if unknown_names:
-                raise ValueError(f"unknown names {sorted(unknown_names)}; known: {known}")
+        _check_names(tuple(sources), tuple(features))
         res = view.grid.resolution_m
         frontier = self.frontier(view)
         x, y, heading = view.odometry_pose
@@ -502,84 +499,99 @@ class GoalFinder:
         )
         reachable = np.isfinite(open_cost)
         walled_off_rc = open_cells[~reachable]
-        targets: list[np.ndarray] = [np.zeros((0, 2), np.int64)]
+        targets: list[np.ndarray] = []
         source: list[np.ndarray] = []
         sizes: list[np.ndarray] = []
-        clusters: list[np.ndarray] = []
+        clusters = _Clusters(np.zeros((0, 2), np.int64), np.zeros(1, np.int64), 0)
         for name in sources:
             if name == "frontier":
                 every = np.stack(np.divmod(members, frontier.shape[1]), axis=1)
                 cells, size = every[best], np.diff(bounds).astype(np.float64)
-                cl = [every[a:b] for a, b in itertools.pairwise(bounds)]
+                clusters = _Clusters(every, bounds, sum(len(t) for t in targets))
             elif name == "hidden_room":
-                cells, size, cl = self.hidden_room_targets(view)
+                cells, size, _ = self.hidden_room_targets(view)
             else:
                 cells = open_cells[reachable]
                 k = self.settings.info_gain_samples
                 if len(cells) > k:
                     cells = cells[np.linspace(0, len(cells) - 1, k).astype(int)]
-                size, cl = np.zeros(len(cells)), []
+                size = np.zeros(len(cells))
             targets.append(cells.reshape(-1, 2))
             source.append(np.full(len(cells), SOURCES.index(name), np.int64))
             sizes.append(size)
-            clusters += cl or [np.zeros((0, 2), np.int64)] * len(cells)
-        target_rc = np.concatenate(targets).astype(np.int64)
-        src = np.concatenate([np.zeros(0, np.int64), *source])
-        size_m = np.concatenate([np.zeros(0), *sizes]) * res
+        if len(targets) == 1:
+            target_rc, src, size_m = targets[0].astype(np.int64), source[0], sizes[0] * res
+        else:
+            target_rc = np.concatenate([np.zeros((0, 2), np.int64), *targets]).astype(np.int64)
+            src = np.concatenate([np.zeros(0, np.int64), *source])
+            size_m = np.concatenate([np.zeros(0), *sizes]) * res
         path_cost, goal_rc = self._approach(paths, target_rc)
         gain = np.full(len(target_rc), np.nan)
         info = src == SOURCES.index("info_gain")
         if info.any() and (max_candidates is not None or "expected_gain_bits" in features):
             gain[info] = self.expected_gain(view, target_rc[info])
-        keep = np.arange(len(target_rc))
         if max_candidates is not None:
             keep = _select(src, path_cost, size_m, gain, max_candidates)
-        target_rc, src, path_cost, size_m, gain = (
-            target_rc[keep],
-            src[keep],
-            path_cost[keep],
-            size_m[keep],
-            gain[keep],
-        )
-        goal_rc = goal_rc[keep]
-        r, c = target_rc[:, 0], target_rc[:, 1]
-        compute = {
-            "path_cost_m": lambda: path_cost,
-            "distance_m": lambda: np.linalg.norm(
-                view.grid.cell_to_world(target_rc) - view.xy, axis=1
-            ),
-            "cluster_size_m": lambda: size_m,
-            "expected_gain_bits": lambda: _fill(
-                gain, lambda m: self.expected_gain(view, target_rc[m])
-            ),
-            "unknown_area_m2": lambda: (
-                self._disk_sum(
-                    belief_classes(view.belief_u8)[2].astype(np.float64),
-                    target_rc,
-                    self._near_offsets,
-                )
-                * res**2
-            ),
-            "heading_change_rad": lambda: self.heading_change(view, target_rc),
-            "times_tried": lambda: self.times_tried[r, c],
-            "times_blacklisted": lambda: self.times_blacklisted[r, c],
-            "is_hidden_room": lambda: src == SOURCES.index("hidden_room"),
-            "strongest_rssi_dbm": lambda: self._strongest_heard_near(view, target_rc),
-        }
+            target_rc, src, path_cost, size_m, gain = (
+                target_rc[keep],
+                src[keep],
+                path_cost[keep],
+                size_m[keep],
+                gain[keep],
+            )
+            goal_rc = goal_rc[keep]
+            clusters = clusters.taken(keep)
         feats = np.full((len(target_rc), len(FEATURES)), np.nan)
         if len(target_rc):
             for name in features:
-                feats[:, _F[name]] = compute[name]()
+                feats[:, _F[name]] = self._feature(
+                    name, view, target_rc, src, path_cost, size_m, gain
+                )
         return CandidateGoals(
             target_rc,
             goal_rc,
             src,
             feats,
             np.isfinite(path_cost),
-            tuple(clusters[i] for i in keep),
+            clusters.padded(len(target_rc)),
             paths,
             walled_off_rc,
         )
+
+    def _feature(
+        self,
+        name: str,
+        view: RobotView,
+        target_rc: np.ndarray,
+        src: np.ndarray,
+        path_cost: np.ndarray,
+        size_m: np.ndarray,
+        gain: np.ndarray,
+    ) -> np.ndarray:
+        """The :data:`FEATURES` column ``name`` of the menu's candidates."""
+        r, c = target_rc[:, 0], target_rc[:, 1]
+        if name == "path_cost_m":
+            return path_cost
+        if name == "heading_change_rad":
+            return self.heading_change(view, target_rc)
+        if name == "cluster_size_m":
+            return size_m
+        if name == "distance_m":
+            return np.linalg.norm(view.grid.cell_to_world(target_rc) - view.xy, axis=1)
+        if name == "expected_gain_bits":
+            return _fill(gain, lambda m: self.expected_gain(view, target_rc[m]))
+        if name == "unknown_area_m2":
+            unknown = belief_classes(view.belief_u8)[2].astype(np.float64)
+            res = view.grid.resolution_m
+            return self._disk_sum(unknown, target_rc, self._near_offsets) * res**2
+        if name == "times_tried":
+            return self.times_tried[r, c]
+        if name == "times_blacklisted":
+            return self.times_blacklisted[r, c]
+        if name == "is_hidden_room":
+            return src == SOURCES.index("hidden_room")
+        assert name == "strongest_rssi_dbm", name
+        return self._strongest_heard_near(view, target_rc)
 
     def hidden_room_targets(
         self, view: RobotView
@@ -592,6 +604,55 @@ class GoalFinder:
         labels, n = ndimage.label(depth > 0, structure=EIGHT_CONNECTED)
         deepest = np.array(ndimage.maximum_position(depth, labels, range(1, n + 1)), np.int64)
         return deepest.reshape(-1, 2), np.zeros(len(deepest)), []
+
+
+@functools.cache
+def _check_names(sources: tuple[str, ...], features: tuple[str, ...]) -> None:
+    """Refuse unknown source or feature names (checked once per pair of tuples)."""
+    for given, known in ((sources, SOURCES), (features, FEATURES)):
+        unknown_names = set(given) - set(known)
+        if unknown_names:
+            raise ValueError(f"unknown names {sorted(unknown_names)}; known: {known}")
+
+
+class _Clusters(Sequence[np.ndarray]):
+    """A menu's per-candidate frontier clusters, sliced from one array when asked: candidate
+    ``i`` has cluster ``i - first`` of ``cells`` (grouped by ``bounds``), or none (empty)."""
+
+    def __init__(
+        self, cells: np.ndarray, bounds: np.ndarray, first: int, size: int | None = None
+    ) -> None:
+        self._cells, self._bounds, self._first = cells, bounds, first
+        self._index: np.ndarray | None = None  # candidate -> cluster (-1: none), once selected
+        self._size = first + len(bounds) - 1 if size is None else size
+
+    def taken(self, keep: np.ndarray) -> _Clusters:
+        """The clusters of the candidates ``keep`` (in that order)."""
+        out = _Clusters(self._cells, self._bounds, 0, len(keep))
+        k = np.asarray(keep, np.int64) - self._first
+        n = len(self._bounds) - 1
+        out._index = np.where((k >= 0) & (k < n), k, -1)
+        return out
+
+    def padded(self, size: int) -> _Clusters:
+        """The same clusters in a menu of ``size`` candidates (those past the frontier's have
+        none)."""
+        self._size = size
+        return self
+
+    def __len__(self) -> int:
+        return self._size
+
+    def __getitem__(self, i):  # type: ignore[override]
+        if isinstance(i, slice):
+            return tuple(self[j] for j in range(*i.indices(len(self))))
+        if not -self._size <= i < self._size:
+            raise IndexError(i)
+        i = int(i) % self._size
+        k = i - self._first if self._index is None else int(self._index[i])
+        if not 0 <= k < len(self._bounds) - 1:
+            return np.zeros((0, 2), np.int64)
+        return self._cells[self._bounds[k] : self._bounds[k + 1]]
 
 
 def _select(
