@@ -35,16 +35,20 @@ from sfw_gym.world.floorplan import Floorplan
 @dataclass(frozen=True)
 class TrackSettings:
     """``--track``: the synthetic odometry's noise, its seed, the particles, floorplans (by
-    floor; the key None: every floor) and the weight a particle keeps when it crosses a wall."""
+    floor; the key None, or one plan alone: every floor) and the weight a particle keeps when
+    it crosses a wall."""
 
     translation_std: float = DRIFT_TRANSLATION_STD
     heading_std_rad: float = DRIFT_HEADING_STD_RAD
     seed: int = 0
     particles: int = TRACK_PARTICLES
-    floorplans: Mapping[int | None, Floorplan] | None = None
+    floorplans: Mapping[int | None, Floorplan] | Floorplan | None = None
     wall_weight: float = WALL_WEIGHT
 
     def plan_for(self, floor: int | None) -> Floorplan | None:
+        """The plan of ``floor`` (one :class:`Floorplan` given: the plan of every floor)."""
+        if isinstance(self.floorplans, Floorplan):
+            return self.floorplans
         plans = self.floorplans or {}
         return plans.get(floor, plans.get(None))
 

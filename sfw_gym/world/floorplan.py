@@ -137,15 +137,19 @@ class Floorplan:
         self,
         a: np.ndarray,
         b: np.ndarray,
-        loss_by_material_db: Mapping[str, float],
+        loss_by_material_db: Mapping[str, float] | float,
         *,
         min_piece_m: float = DEFAULT_MIN_PIECE_M,
     ) -> tuple[np.ndarray, np.ndarray]:
         """Wall counts and summed wall losses (dB) for segments a[i]→b[i].
 
-        Each crossed wall costs the loss of the material of the face the segment enters it by.
+        Each crossed wall costs the loss of the material of the face the segment enters it by
+        (one number: the same loss for every material).
         """
-        table = np.array([float(loss_by_material_db[m]) for m in MATERIALS])
+        if isinstance(loss_by_material_db, Mapping):
+            table = np.array([float(loss_by_material_db[m]) for m in MATERIALS])
+        else:
+            table = np.full(len(MATERIALS), float(loss_by_material_db))
         return self._cross(a, b, table, min_piece_m)
 
     def _cross(

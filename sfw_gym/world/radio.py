@@ -7,6 +7,7 @@ rounded to an integer; a reading below the sensitivity floor is "not heard" (``N
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
@@ -67,8 +68,16 @@ class RadioConfig(Config):
     sensitivity_dbm: float = setting(-90.0, ge=-200.0, le=0.0)
 
     def validate(self) -> None:
+        loss = Range(ge=0.0)
+        if isinstance(self.wall_loss_db, numbers.Real) and not isinstance(self.wall_loss_db, bool):
+            # One number: the same loss for every material.
+            uniform = loss.check("RadioConfig.wall_loss_db", self.wall_loss_db)
+            object.__setattr__(self, "wall_loss_db", _uniform_losses(uniform))
         if not isinstance(self.wall_loss_db, Mapping):
-            raise ConfigError("RadioConfig.wall_loss_db must map material names to losses in dB")
+            raise ConfigError(
+                "RadioConfig.wall_loss_db must map material names to losses in dB, or be one "
+                f"loss for every material; got {self.wall_loss_db!r}"
+            )
         missing = sorted(set(MATERIALS) - set(self.wall_loss_db))
         unknown = sorted(set(self.wall_loss_db) - set(MATERIALS))
         if missing or unknown:
@@ -76,7 +85,6 @@ class RadioConfig(Config):
                 f"RadioConfig.wall_loss_db must give a loss for exactly {list(MATERIALS)}; "
                 f"missing {missing}, unknown {unknown}"
             )
-        loss = Range(ge=0.0)
         # A private plain copy: picklable, and safe from the caller's later edits.
         object.__setattr__(
             self,
@@ -93,7 +101,8 @@ class RadioConfig(Config):
         ``residential`` (per-material losses: the hard mode); ``band`` "2.4" or "5" GHz.
 
         At 5 GHz only the frequency (hence PL(d0) ≈ 46.8 dB) changes; wall losses stay the preset's.
-        A ``wall_loss_db`` override may name some materials only (the rest keep the preset's).
+        A ``wall_loss_db`` override may name some materials only (the rest keep the preset's), or
+        be one number for every material.
         """
         losses = {
             "default": _uniform_losses(10.0),

@@ -4,13 +4,16 @@ from __future__ import annotations
 
 import math
 
+import gymnasium as gym
 import numpy as np
 import pytest
 from shapely.geometry import Polygon
 
+import sfw_gym  # noqa: F401  (registration)
 from sfw_gym.core.constants import NOT_HEARD_DBM
 from sfw_gym.core.errors import ConfigError
-from sfw_gym.world.floorplan import Floorplan, floorplan_from_polygon
+from sfw_gym.world.floorplan import MATERIALS, Floorplan, floorplan_from_polygon
+from sfw_gym.world.generator import generate_floorplan
 from sfw_gym.world.radio import RadioConfig, RadioModel
 
 
@@ -329,3 +332,23 @@ def test_a_wall_loss_override_may_name_some_materials_only():
     )
     with pytest.raises(ConfigError, match=r"unknown \['lava'\]"):
         RadioConfig.preset(wall_loss_db={"lava": 5.0})
+
+
+def test_one_wall_loss_number_means_every_material():
+    """``radio={"wall_loss_db": 12}`` (the shorthand a user types) is 12 dB for every material,
+    through the env's keyword, a preset override and the plan's loss query alike."""
+    assert RadioConfig(wall_loss_db=12).wall_loss_db == dict.fromkeys(MATERIALS, 12.0)
+    assert RadioConfig.preset("residential", wall_loss_db=7.5).wall_loss_db == dict.fromkeys(
+        MATERIALS, 7.5
+    )
+    env = gym.make("SfW-ExploreSmall-v0", radio={"wall_loss_db": 12})
+    assert env.unwrapped.config.radio.wall_loss_db == dict.fromkeys(MATERIALS, 12.0)
+    env.close()
+    for bad in (-1, math.nan, True):
+        with pytest.raises(ConfigError, match=r"^RadioConfig\.wall_loss_db must"):
+            RadioConfig(wall_loss_db=bad)
+    plan = generate_floorplan(3)
+    a, b = np.array([[0.5, 0.5]]), np.array([[9.0, 9.0]])
+    counts, loss = plan.wall_loss_db(a, b, 12.0)
+    assert loss[0] == 12.0 * counts[0]
+    assert np.array_equal(plan.wall_loss_db(a, b, dict.fromkeys(MATERIALS, 12.0))[1], loss)
