@@ -8,6 +8,8 @@ by the robot's own readings) and find the zones and the bands along their border
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numba import njit
 from scipy import ndimage
@@ -101,18 +103,12 @@ def router_scores(
     Returns:
         ``(R, n_rows, n_cols)`` float64.
     """
-    xs, ys = grid.cell_centres()
-    cells = np.stack([xs.ravel(), ys.ravel()], axis=1)
     routers = np.asarray(routers_xy, np.float64).reshape(-1, 2)
     wall_mask = np.zeros(grid.shape, bool) if walls is None else np.asarray(walls, bool)
     use_walls = bool(wall_mask.any()) and wall_loss_db > 0
-
-    def distance_term(points: np.ndarray) -> np.ndarray:
-        d = np.linalg.norm(points[:, None, :] - routers[None, :, :], axis=2)
-        return -10.0 * path_loss_exponent * np.log10(np.maximum(d, 1.0))
-
-    scores = distance_term(cells)
+    scores = _cells_distance_term(grid, routers.tobytes(), float(path_loss_exponent)).copy()
     if use_walls:
+        xs, ys = grid.cell_centres()
         k = max(1, int(coarse_cells))
         h, w = grid.shape
         sub = np.stack([xs[::k, ::k].ravel(), ys[::k, ::k].ravel()], axis=1)
@@ -125,30 +121,74 @@ def router_scores(
         if len(pts) > max_samples:
             keep = np.linspace(0, len(pts) - 1, max_samples).astype(int)
             pts, rssi = pts[keep], rssi[keep]
-        model = distance_term(pts)
+        model = _distance_term(pts, routers, path_loss_exponent)
         if use_walls:
             model -= wall_loss_db * wall_crossings(grid, wall_mask, routers, pts)
         resid = rssi - model
         heard = rssi > NOT_HEARD_DBM
         if heard.any():
             resid = resid - float(np.median(resid[heard]))  # routers share one tx power
-        tree = cKDTree(pts)
+        xs, ys = grid.cell_centres()
         k = min(8, len(pts))
-        dist, idx = tree.query(cells, k=k, distance_upper_bound=residual_radius_m)
-        dist, idx = dist.reshape(len(cells), k), idx.reshape(len(cells), k)
-        found = np.isfinite(dist)
-        idx = np.where(found, idx, 0)
+        dist, idx = cKDTree(pts).query(
+            np.stack([xs.ravel(), ys.ravel()], axis=1), k=k, distance_upper_bound=residual_radius_m
+        )
+        dist, idx = dist.reshape(-1, k), idx.reshape(-1, k)
         for r in range(routers.shape[0]):
-            if not heard[:, r].any():
+            if heard[:, r].any():
+                e = np.where(heard[:, r], resid[:, r], 0.0)
+                _add_spread_residuals(scores[:, r], dist, idx, heard[:, r], e)
+            else:
                 scores[:, r] = -np.inf
-                continue
-            e = np.where(heard[:, r], resid[:, r], 0.0)
-            weight = np.where(found & heard[idx, r], 1.0 / (dist + 0.3) ** 2, 0.0)
-            wsum = weight.sum(axis=1)
-            scores[:, r] += np.where(
-                wsum > 0, (weight * e[idx]).sum(axis=1) / np.maximum(wsum, 1e-12), 0.0
-            )
     return scores.T.reshape(routers.shape[0], *grid.shape)
+
+
+def _distance_term(points: np.ndarray, routers: np.ndarray, exponent: float) -> np.ndarray:
+    """``−10 n log10(max(d, 1 m))`` from every router to every point: ``(P, R)``."""
+    d = np.linalg.norm(points[:, None, :] - routers[None, :, :], axis=2)
+    return -10.0 * exponent * np.log10(np.maximum(d, 1.0))
+
+
+@functools.lru_cache(maxsize=16)
+def _cells_distance_term(grid: GridSpec, routers_bytes: bytes, exponent: float) -> np.ndarray:
+    """:func:`_distance_term` at every cell centre (row-major), kept per map and routers."""
+    xs, ys = grid.cell_centres()
+    routers = np.frombuffer(routers_bytes, np.float64).reshape(-1, 2)
+    term = _distance_term(np.stack([xs.ravel(), ys.ravel()], axis=1), routers, exponent)
+    term.flags.writeable = False
+    return term
+
+
+@njit(cache=True)
+def _add_spread_residuals(scores, dist, idx, heard, e):  # pragma: no cover (compiled)
+    """``scores[i] +=`` the inverse-distance weighted mean of ``e`` over cell i's heard nearest
+    samples (weights ``1 / (d + 0.3)²``; 0 without any), summed in numpy's order (pairwise
+    over 8 neighbours, else in sequence) so the sums equal the vectorised computation's."""
+    k = dist.shape[1]
+    weight = np.empty(k)
+    weighted = np.empty(k)
+    for i in range(len(scores)):
+        for j in range(k):
+            found = np.isfinite(dist[i, j])
+            s = idx[i, j] if found else 0
+            weight[j] = (
+                1.0 / ((dist[i, j] + 0.3) * (dist[i, j] + 0.3)) if found and heard[s] else 0.0
+            )
+            weighted[j] = weight[j] * e[s]
+        total = _numpy_sum(weight)
+        scores[i] += _numpy_sum(weighted) / max(total, 1e-12) if total > 0 else 0.0
+
+
+@njit(cache=True)
+def _numpy_sum(values):  # pragma: no cover (compiled)
+    """``values.sum()`` as numpy adds up a row of up to 8 (8: pairwise, fewer: in sequence)."""
+    if len(values) == 8:
+        v = values
+        return 0.0 + (((v[0] + v[1]) + (v[2] + v[3])) + ((v[4] + v[5]) + (v[6] + v[7])))
+    total = 0.0
+    for x in values:
+        total += x
+    return total
 
 
 def dominance_bands(scores: np.ndarray, band_cells: float) -> tuple[np.ndarray, np.ndarray]:
