@@ -56,6 +56,7 @@ from sfw_gym.navigation.candidates import (
     explore_lite_choice,  # noqa: F401  (re-exported: the teacher's choice, by its old home)
 )
 from sfw_gym.navigation.planning import (
+    SEARCH_RADIUS_M,
     CostField,
     PurePursuit,
     belief_classes,
@@ -145,7 +146,7 @@ class FrontierSettings(AgentSettings):
     blacklist_radius_m: float = setting(0.3, ge=0.0)
     replan_every_steps: int = setting(5, integer=True, ge=1)
     replan_when_resolved: bool = setting(True, choices=(True, False))
-    search_radius_m: float = setting(4.0, gt=0.0)
+    search_radius_m: float = setting(SEARCH_RADIUS_M, gt=0.0)
     unknown_cost: float = setting_of(CandidateSettings, "unknown_cost")
     bump_exclusion_m: float = setting_of(CandidateSettings, "bump_exclusion_m")
     lookahead_m: float = setting(0.4, ge=0.05)

@@ -135,15 +135,14 @@ class CandidateGoals:
         return self.paths.path(tuple(self.goal_rc[i]))
 
 
-def explore_lite_choice(
+def explore_lite_utilities(
     menu: CandidateGoals,
     anchor_rc: tuple[int, int] | None = None,
     anchor_cost_per_m: float = 0.0,
     resolution_m: float = 1.0,
-) -> int | None:
-    """The index of the menu's frontier candidate of best explore_lite utility (with the
-    frontier agent's default scales; None when no frontier candidate is reachable): the
-    frontier agent's choice on a K-candidate menu, the teacher of the learned explorer.
+) -> np.ndarray:
+    """explore_lite's utility of each of the menu's candidates (with the frontier agent's
+    default scales; ``-inf`` for those that are no reachable frontier candidate).
 
     With ``anchor_rc`` (a region chosen higher up: :mod:`sfw_gym.navigation.regions`), each
     candidate's utility also loses ``anchor_cost_per_m`` per metre between its target and the
@@ -160,7 +159,39 @@ def explore_lite_choice(
         offset_m = (menu.target_rc - np.asarray(anchor_rc)) * resolution_m
         utility = utility - anchor_cost_per_m * np.hypot(offset_m[:, 0], offset_m[:, 1])
     ok = menu.valid & (menu.source == SOURCES.index("frontier"))
-    return int(np.argmax(np.where(ok, utility, -np.inf))) if ok.any() else None
+    return np.where(ok, utility, -np.inf)
+
+
+def explore_lite_choice(
+    menu: CandidateGoals,
+    anchor_rc: tuple[int, int] | None = None,
+    anchor_cost_per_m: float = 0.0,
+    resolution_m: float = 1.0,
+) -> int | None:
+    """The index of the menu's frontier candidate of best explore_lite utility (the first of
+    equal ones; None when no frontier candidate is reachable): the frontier agent's choice on
+    a K-candidate menu, the teacher of the learned explorer. The arguments are those of
+    :func:`explore_lite_utilities`."""
+    utility = explore_lite_utilities(menu, anchor_rc, anchor_cost_per_m, resolution_m)
+    return int(np.argmax(utility)) if np.isfinite(utility).any() else None
+
+
+def proven_on_bounded_paths(menu: CandidateGoals, utility: np.ndarray) -> bool:
+    """Whether the best of ``utility`` (:func:`explore_lite_utilities` of a menu of frontier
+    clusters built on a bounded :func:`cost_field`) is the choice a search of the whole map
+    would make: a cluster whose cost counted in the utility (path, turn and anchor terms: the
+    cluster's size less its utility, over ``POTENTIAL_SCALE``) lies within the bound has that
+    exact cost (each cell beyond costs at least the bound), and any other cluster has a utility
+    below its size less ``POTENTIAL_SCALE`` × the bound. The best exact one must beat those."""
+    paths = menu.paths
+    if paths.complete:
+        return True
+    size = menu.feature("cluster_size_m")
+    cost = (GAIN_SCALE * size - utility) / POTENTIAL_SCALE
+    exact = cost <= paths.max_cost_m
+    best = utility[exact].max(initial=-np.inf)
+    beyond = (GAIN_SCALE * size - POTENTIAL_SCALE * paths.max_cost_m)[~exact]
+    return bool(np.isfinite(best) and best > beyond.max(initial=-np.inf))
 
 
 def bits_per_metre(menu: CandidateGoals, distance_offset_m: float = 1.0) -> np.ndarray:

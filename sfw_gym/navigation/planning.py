@@ -156,6 +156,10 @@ def wall_distance_m(walls: np.ndarray, resolution_m: float) -> np.ndarray:
     return ndimage.distance_transform_edt(~walls) * resolution_m
 
 
+#: Path cost (m) of the first, bounded search of a replan: a choice it can prove is kept (the
+#: frontier agent's ``search_radius_m``, the region steering's), else the whole map is searched.
+SEARCH_RADIUS_M = 4.0
+
 #: Cost of an obstacle cell next to the robot (:func:`free_start`): passable, at a price.
 FREE_START_COST = 20.0
 

@@ -15,9 +15,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from sfw_gym.navigation.candidates import POTENTIAL_SCALE, GoalFinder, explore_lite_choice
+from sfw_gym.navigation.candidates import (
+    POTENTIAL_SCALE,
+    GoalFinder,
+    explore_lite_utilities,
+    proven_on_bounded_paths,
+)
 from sfw_gym.navigation.goal_driver import TURN, GoalDriver, resolved
-from sfw_gym.navigation.planning import cost_field
+from sfw_gym.navigation.planning import SEARCH_RADIUS_M, cost_field
 from sfw_gym.navigation.view import RobotView
 
 #: The micro menu: frontier clusters and the features explore_lite's utility reads.
@@ -44,11 +49,13 @@ class RegionSteering:
         self.anchor_rc: tuple[int, int] | None = None
         self.remaining = 0
         self.micro_decisions = 0
+        self.full_searches = 0  # micro decisions whose bounded search could not prove the choice
         self._driving = False  # a goal of this decision is being driven
 
     def reset(self) -> None:
         """A new episode (after the finder's and the driver's resets)."""
         self.anchor_rc, self.remaining, self.micro_decisions = None, 0, 0
+        self.full_searches = 0
         self._driving = False
 
     def start(self, anchor_rc: tuple[int, int] | None, steps: int) -> None:
@@ -76,17 +83,23 @@ class RegionSteering:
         cluster is reachable: the cheapest valid goal of the full menu — hidden rooms and
         information-gain points —, else one step turning)."""
         res = view.grid.resolution_m
-        paths = cost_field(self.finder.costs(view), view.cell, res)
-        # explore_lite's utility minus anchor_cost_per_m per metre from the anchor: the same
-        # per path metre (÷ POTENTIAL_SCALE) where a cluster's cheapest cell is chosen
-        menu = self.finder.find(
-            view,
-            paths,
-            anchor_rc=self.anchor_rc,
-            anchor_cost_per_m=self.anchor_cost_per_m / POTENTIAL_SCALE,
-            **_MICRO,  # type: ignore[arg-type]
-        )
-        choice = explore_lite_choice(menu, self.anchor_rc, self.anchor_cost_per_m, res)
+        costs = self.finder.costs(view)
+        for bound in (SEARCH_RADIUS_M, np.inf):  # a bounded search first, kept when proven
+            paths = cost_field(costs, view.cell, res, max_cost_m=bound)
+            # explore_lite's utility minus anchor_cost_per_m per metre from the anchor: the
+            # same per path metre (÷ POTENTIAL_SCALE) where a cluster's cheapest cell is chosen
+            menu = self.finder.find(
+                view,
+                paths,
+                anchor_rc=self.anchor_rc,
+                anchor_cost_per_m=self.anchor_cost_per_m / POTENTIAL_SCALE,
+                **_MICRO,  # type: ignore[arg-type]
+            )
+            utility = explore_lite_utilities(menu, self.anchor_rc, self.anchor_cost_per_m, res)
+            if proven_on_bounded_paths(menu, utility):
+                break
+            self.full_searches += 1
+        choice = int(np.argmax(utility)) if np.isfinite(utility).any() else None
         if choice is None:
             menu = self.finder.find(view, paths, max_candidates=16)
             cost = np.where(menu.valid, menu.feature("path_cost_m"), np.inf)
