@@ -9,6 +9,7 @@ routers and start pose; the record is the same whichever process runs it.
 from __future__ import annotations
 
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -90,7 +91,7 @@ class EpisodeRecord:
         start: ``time.perf_counter()`` when the episode's work began (its ``wall_s``).
     """
 
-    def __init__(self, spec: EpisodeSpec, info: dict[str, Any], start: float) -> None:
+    def __init__(self, spec: EpisodeSpec, info: Mapping[str, Any], start: float) -> None:
         self.spec = spec
         self.start = start
         self.entropy_at_start = info["entropy_bits"]
@@ -99,7 +100,7 @@ class EpisodeRecord:
         ]
         self.steps = 0
 
-    def step(self, info: dict[str, Any], done: bool) -> None:
+    def step(self, info: Mapping[str, Any], done: bool) -> None:
         """Count a step and sample the curve (every ``curve_every`` steps and the last)."""
         self.steps += 1
         if self.steps % self.spec.curve_every == 0 or done:
@@ -109,7 +110,7 @@ class EpisodeRecord:
 
     def finish(
         self,
-        info: dict[str, Any],
+        info: Mapping[str, Any],
         terminated: bool,
         agent: Any,
         truth: GroundTruth,

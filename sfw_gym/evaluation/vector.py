@@ -1,22 +1,22 @@
 """Episodes on a vector env in this process (``sfw-gym evaluate --vector-envs N``).
 
-``gym.make_vec(id, num_envs=N)`` gives the native vector env (:class:`~sfw_gym.envs.vector.
-SfWVectorEnv`; every SfW id registers it, an id without one is refused). Its explore sub-envs
-step together in one compiled batch, the other env classes one by one. Each sub-env runs one episode
-after another: when one ends, its record is taken from the sub-env, and the sub-env is reset alone
-(``reset_mask``) with the next episode's seed and plan. That reset clears its pending autoreset.
-One agent per episode acts in this process. It is reset with its sub-env as in
-:func:`~sfw_gym.evaluation.rollout.run_episode`, so it holds only a
-:class:`~sfw_gym.agents.base.RobotViewHandle` (``robot_view()``, never the ground truth). The
-records are built by :class:`~sfw_gym.evaluation.rollout.EpisodeRecord`, so they are the
-sequential run's records.
+The env is ``gym.make_vec(id, num_envs=N)``'s native vector env
+(:class:`~sfw_gym.envs.vector.SfWVectorEnv`; every SfW id registers it, an id without one is
+refused). Its explore sub-envs step together in one compiled batch, other env classes one by
+one. Each sub-env runs one episode after another. When one ends, its record is taken from the
+sub-env, which is then reset alone (``reset_mask``, clearing its pending autoreset) with the
+next episode's seed and plan. One agent per episode acts in this process. It is reset with its
+sub-env as :func:`~sfw_gym.evaluation.rollout.run_episode` resets it, so it holds only a
+:class:`~sfw_gym.agents.base.RobotViewHandle` (``robot_view()``, never the ground truth).
+:class:`~sfw_gym.evaluation.rollout.EpisodeRecord` builds the records, so they are the
+sequential run's.
 """
 
 from __future__ import annotations
 
 import time
 from collections import deque
-from collections.abc import Generator, Sequence
+from collections.abc import Generator, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, cast
 
@@ -41,17 +41,29 @@ class _Slot:
     obs: Any
 
 
-def sub_env_row(batched: dict[str, Any], i: int) -> dict[str, Any]:
-    """Sub-env ``i``'s own dict out of a vector env's batched ``obs`` or ``info``: each key
-    whose ``_key`` mask marks it (an info; nested dicts likewise), or every key (an obs)."""
-    row = {}
-    for key, value in batched.items():
-        mask = batched.get(f"_{key}")
-        if mask is None and key.startswith("_") and key[1:] in batched:
-            continue  # a mask
-        if mask is None or mask[i]:
-            row[key] = sub_env_row(value, i) if isinstance(value, dict) else value[i]
-    return row
+class SubEnvInfo(Mapping[str, Any]):
+    """Sub-env ``i``'s info, read out of a vector env's batched info key by key when asked (a
+    record reads few of a step's keys): each key whose ``_key`` mask marks sub-env ``i``,
+    nested dicts likewise."""
+
+    __slots__ = ("_batched", "_i")
+
+    def __init__(self, batched: dict[str, Any], i: int) -> None:
+        self._batched, self._i = batched, i
+
+    def __getitem__(self, key: str) -> Any:
+        mask = self._batched.get(f"_{key}")
+        if mask is None or not mask[self._i]:
+            raise KeyError(key)
+        value = self._batched[key]
+        return SubEnvInfo(value, self._i) if isinstance(value, dict) else value[self._i]
+
+    def __iter__(self) -> Iterator[str]:
+        batched, i = self._batched, self._i
+        return (k for k in batched if f"_{k}" in batched and batched[f"_{k}"][i])
+
+    def __len__(self) -> int:
+        return sum(1 for _ in self)
 
 
 def check_native_vector_env(env_id: str) -> None:
@@ -107,10 +119,10 @@ def run_vector(
             if spec.floorplan:
                 options["floorplan"] = spec.floorplan
             obs, infos = vec.reset(seed=seeds, options=options)
-            episode = EpisodeRecord(spec, sub_env_row(infos, i), begin)
+            episode = EpisodeRecord(spec, SubEnvInfo(infos, i), begin)
             agent = make_agent(spec.agent, **spec.agent_params)
             agent.reset(vec.envs[i], seed=spec.agent_reset_seed)
-            slots[i] = _Slot(index, agent, episode, sub_env_row(obs, i))
+            slots[i] = _Slot(index, agent, episode, {k: v[i] for k, v in obs.items()})
 
         for i in range(n):
             start(i)
@@ -122,8 +134,8 @@ def run_vector(
                 if slot is None:
                     continue
                 done = bool(terminated[i] or truncated[i])
-                info = sub_env_row(infos, i)
-                slot.obs = sub_env_row(obs, i)
+                info = SubEnvInfo(infos, i)
+                slot.obs = {k: v[i] for k, v in obs.items()}
                 slot.episode.step(info, done)
                 if done:
                     sfw = unwrap_sfw(vec.envs[i])

@@ -13,7 +13,7 @@ import pytest
 from sfw_gym import evaluation as ev
 from sfw_gym.cli import main
 from sfw_gym.core.errors import ConfigError
-from sfw_gym.evaluation.vector import sub_env_row
+from sfw_gym.evaluation.vector import SubEnvInfo
 
 SMALL = "SfW-ExploreSmall-v0"
 
@@ -85,7 +85,7 @@ def test_mixed_agents_and_plan_files_on_vector_envs_match_too(tmp_path):
     }
 
 
-def test_a_sub_envs_row_keeps_only_what_its_masks_mark():
+def test_a_sub_envs_info_holds_only_what_its_masks_mark():
     batched = {
         "coverage": np.array([0.1, 0.2]),
         "_coverage": np.array([True, True]),
@@ -94,10 +94,10 @@ def test_a_sub_envs_row_keeps_only_what_its_masks_mark():
         "_private": np.array([1, 2]),  # an info key that starts with "_", with its own mask
         "__private": np.array([True, False]),
     }
-    assert sub_env_row(batched, 0) == {"coverage": 0.1, "_private": 1}
-    assert sub_env_row(batched, 1) == {"coverage": 0.2, "summary": {"steps": 7}}
-    obs = {"state": np.arange(6).reshape(2, 3)}  # an obs: no masks, every key
-    assert sub_env_row(obs, 1)["state"].tolist() == [3, 4, 5]
+    first, second = SubEnvInfo(batched, 0), SubEnvInfo(batched, 1)
+    assert dict(first) == {"coverage": 0.1, "_private": 1} and "summary" not in first
+    assert second["coverage"] == 0.2 and dict(second["summary"]) == {"steps": 7}
+    assert first.get("summary", {}) == {} and len(second) == 2
 
 
 def test_vector_envs_refuse_what_they_cannot_do(tmp_path):
