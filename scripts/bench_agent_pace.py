@@ -54,7 +54,9 @@ def main() -> None:
         for agent in row:
             seconds, steps = time_agent_episode(agent, args.env, seed, **kwargs)
             row[agent].append(1e3 * seconds / steps)
-        print(f"{where} seed {seed}: " + ", ".join(f"{a} {row[a][-1]:.3f}" for a in row), flush=True)
+        print(
+            f"{where} seed {seed}: " + ", ".join(f"{a} {row[a][-1]:.3f}" for a in row), flush=True
+        )
     print(f"\n{'set':<11} {'agent':<15} {'ms/step':>8}  (act + step) ÷ random step, 95 % CI")
     for where, row in per_step.items():
         base = np.array(row["random"])

@@ -19,7 +19,8 @@ import numpy as np
 from numba import njit
 from scipy import ndimage
 
-from sfw_gym.core.angles import wrap_angle
+from sfw_gym.core.angles import wrap_angle_compiled
+from sfw_gym.core.exact_math import hypot as exact_hypot
 from sfw_gym.mapping.grid import GridSpec, belief_classes
 
 
@@ -450,32 +451,55 @@ class PurePursuit:
         return float(np.linalg.norm(rest[0] - xy) + legs)
 
     def command(self, pose: tuple[float, float, float]) -> tuple[float, float]:
-        """``(linear, angular)`` fractions in [-1, 1] towards the carrot; (0, 0) at the end."""
+        """``(linear, angular)`` fractions in [-1, 1] towards the carrot; (0, 0) at the end.
+
+        The progress index advances to the nearest of the next 20 path points (never backwards);
+        the carrot is the first point from there at ``lookahead_m`` or more (else the end)."""
         if not self.has_path:
             return 0.0, 0.0
-        x, y = float(pose[0]), float(pose[1])
-        end = self.path[-1]
-        if math.hypot(end[0] - x, end[1] - y) <= self.goal_tolerance_m:
+        linear, angular, progress = _pursue(
+            self.path,
+            self._progress,
+            float(pose[0]),
+            float(pose[1]),
+            float(pose[2]),
+            self.lookahead_m,
+            self.goal_tolerance_m,
+            self.turn_in_place_rad,
+            self.angular_gain,
+        )
+        if progress < 0:  # the end is reached
             self.path = np.zeros((0, 2))
-            return 0.0, 0.0
-        # Advance the progress index to the nearest path point (never backwards).
-        window = self.path[self._progress : self._progress + 20]
-        self._progress += int(np.argmin(np.hypot(window[:, 0] - x, window[:, 1] - y)))
-        # The carrot: the first point ahead at lookahead distance or more (looked for in chunks:
-        # it is usually within the first few points of a long path).
-        carrot = end
-        for start in range(self._progress, len(self.path), 32):
-            chunk = self.path[start : start + 32]
-            far = np.flatnonzero(np.hypot(chunk[:, 0] - x, chunk[:, 1] - y) >= self.lookahead_m)
-            if len(far):
-                carrot = chunk[far[0]]
-                break
-        bearing = wrap_angle(math.atan2(carrot[1] - y, carrot[0] - x) - pose[2])
-        angular = min(max(self.angular_gain * bearing, -1.0), 1.0)
-        if abs(bearing) > self.turn_in_place_rad:
-            return 0.0, math.copysign(1.0, bearing)
-        linear = min(max(math.cos(bearing), 0.2), 1.0)
+        else:
+            self._progress = progress
         return linear, angular
+
+
+@njit(cache=True)
+def _pursue(
+    path, progress, x, y, heading, lookahead, tolerance, turn_in_place, gain
+):  # pragma: no cover (compiled)
+    """:meth:`PurePursuit.command` in one call: ``(linear, angular, progress)``, progress -1 at
+    the end. Distances as the Python code measured them (CPython's ``math.hypot`` to the end,
+    numpy's ``hypot`` along the path), so the commands are the same to the bit."""
+    n = len(path)
+    if exact_hypot(path[n - 1, 0] - x, path[n - 1, 1] - y) <= tolerance:
+        return 0.0, 0.0, -1
+    best, nearest = np.inf, progress
+    for i in range(progress, min(progress + 20, n)):
+        d = np.hypot(path[i, 0] - x, path[i, 1] - y)
+        if d < best:
+            best, nearest = d, i
+    carrot = n - 1
+    for i in range(nearest, n):
+        if np.hypot(path[i, 0] - x, path[i, 1] - y) >= lookahead:
+            carrot = i
+            break
+    bearing = wrap_angle_compiled(math.atan2(path[carrot, 1] - y, path[carrot, 0] - x) - heading)
+    angular = min(max(gain * bearing, -1.0), 1.0)
+    if abs(bearing) > turn_in_place:
+        return 0.0, math.copysign(1.0, bearing), nearest
+    return min(max(math.cos(bearing), 0.2), 1.0), angular, nearest
 
 
 def to_discrete(linear: float, angular: float, deadband: float = 0.35) -> int:

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from sfw_gym.mapping.grid import GridSpec
+from sfw_gym.core.angles import wrap_angle
 from sfw_gym.navigation.planning import (
     PurePursuit,
     belief_classes,
@@ -26,7 +27,6 @@ from sfw_gym.navigation.planning import (
     simplify_path,
     to_discrete,
     traversal_costs,
-    wrap_angle,
 )
 
 # ---------------------------------------------------------------- belief classes and costs
