@@ -18,7 +18,7 @@ from sfw_gym.navigation.candidates import (
     candidate_goals,
 )
 from sfw_gym.navigation.frontiers import frontier_mask
-from sfw_gym.navigation.planning import cost_field
+from sfw_gym.navigation.planning import SEARCH_RADIUS_M, cost_field
 from sfw_gym.navigation.view import RobotView
 
 RES = 0.1
@@ -192,3 +192,67 @@ def test_unknown_names_are_refused():
         finder.find(view, paths, features=("path_cost",))
     with pytest.raises(ConfigError, match="did you mean 'unknown_cost'"):
         candidate_goals(view, unknown_cots=2.0)
+
+
+def _micro_choice(finder, view, bound, anchor):
+    """explore_lite's choice (and whether it is proven) on a field searched up to ``bound``."""
+    from sfw_gym.navigation.candidates import explore_lite_utilities, proven_on_bounded_paths
+
+    res = view.grid.resolution_m
+    paths = cost_field(finder.costs(view), view.cell, res, max_cost_m=bound)
+    menu = finder.find(
+        view,
+        paths,
+        sources=("frontier",),
+        features=("path_cost_m", "heading_change_rad", "cluster_size_m"),
+        anchor_rc=anchor,
+        anchor_cost_per_m=1.0 / 3.0,
+    )
+    utility = explore_lite_utilities(menu, anchor, 1.0, res)
+    choice = int(np.argmax(utility)) if np.isfinite(utility).any() else None
+    target = None if choice is None else tuple(menu.target_rc[choice])
+    return target, proven_on_bounded_paths(menu, utility)
+
+
+def test_a_proven_bounded_choice_is_the_full_searchs_choice():
+    """Over many robot cells near the frontier of a half-explored plan, with and without an
+    anchor: whenever the bounded search proves its choice it is the choice on the whole map's
+    field, and it often does (not always: a far anchor or a large far cluster needs more)."""
+    from sfw_gym.bench import synthetic_view
+
+    from scipy import ndimage
+
+    base = synthetic_view(128, seed=3)
+    to_unknown = ndimage.distance_transform_edt(base.belief_u8 != U8_UNKNOWN)
+    free = np.argwhere((base.belief_u8 == U8_FREE) & (to_unknown < 12))  # near the frontier
+    rng = np.random.default_rng(0)
+    proven = 0
+    for cell in free[rng.choice(len(free), 40, replace=False)]:
+        xy = base.grid.cell_to_world(cell)
+        view = RobotView.hand_made(
+            base.belief_u8, base.grid, (xy[0], xy[1], rng.uniform(-3, 3)), base.routers_xy
+        )
+        anchor = None if rng.random() < 0.3 else tuple(int(v) for v in rng.integers(0, 128, 2))
+        finder = GoalFinder()
+        finder.reset(view)
+        full, _ = _micro_choice(finder, view, np.inf, anchor)
+        bounded, ok = _micro_choice(finder, view, SEARCH_RADIUS_M, anchor)
+        if ok:
+            proven += 1
+            assert bounded == full
+    assert proven >= 8  # 11 of these 40
+
+
+def test_a_large_cluster_beyond_the_bound_is_not_ruled_out():
+    """A 1-cell frontier next to the robot and a 4 m one 3 m away: searched to 1 m, the near one
+    is the only exact candidate, but the far one could be better: not proven."""
+    b = corridor(free_cols=40, length=60)
+    b[5, 3] = U8_UNKNOWN  # a pocket-free frontier cell by the robot would be excluded: open one
+    b[1:13, 2] = U8_UNKNOWN
+    view = view_of(b, (0.45, 0.65))
+    finder = GoalFinder()
+    finder.reset(view)
+    full, _ = _micro_choice(finder, view, np.inf, None)
+    bounded, ok = _micro_choice(finder, view, 1.0, None)
+    assert not ok
+    assert full is not None

@@ -450,3 +450,21 @@ def test_cost_field_paths_are_mcp_paths_even_where_costs_tie():
     goals = list(map(tuple, np.argwhere(field.reachable())))
     same = sum(np.array_equal(field.path(g), np.asarray(mcp.traceback(g))) for g in goals)
     assert same >= 0.99 * len(goals)
+
+
+@pytest.mark.parametrize("start", [(3, 4), (100, 60), (196, 110)])
+def test_a_bounded_search_in_a_large_grid_is_the_full_searchs_prefix(start):
+    """The bounded search scans and cleans only a window around the start: on a grid much
+    larger than the window (and with the window cut by the grid's edges) its settled cells have
+    the full search's costs and predecessors, and every other cell is ``inf`` / -1."""
+    rng = np.random.default_rng(7)
+    cost = np.where(rng.random((200, 115)) < 0.1, np.inf, 1.0 + 3.0 * rng.random((200, 115)))
+    cost[start] = 1.0
+    full = cost_field(cost, start, 0.1)
+    part = cost_field(cost, start, 0.1, max_cost_m=1.2)
+    known = np.isfinite(part.cumulative)
+    assert 20 < known.sum() < 0.05 * cost.size
+    assert np.array_equal(part.cumulative[known], full.cumulative[known])
+    assert np.array_equal(part.predecessor[known.ravel()], full.predecessor[known.ravel()])
+    assert (part.predecessor[~known.ravel()] == -1).all()
+    assert known[full.cumulative <= 1.2].all()
