@@ -218,9 +218,9 @@ def test_a_proven_bounded_choice_is_the_full_searchs_choice():
     """Over many robot cells near the frontier of a half-explored plan, with and without an
     anchor: whenever the bounded search proves its choice it is the choice on the whole map's
     field, and it often does (not always: a far anchor or a large far cluster needs more)."""
-    from sfw_gym.bench import synthetic_view
-
     from scipy import ndimage
+
+    from sfw_gym.bench import synthetic_view
 
     base = synthetic_view(128, seed=3)
     to_unknown = ndimage.distance_transform_edt(base.belief_u8 != U8_UNKNOWN)
@@ -253,6 +253,6 @@ def test_a_large_cluster_beyond_the_bound_is_not_ruled_out():
     finder = GoalFinder()
     finder.reset(view)
     full, _ = _micro_choice(finder, view, np.inf, None)
-    bounded, ok = _micro_choice(finder, view, 1.0, None)
+    _, ok = _micro_choice(finder, view, 1.0, None)
     assert not ok
     assert full is not None

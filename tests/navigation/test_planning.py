@@ -11,8 +11,8 @@ import math
 import numpy as np
 import pytest
 
-from sfw_gym.mapping.grid import GridSpec
 from sfw_gym.core.angles import wrap_angle
+from sfw_gym.mapping.grid import GridSpec
 from sfw_gym.navigation.planning import (
     PurePursuit,
     belief_classes,
