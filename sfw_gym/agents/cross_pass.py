@@ -26,6 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 from scipy import ndimage
 
 from sfw_gym.agents.base import RobotView
@@ -123,40 +124,39 @@ class CrossPassAgent(FrontierAgent):
     ) -> np.ndarray:
         """Frontier's utility, each band cell of a cluster counting ``1 + band_bonus`` cells."""
         size = np.array([len(c) for c in clusters], np.int64)
-        if self.band is not None and self.settings.band_bonus > 0:
-            in_band = [int(self.band[c[:, 0], c[:, 1]].sum()) for c in clusters]
-            size = size + self.settings.band_bonus * np.array(in_band, np.int64)
+        if self.band is not None and self.settings.band_bonus > 0 and len(clusters):
+            cells = np.concatenate(clusters)
+            in_band = np.concatenate(([0], np.cumsum(self.band[cells[:, 0], cells[:, 1]])))
+            ends = np.cumsum(size)
+            size = size + self.settings.band_bonus * (in_band[ends] - in_band[ends - size])
         res = view.grid.resolution_m
         return self.settings.gain_scale * size * res - self.settings.potential_scale * np.asarray(
             path_m, float
         )
 
-    def unknown_band(self, view: RobotView) -> np.ndarray:
-        """Unknown cells in the estimated border bands not yet targeted by a pass."""
+    def unknown_band(self, view: RobotView, within: np.ndarray | None = None) -> np.ndarray:
+        """Unknown cells in the estimated border bands not yet targeted by a pass, less those
+        :meth:`GoalFinder.exclusion` keeps from frontier goals; only ``within`` a mask if given
+        (the exclusion is evaluated at the remaining cells alone)."""
         if self.band is None:
             return np.zeros(view.grid.shape, bool)
         _, _, unknown = belief_classes(view.belief_u8)
-        return self.band & unknown & ~self.passed & ~self._frontier_exclusion(view)
+        band = self.band & unknown & ~self.passed
+        if within is not None:
+            band &= within
+        flat = np.flatnonzero(band)
+        band.ravel()[flat[self.finder.excluded_at(view, flat)]] = False
+        return band
 
     def _pass_goal(self, view: RobotView, paths: CostField) -> Goal | None:
         res = view.grid.resolution_m
-        targets = self.unknown_band(view) & paths.reachable()
+        targets = self.unknown_band(view, within=paths.reachable())
         if not targets.any():
             return None
-        labels, n = ndimage.label(targets, structure=np.ones((3, 3), bool))
-        sizes = np.bincount(labels.ravel(), minlength=n + 1)
-        sizes[0] = 0
-        cost = np.where(labels > 0, paths.cumulative, np.inf)
         min_cells = self.settings.min_band_area_m2 / res**2
-        best_cost = ndimage.minimum(cost, labels, index=np.arange(1, n + 1))
-        order = np.argsort(best_cost)
-        for i in order:
-            lab = i + 1
-            if best_cost[i] > self.settings.pass_trigger_m:
-                break
-            if sizes[lab] < min_cells:
+        for rows, cols in self._clusters_within_trigger(targets, paths.cumulative):
+            if len(rows) < min_cells:
                 continue
-            rows, cols = np.nonzero(labels == lab)
             self.passed[rows, cols] = True
             waypoints = self._pass_waypoints(view, paths, rows, cols)
             if len(waypoints) >= 2:
@@ -164,6 +164,36 @@ class CrossPassAgent(FrontierAgent):
                 mark_disk(self.passed, centre, self.settings.pass_spacing_m / res)
                 return Goal(waypoints[0], waypoints[0], "pass", waypoints=waypoints[1:])
         return None
+
+    def _clusters_within_trigger(
+        self, targets: np.ndarray, cost: np.ndarray
+    ) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The 8-connected clusters of ``targets`` whose nearest cell costs at most
+        ``pass_trigger_m``, nearest first: ``(rows, cols)`` each.
+
+        Filled from the cells within the trigger only; where two clusters are equally near, their
+        order is the one ``np.argsort`` gives over all clusters of the map (as labelled by
+        ``ndimage.label``), so the choice never depends on how the clusters were found.
+        """
+        w = targets.shape[1]
+        seeds = np.flatnonzero(targets & (cost <= self.settings.pass_trigger_m))
+        if len(seeds) == 0:
+            return []
+        cells, starts = _fill_from_seeds(targets, seeds)
+        best = np.minimum.reduceat(cost.ravel()[cells], starts[:-1])
+        if len(np.unique(best)) == len(best):
+            return [
+                divmod(np.sort(cells[a:b]), w)
+                for a, b in (starts[i : i + 2] for i in np.argsort(best))
+            ]
+        labels, n = ndimage.label(targets, structure=np.ones((3, 3), bool))
+        best_all = ndimage.minimum(np.where(labels > 0, cost, np.inf), labels, np.arange(1, n + 1))
+        nearest_first = []
+        for i in np.argsort(best_all):
+            if best_all[i] <= self.settings.pass_trigger_m:
+                rows, cols = np.nonzero(labels == i + 1)
+                nearest_first.append((rows, cols))
+        return nearest_first
 
     def _pass_waypoints(
         self, view: RobotView, paths: CostField, rows: np.ndarray, cols: np.ndarray
@@ -225,3 +255,36 @@ class CrossPassAgent(FrontierAgent):
             if 0 <= r < h and 0 <= c < w and np.isfinite(paths.cumulative[r, c]):
                 return r, c
         return None
+
+
+@njit(cache=True)
+def _fill_from_seeds(mask, seeds):  # pragma: no cover (compiled)
+    """The 8-connected components of ``mask`` that hold a seed (flat indices): their cells (flat,
+    grouped by component, in the order of the seeds first met) and each group's start (with the
+    end appended)."""
+    h, w = mask.shape
+    flat = mask.ravel()
+    seen = np.zeros(h * w, np.bool_)
+    cells = np.empty(h * w, np.int64)
+    starts = [0]
+    n = 0
+    for seed in seeds:
+        if seen[seed]:
+            continue
+        seen[seed] = True
+        cells[n] = seed
+        head = n
+        n += 1
+        while head < n:
+            i = cells[head]
+            head += 1
+            r0, c0 = i // w, i % w
+            for r in range(max(r0 - 1, 0), min(r0 + 2, h)):
+                for c in range(max(c0 - 1, 0), min(c0 + 2, w)):
+                    j = r * w + c
+                    if flat[j] and not seen[j]:
+                        seen[j] = True
+                        cells[n] = j
+                        n += 1
+        starts.append(n)
+    return cells[:n].copy(), np.array(starts, np.int64)
