@@ -23,19 +23,22 @@ import gymnasium as gym
 import sfw_gym  # noqa: F401  (registers the ids)
 
 
-def env_steps_per_s(env: gym.Env | gym.vector.VectorEnv, steps: int, batch: int) -> float:
-    """Env steps per second over ``steps`` calls of random actions (after a warm-up)."""
+def env_steps_per_s(
+    env: gym.Env | gym.vector.VectorEnv, steps: int, batch: int, clock: Any = time.perf_counter
+) -> float:
+    """Env steps per second of ``clock`` over ``steps`` calls of random actions (after a
+    warm-up)."""
     env.reset(seed=0)
     env.action_space.seed(0)
     actions = [env.action_space.sample() for _ in range(steps + 20)]
     for action in actions[:20]:
         env.step(action)
-    start = time.perf_counter()
+    start = clock()
     for action in actions[20:]:
         out = env.step(action)
         if batch == 1 and (out[2] or out[3]):
             env.reset()
-    rate = steps * batch / (time.perf_counter() - start)
+    rate = steps * batch / (clock() - start)
     env.close()
     return rate
 
@@ -50,16 +53,20 @@ def _native_rate(job: tuple[str, int, int, dict[str, Any], Any]) -> float:
     return env_steps_per_s(gym.make_vec(env_id, num_envs=n, **kwargs), steps, n)
 
 
-def native_rounds(env_id: str, n: int, steps: int, rounds: int, kwargs: dict[str, Any]) -> None:
+def native_rounds(
+    env_id: str, n: int, steps: int, rounds: int, kwargs: dict[str, Any], clock_name: str
+) -> None:
     """One env (``n * steps`` steps) and the native ``n``-env batch (``steps`` steps) timed
     alternately; the per-round ratios' median."""
+    clock = time.process_time if clock_name == "cpu" else time.perf_counter
     rates: dict[str, list[float]] = {"one env": [], f"{n} envs, native": []}
     for _ in range(rounds):
-        rates["one env"].append(env_steps_per_s(gym.make(env_id, **kwargs), n * steps, 1))
+        one = gym.make(env_id, **kwargs)
+        rates["one env"].append(env_steps_per_s(one, n * steps, 1, clock))
         vec = gym.make_vec(env_id, num_envs=n, **kwargs)
-        rates[f"{n} envs, native"].append(env_steps_per_s(vec, steps, n))
+        rates[f"{n} envs, native"].append(env_steps_per_s(vec, steps, n, clock))
     ratios = [b / a for a, b in zip(*rates.values(), strict=True)]
-    print(f"{env_id}: env steps/s, median of {rounds} alternating rounds")
+    print(f"{env_id}: env steps per {clock_name} second, median of {rounds} alternating rounds")
     for name, values in rates.items():
         print(f"  {name:34s} {statistics.median(values):10,.0f}")
     q = statistics.quantiles(ratios, n=4) if rounds > 1 else ratios * 3
@@ -77,12 +84,18 @@ def main() -> None:
     parser.add_argument("--processes", type=int, default=2, help="processes of the last row")
     parser.add_argument("--floorplan", default=None, help="a plan file for every episode")
     parser.add_argument("--rounds", type=int, default=0, help="only one env vs native, R rounds")
+    parser.add_argument(
+        "--clock",
+        choices=("wall", "cpu"),
+        default="wall",
+        help="with --rounds: wall time, or this process's CPU time (a machine others load)",
+    )
     args = parser.parse_args()
     n, kwargs = args.num_envs, {} if args.floorplan is None else {"floorplan": args.floorplan}
     env_steps_per_s(gym.make(args.env, **kwargs), 200, 1)  # warm-up: compiled kernels
     if args.rounds:
         env_steps_per_s(gym.make_vec(args.env, num_envs=n, **kwargs), 20, n)  # warm-up
-        native_rounds(args.env, n, args.steps, args.rounds, kwargs)
+        native_rounds(args.env, n, args.steps, args.rounds, kwargs, args.clock)
         return
     one = env_steps_per_s(gym.make(args.env, **kwargs), args.steps, 1)
     rows = [("one env", one)]
