@@ -113,8 +113,9 @@ def router_scores_numpy(grid, routers_xy, samples_xy, samples_rssi, walls, wall_
 
 @pytest.mark.parametrize("seed", range(4))
 def test_router_scores_equal_the_vectorised_computation_bit_for_bit(seed):
-    """Random walks (some standing still: equal distances), some routers never heard, fewer
-    and more than 8 (and 600) samples, with and without walls; signed zeros compared too."""
+    """Random walks (some standing still: equal distances; some off the map), some routers never
+    heard, fewer and more than 8 (and 600) samples, with and without walls; signed zeros
+    compared too."""
     rng = np.random.default_rng(seed)
     for _ in range(25):
         h, w = (int(v) for v in rng.integers(5, 50, 2))
@@ -123,6 +124,8 @@ def test_router_scores_equal_the_vectorised_computation_bit_for_bit(seed):
         steps = rng.normal(0.0, 0.1, (int(rng.choice([1, 5, 8, 40, 700])), 2))
         steps[rng.random(len(steps)) < 0.3] = 0.0
         samples = np.clip(0.05 * np.array([w, h]) + np.cumsum(steps, axis=0), 0.0, None)
+        if rng.random() < 0.1:
+            samples += 50.0  # off the map: no cell has a sample in reach
         rssi = rng.uniform(-90.0, -30.0, (len(samples), len(routers)))
         rssi[rng.random(rssi.shape) < 0.2] = NOT_HEARD_DBM
         if rng.random() < 0.2:
