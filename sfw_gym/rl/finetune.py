@@ -36,6 +36,10 @@ from torch.nn import functional as F
 
 logger = logging.getLogger(__name__)
 
+#: Keys under which :meth:`AnchoredMaskablePPO.train` keeps the anchor's distribution of each
+#: rollout sample beside its observation (a leading underscore: no observation is named so).
+ANCHOR_PROBS, ANCHOR_LOGITS = "_anchor_probs", "_anchor_logits"
+
 
 def _categoricals(dist: MaskableDistribution) -> list[MaskableCategorical]:
     """The categorical distribution(s) behind a (multi-)categorical maskable distribution."""
@@ -51,6 +55,15 @@ def masked_kl(anchor: MaskableDistribution, current: MaskableDistribution) -> to
         total = terms if total is None else total + terms
     assert total is not None
     return total
+
+
+def kl_from_anchor_rows(
+    probs: torch.Tensor, logits: torch.Tensor, current: MaskableDistribution
+) -> torch.Tensor:
+    """:func:`masked_kl` with the anchor given by its (masked, normalised) ``probs`` and
+    ``logits`` rows, as :meth:`AnchoredMaskablePPO.anchor_rows` keeps them."""
+    (q,) = _categoricals(current)
+    return torch.where(probs > 0, probs * (logits - q.logits), 0.0).sum(-1)
 
 
 def frozen_copy(policy: MaskableActorCriticPolicy) -> MaskableActorCriticPolicy:
@@ -190,6 +203,43 @@ class AnchoredMaskablePPO(MaskablePPO):
 
     # --- the update ----------------------------------------------------------------------------
 
+    def _cache_anchor_rows(self) -> bool:
+        """Put the anchor's masked distribution of every rollout sample into the rollout
+        buffer's observations (:data:`ANCHOR_PROBS`, :data:`ANCHOR_LOGITS`), so that each
+        minibatch carries its rows: the frozen anchor runs once per rollout instead of once per
+        epoch. Its outputs do not depend on which samples share a batch (the policies here
+        compute each sample alone: tested), so the KL term is the same. False (nothing cached):
+        no anchor, a dict-less buffer, several categoricals, or a buffer already flattened."""
+        buffer: Any = self.rollout_buffer
+        if (
+            self.anchor is None
+            or not isinstance(buffer.observations, dict)
+            or buffer.generator_ready
+            or not isinstance(self.action_space, spaces.Discrete)
+        ):
+            return False
+        n_steps, n_envs = buffer.buffer_size, buffer.n_envs
+        flat, size = n_steps * n_envs, self.batch_size or n_steps * n_envs
+        # (step, env) order: reshaped back below, swapped and flattened by buffer.get as the rest
+        rows = {
+            key: value.reshape(flat, *value.shape[2:]) for key, value in buffer.observations.items()
+        }
+        all_masks = buffer.action_masks.reshape(flat, -1)
+        probs, logits = [], []
+        with torch.no_grad():
+            for start in range(0, flat, size):
+                obs = {
+                    key: buffer.to_torch(value[start : start + size]) for key, value in rows.items()
+                }
+                masks: Any = buffer.to_torch(all_masks[start : start + size])  # a tensor: fine
+                dist = self.anchor.get_distribution(obs, action_masks=masks)
+                (p,) = _categoricals(dist)
+                probs.append(p.probs.cpu().numpy())
+                logits.append(p.logits.cpu().numpy())
+        buffer.observations[ANCHOR_PROBS] = np.concatenate(probs).reshape(n_steps, n_envs, -1)
+        buffer.observations[ANCHOR_LOGITS] = np.concatenate(logits).reshape(n_steps, n_envs, -1)
+        return True
+
     def train(self) -> None:
         """One PPO update (clipped surrogate, value loss, entropy, target-KL early stop), plus
         the anchor's KL; the actor's steps are scaled by :meth:`actor_lr_scale`."""
@@ -207,6 +257,7 @@ class AnchoredMaskablePPO(MaskablePPO):
             raise ValueError("kl_coef > 0 needs an anchor: call set_anchor() first")
         actor = self._actor_parameters() if actor_scale < 1.0 else []
 
+        cached = self._cache_anchor_rows()
         stats: dict[str, list[float]] = defaultdict(list)
         approx_kls: list[float] = []
         loss = torch.zeros(())
@@ -214,12 +265,18 @@ class AnchoredMaskablePPO(MaskablePPO):
         for epoch in range(self.n_epochs):
             approx_kls = []
             for batch in self.rollout_buffer.get(self.batch_size):
+                observations = batch.observations
+                anchor_rows = None
+                if cached:  # the anchor's rows of this minibatch, left out of the policy's input
+                    assert isinstance(observations, dict)
+                    observations = dict(observations)
+                    anchor_rows = observations.pop(ANCHOR_PROBS), observations.pop(ANCHOR_LOGITS)
                 actions = batch.actions
                 if isinstance(self.action_space, spaces.Discrete):
                     actions = actions.long().flatten()
                 masks: Any = batch.action_masks  # a tensor: apply_masking takes it too
-                dist = policy.get_distribution(batch.observations, action_masks=masks)
-                values = policy.predict_values(batch.observations).flatten()
+                dist = policy.get_distribution(observations, action_masks=masks)
+                values = policy.predict_values(observations).flatten()
                 log_prob = dist.log_prob(actions)
                 entropy = dist.entropy()
 
@@ -242,11 +299,14 @@ class AnchoredMaskablePPO(MaskablePPO):
                 else:  # critic warm-up
                     loss = self.vf_coef * value_loss
                 if self.anchor is not None:
-                    with torch.no_grad():
-                        anchor_dist = self.anchor.get_distribution(
-                            batch.observations, action_masks=masks
-                        )
-                    kl = masked_kl(anchor_dist, dist).mean()
+                    if anchor_rows is not None:
+                        kl = kl_from_anchor_rows(*anchor_rows, dist).mean()
+                    else:
+                        with torch.no_grad():
+                            anchor_dist = self.anchor.get_distribution(
+                                observations, action_masks=masks
+                            )
+                        kl = masked_kl(anchor_dist, dist).mean()
                     stats["kl_to_anchor"].append(kl.item())
                     if kl_weight > 0 and actor_scale > 0:
                         loss = loss + kl_weight * kl
@@ -286,6 +346,10 @@ class AnchoredMaskablePPO(MaskablePPO):
 
         self.n_train_calls += 1
         buffer = self.rollout_buffer
+        if cached:
+            kept: Any = buffer.observations
+            for key in (ANCHOR_PROBS, ANCHOR_LOGITS):
+                kept.pop(key)
         explained_var = explained_variance(buffer.values.flatten(), buffer.returns.flatten())
         for name, values_ in stats.items():
             self.logger.record(f"train/{name}", float(np.mean(values_)))

@@ -231,6 +231,24 @@ def test_the_anchor_holds_the_policy_near_the_cloned_one():
     assert kls[1] < 0.2 * kls[0]
 
 
+def test_the_anchor_run_once_per_rollout_trains_as_once_per_minibatch(monkeypatch):
+    """The anchor's distribution kept per rollout sample gives the same update, bit for bit, as
+    the anchor run on each minibatch (the policy's samples do not depend on their batch)."""
+    trained = []
+    for cached in (True, False):
+        if not cached:
+            monkeypatch.setattr(AnchoredMaskablePPO, "_cache_anchor_rows", lambda self: False)
+        model = make_model(kl_coef=5.0, n_steps=24, batch_size=8, n_epochs=3)
+        model.set_anchor()
+        model.learn(48)
+        assert set(model.rollout_buffer.observations) == set(FakeRegions().observation_space)
+        trained.append(
+            (params_of(model.policy.parameters()), model.logger.name_to_value["train/kl_to_anchor"])
+        )
+    assert trained[0][1] > 0  # the policy moved off its anchor
+    assert same(trained[0][0], trained[1][0]) and trained[0][1] == trained[1][1]
+
+
 def test_the_kl_weight_halves_every_half_life_after_the_critic_warm_up():
     model = make_model(critic_warmup_updates=3, kl_coef=2.0, kl_half_life_updates=4)
     assert model.kl_weight(0) == model.kl_weight(3) == 2.0
