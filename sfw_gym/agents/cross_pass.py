@@ -30,7 +30,7 @@ from numba import njit
 from scipy import ndimage
 
 from sfw_gym.agents.base import RobotView
-from sfw_gym.agents.frontier import FrontierAgent, FrontierSettings, Goal
+from sfw_gym.agents.frontier import _UNCERTAIN, FrontierAgent, FrontierSettings, Goal
 from sfw_gym.core.config import setting
 from sfw_gym.mapping.grid import GridSpec
 from sfw_gym.navigation.planning import CostField, belief_classes, mark_disk
@@ -52,6 +52,9 @@ class CrossPassSettings(FrontierSettings):
             ``1 + band_bonus`` times (the main route favours the bands).
         wall_loss_db: Loss per believed wall in the zone model (a prior).
         pass_spacing_m: No new pass within this distance of an earlier one.
+        search_radius_m: The first path search's bound (see :class:`FrontierSettings`); a plan
+            is kept on it only when no band cell lies within ``pass_trigger_m``, which it can
+            tell only when it reaches that far (it does by default).
     """
 
     band_m: float = setting(0.8, ge=0.05)
@@ -63,6 +66,7 @@ class CrossPassSettings(FrontierSettings):
     band_bonus: float = setting(2.0, ge=0.0)
     wall_loss_db: float = setting(10.0, ge=0.0)
     pass_spacing_m: float = setting(3.0, ge=0.0)
+    search_radius_m: float = setting(5.0, gt=0.0)
 
 
 class CrossPassAgent(FrontierAgent):
@@ -72,7 +76,6 @@ class CrossPassAgent(FrontierAgent):
     """
 
     name = "cross-pass"
-    _bounded_search = False
     _committed_kinds = ("pass",)
 
     settings_class = CrossPassSettings
@@ -113,11 +116,21 @@ class CrossPassAgent(FrontierAgent):
     def _choose_goal(self, view: RobotView, paths: CostField) -> Goal | None:
         if len(view.routers_xy) > 1:
             self._update_zones(view)
-            goal = self._pass_goal(view, paths)
-            if goal is not None:
+            if not paths.complete:
+                if self._pass_may_be_due(view, paths):
+                    return _UNCERTAIN  # passes are planned on the whole map's paths
+            elif (goal := self._pass_goal(view, paths)) is not None:
                 self.n_passes += 1
                 return goal
         return super()._choose_goal(view, paths)
+
+    def _pass_may_be_due(self, view: RobotView, paths: CostField) -> bool:
+        """Whether a bounded search cannot rule out a pass: a band target within the trigger
+        (or the search stopped short of the trigger)."""
+        trigger = self.settings.pass_trigger_m
+        if paths.max_cost_m < trigger:
+            return True
+        return bool(self.unknown_band(view, within=paths.cumulative <= trigger).any())
 
     def _utilities(
         self, view: RobotView, clusters: list[np.ndarray], path_m: np.ndarray

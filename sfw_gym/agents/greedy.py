@@ -84,10 +84,9 @@ class GreedyInfoGainAgent(FrontierAgent):
             self._stop("all_blacklisted")
             return None
         score = bits_per_metre(menu, self.settings.distance_offset_m)
-        self.candidates = [
-            ((int(r), int(c)), s)
-            for (r, c), s in zip(menu.target_rc.tolist(), score.tolist(), strict=True)
-        ]
+        self.candidates = list(
+            zip(map(tuple, menu.target_rc.tolist()), score.tolist(), strict=True)
+        )
         i = int(np.argmax(score))
         self._log_decision(menu, i)
         self._resume()
