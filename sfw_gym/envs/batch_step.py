@@ -36,7 +36,13 @@ from sfw_gym.envs.map_tracker import (
     _WALL_NEAR,
 )
 from sfw_gym.envs.map_tracker import _apply as _track_changes
-from sfw_gym.envs.observation import RSSI_FLOOR_DBM, RSSI_SPAN_DB, TRAJECTORY_U8, draw_rest_into
+from sfw_gym.envs.observation import (
+    RSSI_FLOOR_DBM,
+    RSSI_SPAN_DB,
+    TRAJECTORY_U8,
+    copy_into,
+    draw_rest_into,
+)
 from sfw_gym.mapping.sparse import _S_ENTROPY, _S_N_CHANGED, _S_N_TOUCHED, _update_kernel
 from sfw_gym.world import robot as robot_module
 from sfw_gym.world.radio import _rssi_range
@@ -291,7 +297,7 @@ def sense_and_map(
         rows, cols = int(c[GRID_ROWS]), int(c[GRID_COLS])
         cr = min(max(int((py - c[GY0]) / c[GRID_RES]), 0), rows - 1)
         cc = min(max(int((px - c[GX0]) / c[GRID_RES]), 0), cols - 1)
-        obs_map[i, 0] = belief_px
+        copy_into(obs_map[i, 0], belief_px)
         draw_rest_into(
             maps[2].reshape((rows, cols)), trajectory, router_px, pr, pc, cr, cc,
             int(c[OBS_CROP]), obs_map[i], obs_local[i],

@@ -207,15 +207,30 @@ def draw_rest_into(
 ) -> None:
     """Write every part of :func:`_draw`'s ``map`` image but its belief channel ``image[0]``
     (the caller's), and the ``local`` crop."""
-    image[1] = trajectory
-    image[2] = routers
+    copy_into(image[1], trajectory)
+    copy_into(image[2], routers)
     image[1, max(r - 1, 0) : r + 2, max(c - 1, 0) : c + 2] = ROBOT_U8
     rows, cols = belief.shape
     half = crop // 2
-    local[:] = U8_UNKNOWN
+    flat_local = local.reshape(-1)
+    for k in range(flat_local.shape[0]):
+        flat_local[k] = U8_UNKNOWN
     c0 = cc - half  # belief column of the crop's first column
     j0, j1 = max(0, -c0), min(crop, cols - c0)  # the crop's columns inside the grid
     for i in range(crop):
         br = cr + i - half
         if 0 <= br < rows and j0 < j1:
-            local[0, i, j0:j1] = belief[br, c0 + j0 : c0 + j1]
+            out = local[0, i]
+            row = belief[br]
+            for j in range(j0, j1):
+                out[j] = row[c0 + j]
+
+
+@njit(cache=True)
+def copy_into(dst: np.ndarray, src: np.ndarray) -> None:
+    """``dst[...] = src`` for C-contiguous arrays of one shape, as one flat loop (numba's
+    array assignment steps through every dimension, several times slower)."""
+    flat_dst = dst.reshape(-1)
+    flat_src = src.reshape(-1)
+    for k in range(flat_dst.shape[0]):
+        flat_dst[k] = flat_src[k]
