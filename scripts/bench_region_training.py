@@ -2,17 +2,18 @@
 ppo_mask --env SfW-ExploreRegions-v0``, two code trees run alternately in one session, so a
 neighbour's load falls on both alike.
 
-    python scripts/bench_region_training.py --before /tmp/before --timesteps 1200 --rounds 2
+    python scripts/bench_region_training.py --before /tmp/before --timesteps 600 --rounds 3
 
 Each run is ``sfw-gym train`` (``sfw_gym.cli.main``) in a fresh process whose ``PYTHONPATH`` is
 the tree (started outside the repository, so that the tree, not the working directory, is
-imported), with that tree's own ``ppo_mask.yml`` less its ``behaviour_cloning`` block: the figure
-is PPO's (``model.learn``: rollouts and updates) on a fresh policy. Two figures per run: decisions
-per second of the learn call's wall time (the run's ``config.yml``), and per second of its CPU
-time in the training process (``time.process_time`` around ``MaskablePPO.learn``), which a
-neighbour's load on a shared machine moves far less; with ``--vec-env subproc`` the workers' CPU
-is not in it. ``--before-args``/``--after-args`` add ``sfw-gym train`` options to one side
-(``--after-args "--vec-env subproc"``).
+imported), with that tree's own ``ppo_mask.yml`` less its ``behaviour_cloning`` block and with no
+critic warm-up (4 of a 30,000-decision run's 50 updates; a short run would be all warm-up, whose
+updates skip the actor's backward pass): PPO (``model.learn``: rollouts and updates) on a fresh
+policy. Two figures per run: decisions per second of the learn call's wall time (the run's
+``config.yml``), and per second of its CPU time in the training process (``time.process_time``
+around ``MaskablePPO.learn``), which a neighbour's load on a shared machine moves far less (with
+``--vec-env subproc`` the workers' CPU is not in it). ``--before-args``/``--after-args`` add
+``sfw-gym train`` options to one side (``--after-args "--vec-env subproc"``).
 """
 
 from __future__ import annotations
@@ -34,9 +35,12 @@ REPO = Path(__file__).resolve().parents[1]
 
 
 def hyperparams_without_cloning(tree: Path, out: Path) -> Path:
-    """``tree``'s ppo_mask.yml without the region block's behaviour cloning, written to ``out``."""
+    """``tree``'s ppo_mask.yml without the region block's behaviour cloning and critic warm-up,
+    written to ``out``."""
     table = yaml.safe_load((tree / "agents" / "hyperparams" / "ppo_mask.yml").read_text())
-    table["sfw_gym"][ENV_ID].pop("behaviour_cloning", None)
+    block = table["sfw_gym"][ENV_ID]
+    block.pop("behaviour_cloning", None)
+    block.get("fine_tuning", {})["critic_warmup_updates"] = 0
     out.write_text(yaml.safe_dump(table))
     return out
 
