@@ -51,6 +51,7 @@ from sfw_gym.core.constants import U8_FREE_MIN, U8_WALL_MAX
 from sfw_gym.navigation.candidates import (
     GAIN_SCALE,
     POTENTIAL_SCALE,
+    CandidateGoals,
     CandidateSettings,
     GoalFinder,
     explore_lite_choice,  # noqa: F401  (re-exported: the teacher's choice, by its old home)
@@ -86,6 +87,9 @@ class Goal:
     steps_without_progress: int = 0
     bumps: int = 0
 
+
+#: The menu columns that explore_lite's utility reads.
+_FRONTIER_FEATURES = ("path_cost_m", "heading_change_rad", "cluster_size_m")
 
 #: What :meth:`FrontierAgent._choose_goal` returns when a bounded search cannot prove its choice.
 _UNCERTAIN = Goal((-1, -1), (-1, -1), "uncertain")
@@ -478,7 +482,7 @@ class FrontierAgent(Agent):
             self._stop("no_frontiers")
             return None
         menu = self.finder.find(
-            view, paths, sources=("frontier",), features=("path_cost_m", "heading_change_rad")
+            view, paths, sources=("frontier",), features=_FRONTIER_FEATURES
         )
         cost = menu.feature("path_cost_m") + self.settings.turn_cost_m_per_rad * menu.feature(
             "heading_change_rad"
@@ -488,14 +492,14 @@ class FrontierAgent(Agent):
         exact = paths.complete | (cost <= paths.max_cost_m)
         far = np.flatnonzero(~exact)
         bound = np.full(len(far), paths.max_cost_m)
-        beyond = self._utilities(view, [menu.clusters[i] for i in far], bound).max(initial=-np.inf)
+        beyond = self._menu_utilities(view, menu, far, bound).max(initial=-np.inf)
         for i in np.flatnonzero(exact & ~menu.valid):  # walled off on the belief map
             self.finder.mark_unreachable(
                 menu.clusters[i], self.steps + self.settings.unreachable_ttl_steps
             )
             self.n_blacklisted += 1
         ok = np.flatnonzero(exact & menu.valid)
-        u = self._utilities(view, [menu.clusters[i] for i in ok], cost[ok])
+        u = self._menu_utilities(view, menu, ok, cost[ok])
         self.candidates = list(
             zip(map(tuple, menu.target_rc[ok].tolist()), u.tolist(), strict=True)
         )
@@ -513,6 +517,18 @@ class FrontierAgent(Agent):
     def _utility(self, view: RobotView, cluster: np.ndarray, path_m: float) -> float:
         """explore_lite's utility of a frontier cluster (its ``(N, 2)`` cells) at ``path_m``."""
         return float(self._utilities(view, [cluster], np.array([path_m]))[0])
+
+    def _menu_utilities(
+        self, view: RobotView, menu: CandidateGoals, index: np.ndarray, path_m: np.ndarray
+    ) -> np.ndarray:
+        """:meth:`_utilities` of the menu's candidates ``index`` at ``path_m``: from the
+        clusters' sizes on the menu, unless a subclass weighs the clusters' cells."""
+        if type(self)._utilities is FrontierAgent._utilities:
+            size_m = menu.feature("cluster_size_m")[index]
+            return self.settings.gain_scale * size_m - self.settings.potential_scale * np.asarray(
+                path_m, np.float64
+            )
+        return self._utilities(view, [menu.clusters[i] for i in index], path_m)
 
     def _utilities(
         self, view: RobotView, clusters: list[np.ndarray], path_m: np.ndarray

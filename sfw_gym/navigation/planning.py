@@ -105,24 +105,26 @@ def update_wall_cost_term(
     recomputation)."""
     outer = radius_m + clearance_m
     lethal = 0.5 * resolution_m if lethal_radius_m is None else lethal_radius_m
-    reach = int(np.ceil(outer / resolution_m)) + 1
+    reach, offsets, dist = _band_offsets(float(resolution_m), float(outer))
+    _update_wall_term(
+        term, walls, changed, offsets, dist, reach, outer, clearance_m, inflation_cost, lethal
+    )
+
+
+@functools.lru_cache(maxsize=8)
+def _band_offsets(resolution_m: float, outer_m: float) -> tuple[int, np.ndarray, np.ndarray]:
+    """The cells nearer than ``outer_m`` to a cell, nearest first: their reach (cells), offsets
+    ``(K, 2)`` and distances (m) (read-only)."""
+    reach = int(np.ceil(outer_m / resolution_m)) + 1
     dr, dc = np.mgrid[-reach : reach + 1, -reach : reach + 1]
     dist = np.sqrt((dr * dr + dc * dc).astype(np.float64)).ravel() * resolution_m
-    near = dist < outer
+    near = dist < outer_m
     order = np.argsort(dist[near], kind="stable")  # nearest first: the first wall found is it
     offsets = np.stack([dr.ravel()[near], dc.ravel()[near]], axis=1)[order]
-    _update_wall_term(
-        term,
-        walls,
-        changed,
-        offsets,
-        dist[near][order],
-        reach,
-        outer,
-        clearance_m,
-        inflation_cost,
-        lethal,
-    )
+    out = offsets, dist[near][order]
+    for a in out:
+        a.flags.writeable = False
+    return reach, *out
 
 
 @njit(cache=True)
