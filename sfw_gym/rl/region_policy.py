@@ -225,7 +225,8 @@ class RegionsPolicy(MaskableMultiInputActorCriticPolicy):
     def actor_logits(self, obs: Mapping[str, torch.Tensor | np.ndarray]) -> torch.Tensor:
         """The unmasked logits ``(B, K)`` of a batch of raw observations (only
         :attr:`actor_keys` are read; ``true_map`` need not be there)."""
-        inputs = {k: torch.as_tensor(obs[k], device=self.device).float() for k in self.actor_keys}
+        device = self.device  # SB3 walks the parameters to find it: once per call
+        inputs = {k: torch.as_tensor(obs[k], device=device).float() for k in self.actor_keys}
         return self.heads.actor(inputs)
 
     def parameter_groups(self) -> dict[str, list[nn.Parameter]]:
