@@ -3,19 +3,24 @@ Gymnasium's ``SyncVectorEnv`` and ``AsyncVectorEnv``, each as a multiple of one 
 measured in the same run; and P processes each stepping a native N-env batch at once (issue 33).
 
 With ``--rounds R`` it times only one env and the native N-env batch, alternately in R rounds,
-and prints the median of the per-round ratios (a neighbour's load hits both sides of a round).
+and prints the median of the per-round ratios (a neighbour's load hits both sides of a round);
+``--against DIR`` times the code in DIR (say, a worktree of an older commit) in the same rounds.
 
     python scripts/bench_vector_envs.py --env SfW-Explore-v0 --num-envs 16 --steps 200
     python scripts/bench_vector_envs.py --floorplan ../shared/floorplans/houseexpo/PLAN.json
-    python scripts/bench_vector_envs.py --rounds 9 --steps 200
+    python scripts/bench_vector_envs.py --rounds 15 --steps 150 --clock cpu --against /tmp/before
 """
 
 from __future__ import annotations
 
 import argparse
 import multiprocessing
+import os
 import statistics
+import subprocess
+import sys
 import time
+from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
@@ -53,27 +58,75 @@ def _native_rate(job: tuple[str, int, int, dict[str, Any], Any]) -> float:
     return env_steps_per_s(gym.make_vec(env_id, num_envs=n, **kwargs), steps, n)
 
 
-def native_rounds(
-    env_id: str, n: int, steps: int, rounds: int, kwargs: dict[str, Any], clock_name: str
-) -> None:
-    """One env (``n * steps`` steps) and the native ``n``-env batch (``steps`` steps) timed
-    alternately; the per-round ratios' median."""
-    clock = time.process_time if clock_name == "cpu" else time.perf_counter
-    rates: dict[str, list[float]] = {"one env": [], f"{n} envs, native": []}
-    for _ in range(rounds):
-        one = gym.make(env_id, **kwargs)
-        rates["one env"].append(env_steps_per_s(one, n * steps, 1, clock))
-        vec = gym.make_vec(env_id, num_envs=n, **kwargs)
-        rates[f"{n} envs, native"].append(env_steps_per_s(vec, steps, n, clock))
-    ratios = [b / a for a, b in zip(*rates.values(), strict=True)]
-    print(f"{env_id}: env steps per {clock_name} second, median of {rounds} alternating rounds")
-    for name, values in rates.items():
-        print(f"  {name:34s} {statistics.median(values):10,.0f}")
-    q = statistics.quantiles(ratios, n=4) if rounds > 1 else ratios * 3
-    print(
-        f"  {n} envs native / one env: median {statistics.median(ratios):.2f}x "
-        f"(quartiles {q[0]:.2f}-{q[-1]:.2f})"
-    )
+def _clock(name: str) -> Any:
+    return time.process_time if name == "cpu" else time.perf_counter
+
+
+def serve(env_id: str, n: int, steps: int, kwargs: dict[str, Any], clock_name: str) -> None:
+    """A worker of ``--against``: for each line read ("one" or "vec"), time one env
+    (``n * steps`` steps) or the native ``n``-env batch (``steps`` steps) and print its rate."""
+    clock = _clock(clock_name)
+    env_steps_per_s(gym.make_vec(env_id, num_envs=n, **kwargs), 20, n)  # warm-up
+    print("ready", flush=True)
+    for line in sys.stdin:
+        if line.strip() == "one":
+            rate = env_steps_per_s(gym.make(env_id, **kwargs), n * steps, 1, clock)
+        else:
+            rate = env_steps_per_s(gym.make_vec(env_id, num_envs=n, **kwargs), steps, n, clock)
+        print(rate, flush=True)
+
+
+def native_rounds(args: argparse.Namespace, kwargs: dict[str, Any]) -> None:
+    """One env and the native batch timed alternately in ``args.rounds`` rounds, by this
+    checkout and, with ``--against DIR``, by the code in DIR (two worker processes taking turns);
+    prints the medians of the per-round rates and ratios."""
+    worker = [sys.executable, __file__, "--serve", "--env", args.env, "--num-envs",
+              str(args.num_envs), "--steps", str(args.steps), "--clock", args.clock]  # fmt: skip
+    if args.floorplan:
+        worker += ["--floorplan", args.floorplan]
+    trees = {"this checkout": str(Path(__file__).resolve().parents[1])}
+    if args.against:
+        trees[f"against {args.against}"] = str(Path(args.against).resolve())
+    workers = {
+        name: subprocess.Popen(
+            worker,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+            env={**os.environ, "PYTHONPATH": tree},
+        )
+        for name, tree in trees.items()
+    }
+    for w in workers.values():
+        assert w.stdout is not None and w.stdout.readline().strip() == "ready"
+    rates: dict[tuple[str, str], list[float]] = {(t, k): [] for t in trees for k in ("one", "vec")}
+    for _ in range(args.rounds):
+        for kind in ("one", "vec"):
+            for name, w in workers.items():
+                assert w.stdin is not None and w.stdout is not None
+                w.stdin.write(kind + "\n")
+                w.stdin.flush()
+                rates[name, kind].append(float(w.stdout.readline()))
+    for w in workers.values():
+        assert w.stdin is not None
+        w.stdin.close()
+        w.wait()
+    n = args.num_envs
+    print(f"{args.env}: env steps per {args.clock} second, medians of {args.rounds} rounds")
+    for name in trees:
+        one, vec = rates[name, "one"], rates[name, "vec"]
+        ratios = [b / a for a, b in zip(one, vec, strict=True)]
+        q = statistics.quantiles(ratios, n=4) if len(ratios) > 1 else ratios * 3
+        print(
+            f"  {name}: one env {statistics.median(one):,.0f}, {n} native "
+            f"{statistics.median(vec):,.0f}; {n} native / one env {statistics.median(ratios):.2f}x "
+            f"(quartiles {q[0]:.2f}-{q[-1]:.2f})"
+        )
+    if args.against:
+        this, other = trees
+        for kind in ("one", "vec"):
+            gain = [a / b for a, b in zip(rates[this, kind], rates[other, kind], strict=True)]
+            print(f"  {kind}: this checkout / against, median {statistics.median(gain):.2f}x")
 
 
 def main() -> None:
@@ -88,14 +141,18 @@ def main() -> None:
         "--clock",
         choices=("wall", "cpu"),
         default="wall",
-        help="with --rounds: wall time, or this process's CPU time (a machine others load)",
+        help="with --rounds: wall time, or the process's CPU time (a machine others load)",
     )
+    parser.add_argument("--against", default=None, help="with --rounds: the code in this dir too")
+    parser.add_argument("--serve", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     n, kwargs = args.num_envs, {} if args.floorplan is None else {"floorplan": args.floorplan}
-    env_steps_per_s(gym.make(args.env, **kwargs), 200, 1)  # warm-up: compiled kernels
     if args.rounds:
-        env_steps_per_s(gym.make_vec(args.env, num_envs=n, **kwargs), 20, n)  # warm-up
-        native_rounds(args.env, n, args.steps, args.rounds, kwargs, args.clock)
+        native_rounds(args, kwargs)
+        return
+    env_steps_per_s(gym.make(args.env, **kwargs), 200, 1)  # warm-up: compiled kernels
+    if args.serve:
+        serve(args.env, n, args.steps, kwargs, args.clock)
         return
     one = env_steps_per_s(gym.make(args.env, **kwargs), args.steps, 1)
     rows = [("one env", one)]

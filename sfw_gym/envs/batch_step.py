@@ -45,7 +45,7 @@ from sfw_gym.envs.observation import (
 )
 from sfw_gym.mapping.sparse import _S_ENTROPY, _S_N_CHANGED, _S_N_TOUCHED, _update_kernel
 from sfw_gym.world import robot as robot_module
-from sfw_gym.world.radio import _rssi_range
+from sfw_gym.world.radio import _rssi_range, crossing_scratch
 
 # A sub-env's scalar state: one row of `BatchStepper.state`.
 (X, Y, A, ODO_X, ODO_Y, ODO_T, BUMPED, CLEAR_X, CLEAR_Y, CLEAR_D, VX, VY, W, UNSYNCED, CALLBACK,
@@ -224,7 +224,7 @@ def sense_and_map(
         est_cls, truth_cls, near_wall, interior, found_by, offsets, counts = tracker
         belief_px, px_rows, px_cols, trajectory, router_px = builder
         rssi_rows, true_rows, odometry_rows, estimate_rows = history
-        pts, mean_db, true_k, rssi, readings = scratch
+        pts, mean_db, true_k, rssi, readings, crossings = scratch
         n_routers = routers.shape[0]
         if moved[n]:
             _odometry(s, c, normals)
@@ -236,7 +236,7 @@ def sense_and_map(
         pts[0, 0], pts[0, 1] = tx, ty
         _rssi_range(
             edges, edge_loss, wall_index, routers, pts, radio_params, tables, origin, spacing,
-            mean_db, true_k, 0, 1,
+            mean_db, true_k, 0, 1, crossings,
         )  # fmt: skip
         for r in range(n_routers):
             db = mean_db[0, r]
@@ -476,7 +476,7 @@ class BatchStepper:
              builder._trajectory, builder._routers),
             buffers,
             (np.zeros((1, 2)), np.zeros((1, n_r)), np.zeros((1, n_r), np.int32),
-             np.zeros(n_r, np.int32), np.zeros(n_r)),
+             np.zeros(n_r, np.int32), np.zeros(n_r), crossing_scratch(radio.floorplan.edges)),
             np.zeros(NORMALS_AHEAD),
         )  # fmt: skip
         if self.parts is None:

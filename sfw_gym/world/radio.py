@@ -179,9 +179,16 @@ def _bilinear(
     tables: np.ndarray, origin: np.ndarray, spacing: float, pts: np.ndarray
 ) -> np.ndarray:
     """Bilinear interpolation of (R, ny, nx) node tables at points (M, 2), clamped to the grid."""
+    out = np.empty((pts.shape[0], tables.shape[0]))
+    _bilinear_into(tables, origin, spacing, pts, out, 0, pts.shape[0])
+    return out
+
+
+@njit(cache=True)
+def _bilinear_into(tables, origin, spacing, pts, out, lo, hi):
+    """`_bilinear` at points lo..hi, written into those rows of ``out``."""
     n_r, ny, nx = tables.shape
-    out = np.empty((pts.shape[0], n_r))
-    for m in range(pts.shape[0]):
+    for m in range(lo, hi):
         fx = min(max((pts[m, 0] - origin[0]) / spacing, 0.0), nx - 1.000001)
         fy = min(max((pts[m, 1] - origin[1]) / spacing, 0.0), ny - 1.000001)
         i = int(fx)
@@ -192,20 +199,20 @@ def _bilinear(
             top = tables[r, j, i] * (1 - tx) + tables[r, j, i + 1] * tx
             bottom = tables[r, j + 1, i] * (1 - tx) + tables[r, j + 1, i + 1] * tx
             out[m, r] = top * (1 - ty) + bottom * ty
-    return out
 
 
 @njit(cache=True)
 def _rssi_range(
-    edges, edge_loss, index, routers, pts, params, tables, origin, spacing, rssi, k, lo, hi
-):
+    edges, edge_loss, index, routers, pts, params, tables, origin, spacing, rssi, k, lo, hi,
+    scratch,
+):  # fmt: skip
     """Mean RSSI and wall counts for points lo..hi: the whole model in one compiled loop
-    (``index``: the walls' `wall_index` around the routers, and the edges 0..E-1)."""
+    (``index``: the walls' `wall_index` around the routers, and the edges 0..E-1;
+    ``scratch``: `crossing_scratch`)."""
     tx, pl0, ten_n, d0, cap, min_piece = params
     starts, edge_ids, all_edges = index
-    ts = np.empty(edges.shape[0] + 1)
-    ids = np.empty(edges.shape[0] + 1, np.int64)
-    shadow = _bilinear(tables, origin, spacing, pts[lo:hi])
+    ts, ids = scratch
+    _bilinear_into(tables, origin, spacing, pts, rssi, lo, hi)  # the shadowing, added below
     for m in range(lo, hi):
         for r in range(routers.shape[0]):
             c, loss = cross_from_router(
@@ -225,7 +232,13 @@ def _rssi_range(
             )
             d = max(np.hypot(pts[m, 0] - routers[r, 0], pts[m, 1] - routers[r, 1]), d0)
             k[m, r] = c
-            rssi[m, r] = tx - (pl0 + ten_n * np.log10(d / d0)) - min(loss, cap) + shadow[m - lo, r]
+            rssi[m, r] = tx - (pl0 + ten_n * np.log10(d / d0)) - min(loss, cap) + rssi[m, r]
+
+
+@njit(cache=True)
+def crossing_scratch(edges):
+    """The wall crossings' scratch arrays (sorted crossings and their edges) for ``edges``."""
+    return np.empty(edges.shape[0] + 1), np.empty(edges.shape[0] + 1, np.int64)
 
 
 @njit(cache=True)
@@ -234,7 +247,7 @@ def _rssi(edges, edge_loss, index, routers, pts, params, tables, origin, spacing
     k = np.empty((pts.shape[0], routers.shape[0]), np.int32)
     _rssi_range(
         edges, edge_loss, index, routers, pts, params, tables, origin, spacing, rssi, k, 0,
-        len(pts),
+        len(pts), crossing_scratch(edges),
     )  # fmt: skip
     return rssi, k
 
@@ -260,6 +273,7 @@ def _rssi_parallel(edges, edge_loss, index, routers, pts, params, tables, origin
             k,
             c * 512,
             min(m, (c + 1) * 512),
+            crossing_scratch(edges),
         )
     return rssi, k
 
