@@ -25,6 +25,7 @@ from sfw_gym.agents import (
     known_agent,
     make_agent,
 )
+from sfw_gym.core.angles import wrap_angle
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.mapping import GridSpec
 from sfw_gym.navigation import (
@@ -39,7 +40,6 @@ from sfw_gym.navigation.planning import (
     cost_field,
     to_discrete,
     traversal_costs,
-    wrap_angle,
 )
 
 W, U, F = 0, 127, 255  # wall, unknown, free
