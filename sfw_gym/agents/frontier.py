@@ -495,7 +495,7 @@ class FrontierAgent(Agent):
         beyond = self._menu_utilities(view, menu, far, bound).max(initial=-np.inf)
         for i in np.flatnonzero(exact & ~menu.valid):  # walled off on the belief map
             self.finder.mark_unreachable(
-                menu.clusters[i], self.steps + self.settings.unreachable_ttl_steps
+                menu.clusters[int(i)], self.steps + self.settings.unreachable_ttl_steps
             )
             self.n_blacklisted += 1
         ok = np.flatnonzero(exact & menu.valid)

@@ -674,7 +674,7 @@ class _Clusters(Sequence[np.ndarray]):
     def __len__(self) -> int:
         return self._size
 
-    def __getitem__(self, i):  # type: ignore[override]
+    def __getitem__(self, i):
         if isinstance(i, slice):
             return tuple(self[j] for j in range(*i.indices(len(self))))
         if not -self._size <= i < self._size:
