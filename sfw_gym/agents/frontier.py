@@ -481,9 +481,7 @@ class FrontierAgent(Agent):
         if not self.finder.frontier(view).any():
             self._stop("no_frontiers")
             return None
-        menu = self.finder.find(
-            view, paths, sources=("frontier",), features=_FRONTIER_FEATURES
-        )
+        menu = self.finder.find(view, paths, sources=("frontier",), features=_FRONTIER_FEATURES)
         cost = menu.feature("path_cost_m") + self.settings.turn_cost_m_per_rad * menu.feature(
             "heading_change_rad"
         )
@@ -524,10 +522,7 @@ class FrontierAgent(Agent):
         """:meth:`_utilities` of the menu's candidates ``index`` at ``path_m``: from the
         clusters' sizes on the menu, unless a subclass weighs the clusters' cells."""
         if type(self)._utilities is FrontierAgent._utilities:
-            size_m = menu.feature("cluster_size_m")[index]
-            return self.settings.gain_scale * size_m - self.settings.potential_scale * np.asarray(
-                path_m, np.float64
-            )
+            return self._size_utilities(menu.feature("cluster_size_m")[index], path_m)
         return self._utilities(view, [menu.clusters[i] for i in index], path_m)
 
     def _utilities(
@@ -535,9 +530,12 @@ class FrontierAgent(Agent):
     ) -> np.ndarray:
         """:meth:`_utility` of each cluster at its ``path_m``."""
         size_m = np.array([len(c) for c in clusters], np.int64) * view.grid.resolution_m
-        return self.settings.gain_scale * size_m - self.settings.potential_scale * np.asarray(
-            path_m, np.float64
-        )
+        return self._size_utilities(size_m, path_m)
+
+    def _size_utilities(self, size_m: np.ndarray, path_m: np.ndarray) -> np.ndarray:
+        """explore_lite's utility of clusters of ``size_m`` metres at ``path_m``."""
+        gain = self.settings.gain_scale * np.asarray(size_m, np.float64)
+        return gain - self.settings.potential_scale * np.asarray(path_m, np.float64)
 
     def _sweep_goal(self, view: RobotView, paths: CostField) -> Goal | None:
         """Fallback: the reachable cell farthest from the path so far (keeps the rays sweeping)."""

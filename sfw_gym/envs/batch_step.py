@@ -220,7 +220,7 @@ def sense_and_map(
         _, radio, mapper, tracker, builder, history, scratch, normals = parts[i]
         edges, edge_loss, wall_index, routers, radio_params, tables, origin, spacing = radio
         (routers_g, policy_all, extend, map_params, kest, feature, k_est, selected, dist_buf,
-         maps, track, ray, anchors) = mapper  # fmt: skip
+         raster, maps, track, ray, anchors) = mapper  # fmt: skip
         est_cls, truth_cls, near_wall, interior, found_by, offsets, counts = tracker
         belief_px, px_rows, px_cols, trajectory, router_px = builder
         rssi_rows, true_rows, odometry_rows, estimate_rows = history
@@ -272,7 +272,8 @@ def sense_and_map(
                 readings[r] = rssi[r]
             gain, due[n] = _update_kernel(
                 gx, gy, readings, s[BUMPED] != 0.0, pt, routers_g, policy_all, extend,
-                map_params, kest, feature, k_est, selected, dist_buf, maps, track, ray, anchors,
+                map_params, kest, feature, k_est, selected, dist_buf, raster, maps, track, ray,
+                anchors,
             )  # fmt: skip
             s[N_UPDATES] += 1.0
             _redraw_touched(track, maps[2], int(c[GRID_COLS]), belief_px, px_rows, px_cols)
@@ -467,7 +468,8 @@ class BatchStepper:
              *map(_read_only, (radio.routers, radio._params, table, origin)), float(spacing)),
             (mapper._routers_g, bool(mapper._policy_all), bool(mapper.config.extend_past_robot),
              mapper._params, _float_tuple(mapper._kest), ke._feature, ke._k, mapper._selected,
-             mapper._dist, mapper._maps, mapper._track, mapper._ray, mapper._anchors),
+             mapper._dist, mapper._raster, mapper._maps, mapper._track, mapper._ray,
+             mapper._anchors),
             (tracker._est_cls, tracker._truth_cls, tracker._near_wall, tracker._interior,
              tracker._found_by, tracker._offsets, tracker._counts),
             (builder.image_of(mapper.occupancy_u8),

@@ -83,19 +83,8 @@ _S_ENTROPY, _S_UID, _S_PREV_X, _S_PREV_Y, _S_HAS_PREV, _S_N_TOUCHED, _S_N_CHANGE
     _P_LMAX,
     _P_GAP,
     _P_CAP,
-    _P_ROWS,
-    _P_COLS,
-) = range(15)
-# The kernel's per-cell state, laid out for the cache: a ray visits cells far apart in memory,
-# and reads each cell's log-odds, class and trajectory features together. `cells` (n_cells,
-# 2 + R) float32 holds the log-odds, the class (-1: outside ``outer_bounds_m``, never updated)
-# and the feature each router's trajectory raster stores there (NaN: not visited); `entropy`
-# (n_cells, 2) float64 the cell's entropy and the update that last touched it; `visited`
-# (R, ceil(n_cells / 64)) int64 one bit per cell with a feature, so that a ray finds its
-# trajectory points in a few kilobytes instead of reading every cell it crosses.
-_C_LO, _C_CLS, _C_FEATURE = 0, 1, 2
-_E_BITS, _E_STAMP = 0, 1
-_CLS_OUTSIDE = -1
+) = range(13)
+# Cell classes kept in `cls`.
 
 
 @njit(cache=True)
@@ -122,30 +111,30 @@ def _apply(cell, delta, cap, lmin, maps, track):
     ``cap`` (nor lowers one already above it). Keeps the cell's entropy and uint8 value current
     and records the cell (with its class before this update) the first time it is touched.
     """
-    cells, entropy, u8, _, _ = maps
+    lo, ent, u8, cls, _, inside, stamp = maps
     touched, old_cls, _, state = track
-    if cells[cell, _C_CLS] == _CLS_OUTSIDE:
+    if not inside[cell]:
         return 0.0
-    old = cells[cell, _C_LO]
+    old = lo[cell]
     if delta > 0.0:
         new = np.float32(min(old + delta, max(old, cap)))
     else:
         new = np.float32(max(old + delta, lmin))
     if new == old:
         return 0.0
-    uid = state[_S_UID]
-    if entropy[cell, _E_STAMP] != uid:
+    uid = np.int64(state[_S_UID])
+    if stamp[cell] != uid:
         n = np.int64(state[_S_N_TOUCHED])
-        entropy[cell, _E_STAMP] = uid
+        stamp[cell] = uid
         touched[n] = cell
-        old_cls[n] = np.int8(cells[cell, _C_CLS])
+        old_cls[n] = cls[cell]
         state[_S_N_TOUCHED] = n + 1
-    cells[cell, _C_LO] = new
+    lo[cell] = new
     a = abs(np.float64(new))
     e = np.exp(-a)
     h = (np.log1p(e) + a * e / (1.0 + e)) / _LN2
-    gain = entropy[cell, _E_BITS] - h
-    entropy[cell, _E_BITS] = h
+    gain = ent[cell] - h
+    ent[cell] = h
     p_free = e / (1.0 + e) if new >= 0.0 else 1.0 / (1.0 + e)
     u8[cell] = min(int(255.0 * p_free), 255)
     return gain
@@ -155,7 +144,7 @@ def _apply(cell, delta, cap, lmin, maps, track):
 def _wall_piece(s_a, s_b, dk, j0, j1, ray, l_tot, n_cols, params, maps, track):
     """Eq. 6 over ray cells ``j0..j1-1`` for an interval ``[s_a, s_b]`` holding ``dk`` walls."""
     rows, cols, t0, t1 = ray
-    cells = maps[0]
+    lo = maps[0]
     res = params[_P_RES]
     sub = (s_b - s_a) / dk
     sigma = max(params[_P_SMIN] / res, params[_P_SFRAC] * sub)
@@ -176,13 +165,13 @@ def _wall_piece(s_a, s_b, dk, j0, j1, ray, l_tot, n_cols, params, maps, track):
         delta = np.log(p / (1.0 - p))
         cap = min(lmax, cap_factor * delta)
         cell = rows[j] * n_cols + cols[j]
-        if cells[cell, _C_LO] < cap:
+        if lo[cell] < cap:
             gain += _apply(cell, delta, cap, lmin, maps, track)
     return gain
 
 
 @njit(cache=True)
-def _wall_candidates(j0, j1, dk, s_mid, ray, l_tot, cells, n_cols):
+def _wall_candidates(j0, j1, dk, s_mid, ray, l_tot, cls, n_cols):
     """Ray cells ``[j_lo, j_hi)`` where the walls of a piece can be (not known free).
 
     One wall (``dk == 1``): the longest run of cells not classified free (ties: the run nearest
@@ -192,10 +181,10 @@ def _wall_candidates(j0, j1, dk, s_mid, ray, l_tot, cells, n_cols):
     rows, cols, t0, t1 = ray
     if dk > 1:
         j_lo = j0
-        while j_lo < j1 and cells[rows[j_lo] * n_cols + cols[j_lo], _C_CLS] == CLASS_FREE:
+        while j_lo < j1 and cls[rows[j_lo] * n_cols + cols[j_lo]] == CLASS_FREE:
             j_lo += 1
         j_hi = j1
-        while j_hi > j_lo and cells[rows[j_hi - 1] * n_cols + cols[j_hi - 1], _C_CLS] == CLASS_FREE:
+        while j_hi > j_lo and cls[rows[j_hi - 1] * n_cols + cols[j_hi - 1]] == CLASS_FREE:
             j_hi -= 1
         return j_lo, j_hi
     best_lo = j0
@@ -203,11 +192,11 @@ def _wall_candidates(j0, j1, dk, s_mid, ray, l_tot, cells, n_cols):
     best_off = np.inf
     j = j0
     while j < j1:
-        if cells[rows[j] * n_cols + cols[j], _C_CLS] == CLASS_FREE:
+        if cls[rows[j] * n_cols + cols[j]] == CLASS_FREE:
             j += 1
             continue
         start = j
-        while j < j1 and cells[rows[j] * n_cols + cols[j], _C_CLS] != CLASS_FREE:
+        while j < j1 and cls[rows[j] * n_cols + cols[j]] != CLASS_FREE:
             j += 1
         off = abs(0.5 * (t0[start] + t1[j - 1]) * l_tot - s_mid)
         if j - start > best_hi - best_lo or (j - start == best_hi - best_lo and off < best_off):
@@ -218,28 +207,12 @@ def _wall_candidates(j0, j1, dk, s_mid, ray, l_tot, cells, n_cols):
 
 
 @njit(cache=True)
-def _set_feature(cells, visited, r, cell, f):
-    """Store router ``r``'s trajectory feature ``f`` at ``cell``, and its visited bit."""
-    cells[cell, _C_FEATURE + r] = f
-    bit = np.int64(1) << (cell & 63)
-    if f == f:
-        visited[r, cell >> 6] |= bit
-    else:
-        visited[r, cell >> 6] &= ~bit
-
-
-@njit(cache=True)
 def _push_anchors(
-    cells, visited_r, feature_col, n_cols, ray, l_tot, thresholds_r, n_thr_r, lo, hi, anc_j,
-    anc_s, anc_k, n_anc,
-):  # fmt: skip
+    raster_r, rows, cols, t0, t1, l_tot, thresholds_r, n_thr_r, lo, hi, anc_j, anc_s, anc_k, n_anc
+):
     """Append the visited ray cells lo..hi-1 (trajectory points) as anchors with their k."""
-    rows, cols, t0, t1 = ray
     for j in range(lo, hi):
-        cell = rows[j] * n_cols + cols[j]
-        if not (visited_r[cell >> 6] >> (cell & 63)) & 1:
-            continue
-        f = cells[cell, feature_col]
+        f = raster_r[rows[j], cols[j]]
         if f == f:  # visited (not NaN)
             anc_j[n_anc] = j
             anc_s[n_anc] = 0.5 * (t0[j] + t1[j]) * l_tot
@@ -258,6 +231,7 @@ def _ray_update(
     rgy,
     extend,
     params,
+    raster,
     thresholds,
     n_thr,
     maps,
@@ -268,9 +242,10 @@ def _ray_update(
     """Segment the ray of router ``r`` at earlier trajectory points and update every piece."""
     rows, cols, t0, t1 = ray
     anc_j, anc_s, anc_k = anchors
-    cells = maps[0]
-    n_rows = int(params[_P_ROWS])
-    n_cols = int(params[_P_COLS])
+    lo = maps[0]
+    cls = maps[3]
+    n_rows = raster.shape[1]
+    n_cols = raster.shape[2]
     dx = gx - rgx
     dy = gy - rgy
     dist = np.sqrt(dx * dx + dy * dy)
@@ -297,21 +272,43 @@ def _ray_update(
     anc_s[0] = 0.0
     anc_k[0] = 0
     n_anc = 1
-    feature_col = _C_FEATURE + r
-    visited_r = maps[4][r]
     n_anc = _push_anchors(
-        cells, visited_r, feature_col, n_cols, ray, l_tot, thresholds[r], n_thr[r], 0, i_r,
-        anc_j, anc_s, anc_k, n_anc,
-    )  # fmt: skip
+        raster[r],
+        rows,
+        cols,
+        t0,
+        t1,
+        l_tot,
+        thresholds[r],
+        n_thr[r],
+        0,
+        i_r,
+        anc_j,
+        anc_s,
+        anc_k,
+        n_anc,
+    )
     anc_j[n_anc] = i_r
     anc_s[n_anc] = dist
     anc_k[n_anc] = k_robot
     n_anc += 1
     if extend:
         n_anc = _push_anchors(
-            cells, visited_r, feature_col, n_cols, ray, l_tot, thresholds[r], n_thr[r], i_r + 1,
-            n, anc_j, anc_s, anc_k, n_anc,
-        )  # fmt: skip
+            raster[r],
+            rows,
+            cols,
+            t0,
+            t1,
+            l_tot,
+            thresholds[r],
+            n_thr[r],
+            i_r + 1,
+            n,
+            anc_j,
+            anc_s,
+            anc_k,
+            n_anc,
+        )
     rad = params[_P_RADIUS] / params[_P_RES]
     lmin = params[_P_LMIN]
     lmax = params[_P_LMAX]
@@ -329,14 +326,14 @@ def _ray_update(
         if dk == 0:
             for j in range(j0, j1):
                 cell = rows[j] * n_cols + cols[j]
-                if cells[cell, _C_LO] > lmin:  # cheap skip of saturated cells (most of them)
+                if lo[cell] > lmin:  # cheap skip of saturated cells (most of them)
                     gain += _apply(cell, free, lmax, lmin, maps, track)
         elif dk > 0:
             # A wall keeps a robot radius from every trajectory point (the router is none)
             # and lies where the map does not already know free space.
             s_a = anc_s[a] + (rad if a > 0 else 0.0)
             s_b = anc_s[a + 1] - rad
-            j_lo, j_hi = _wall_candidates(j0, j1, dk, 0.5 * (s_a + s_b), ray, l_tot, cells, n_cols)
+            j_lo, j_hi = _wall_candidates(j0, j1, dk, 0.5 * (s_a + s_b), ray, l_tot, cls, n_cols)
             if j_hi == j_lo:
                 continue
             s_a = max(s_a, t0[j_lo] * l_tot)
@@ -363,6 +360,7 @@ def _update_kernel(
     k_out,
     selected,
     dist_buf,
+    raster,
     maps,
     track,
     ray,
@@ -375,11 +373,11 @@ def _update_kernel(
             return np.nan, False
     thresholds = kest[KERNEL_ARG_THRESHOLDS]
     n_thr = kest[KERNEL_ARG_N_THR]
-    cells, _, u8, classified, visited = maps
+    lo, _, u8, cls, classified, _, _ = maps
     touched, old_cls, changed, state = track
     rows, cols, t0, t1 = ray
-    n_rows = int(params[_P_ROWS])
-    n_cols = int(params[_P_COLS])
+    n_rows = raster.shape[1]
+    n_cols = raster.shape[2]
     n_r = rssi.shape[0]
     res = params[_P_RES]
     lmin = params[_P_LMIN]
@@ -404,8 +402,8 @@ def _update_kernel(
         for j in range(c_lo, c_hi + 1):
             ddx = j + 0.5 - gx
             ddy = i + 0.5 - gy
-            if (ddx * ddx + ddy * ddy <= rad * rad or (i == rr and j == rc)) and cells[
-                i * n_cols + j, _C_LO
+            if (ddx * ddx + ddy * ddy <= rad * rad or (i == rr and j == rc)) and lo[
+                i * n_cols + j
             ] > lmin:
                 gain += _apply(i * n_cols + j, foot, lmax, lmin, maps, track)
     if bumped and heading == heading:
@@ -440,6 +438,7 @@ def _update_kernel(
             routers_g[r, 1],
             extend,
             params,
+            raster,
             thresholds,
             n_thr,
             maps,
@@ -459,8 +458,8 @@ def _update_kernel(
             continue
         f = np.float32(feature[r])
         for j in range(n_traj):
-            _set_feature(cells, visited, r, rows[j] * n_cols + cols[j], f)
-        _set_feature(cells, visited, r, rr * n_cols + rc, f)
+            raster[r, rows[j], cols[j]] = f
+        raster[r, rr, rc] = f
     state[_S_PREV_X] = gx
     state[_S_PREV_Y] = gy
     state[_S_HAS_PREV] = 1.0
@@ -469,7 +468,7 @@ def _update_kernel(
     for i in range(np.int64(state[_S_N_TOUCHED])):
         cell = touched[i]
         c = u8_class(u8[cell])
-        cells[cell, _C_CLS] = c
+        cls[cell] = c
         classified[cell] = c != CLASS_UNKNOWN
         if c != old_cls[i]:
             changed[n_c] = cell
@@ -526,8 +525,6 @@ class SparseInverseKVisibility:
                 cfg.log_odds_max,
                 cfg.trajectory_gap_max_m,
                 cfg.wall_cap_factor,
-                grid.shape[0],
-                grid.shape[1],
             ],
             dtype=np.float64,
         )
@@ -544,13 +541,22 @@ class SparseInverseKVisibility:
         ray_n = ray_buffer_size(grid.shape)
         rad_cells = math.ceil(cfg.robot_radius_m / grid.resolution_m) + 2
         touched_cap = (2 * rad_cells + 1) ** 2 + 2 + n_r * ray_n
-        self._cells = np.empty((n_cells, _C_FEATURE + n_r), np.float32)
-        self._entropy = np.empty((n_cells, 2), np.float64)
+        self._lo = np.zeros(n_cells, np.float32)
+        self._ent = np.ones(n_cells, np.float64)
         self._u8 = np.full(n_cells, U8_UNKNOWN, np.uint8)
+        self._cls = np.zeros(n_cells, np.int8)
         self._classified = np.zeros(n_cells, np.bool_)
         self._inside = inside
-        self._visited = np.empty((n_r, (n_cells + 63) // 64), np.int64)
-        self._maps = (self._cells, self._entropy, self._u8, self._classified, self._visited)
+        self._stamp = np.zeros(n_cells, np.int64)
+        self._maps = (
+            self._lo,
+            self._ent,
+            self._u8,
+            self._cls,
+            self._classified,
+            inside,
+            self._stamp,
+        )
         self._changed = np.empty(touched_cap, np.int64)
         self._state = np.zeros(7, np.float64)
         self._track = (
@@ -570,21 +576,23 @@ class SparseInverseKVisibility:
             np.empty(ray_n + 2, np.float64),
             np.empty(ray_n + 2, np.int64),
         )
+        self._raster = np.full((n_r, h, w), np.nan, np.float32)
         self._selected = np.zeros(n_r, np.int64)
         self._dist = np.empty(n_r, np.float64)
-        self._make_views()
+        self._lo_view = self._read_only(self._lo)
+        self._u8_view = self._read_only(self._u8)
+        self._classified_view = self._read_only(self._classified)
         self.reset()
 
     def reset(self) -> None:
         """Forget the map, the trajectory and the k-estimator (in place: views stay valid)."""
-        self._cells[:, _C_LO] = 0.0
-        self._cells[:, _C_CLS] = np.where(self._inside, CLASS_UNKNOWN, _CLS_OUTSIDE)
-        self._cells[:, _C_FEATURE:] = np.nan
-        self._visited.fill(0)
-        self._entropy[:, _E_BITS] = 1.0
-        self._entropy[:, _E_STAMP] = 0.0
+        self._lo.fill(0.0)
+        self._ent.fill(1.0)
         self._u8.fill(U8_UNKNOWN)
+        self._cls.fill(CLASS_UNKNOWN)
         self._classified.fill(False)
+        self._raster.fill(np.nan)
+        self._stamp.fill(0)
         self._state.fill(0.0)
         self._state[_S_ENTROPY] = float(self._inside.sum())
         self._k_estimator.reset()
@@ -595,11 +603,6 @@ class SparseInverseKVisibility:
         view.flags.writeable = False
         return view
 
-    def _make_views(self) -> None:
-        self._lo_view = self._read_only(self._cells[:, _C_LO])
-        self._u8_view = self._read_only(self._u8)
-        self._classified_view = self._read_only(self._classified)
-
     def __getstate__(self) -> dict:
         # Views would unpickle as copies, cut off from the arrays they show: rebuild them.
         state = self.__dict__.copy()
@@ -609,7 +612,9 @@ class SparseInverseKVisibility:
 
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
-        self._make_views()
+        self._lo_view = self._read_only(self._lo)
+        self._u8_view = self._read_only(self._u8)
+        self._classified_view = self._read_only(self._classified)
 
     def update(
         self,
@@ -677,6 +682,7 @@ class SparseInverseKVisibility:
             ke._k,
             self._selected,
             self._dist,
+            self._raster,
             self._maps,
             self._track,
             self._ray,
@@ -742,6 +748,6 @@ class SparseInverseKVisibility:
 
     def recompute_entropy_bits(self) -> float:
         """Entropy recomputed from the whole map (for checks; O(cells))."""
-        a = np.abs(self._cells[:, _C_LO].astype(np.float64))[self._inside]
+        a = np.abs(self._lo.astype(np.float64))[self._inside]
         e = np.exp(-a)
         return float(((np.log1p(e) + a * e / (1.0 + e)) / _LN2).sum())
