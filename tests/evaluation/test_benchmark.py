@@ -13,6 +13,7 @@ from pathlib import Path
 
 import gymnasium as gym
 import pytest
+import yaml
 
 from sfw_gym.cli import main
 from sfw_gym.core.data import data_path
@@ -96,6 +97,11 @@ def test_a_folder_of_another_run_is_refused(tmp_path, capsys):
     out = ["--out", str(tmp_path)]
     assert main(["benchmark", "--agent", "random", *common, *out]) == 0
     capsys.readouterr()
+    # the run's files: one episode per env of the protocol, a table per env
+    results = bm.load_results(tmp_path / "results.json")
+    assert [r["env_id"] for r in results["episodes"]] == ["SfW-Explore-v0", "SfW-ExploreDrift-v0"]
+    table = (tmp_path / "results.md").read_text(encoding="utf-8")
+    assert "\n## SfW-ExploreDrift-v0 (1 episodes)\n\n| metric | value |\n|---|---:|\n" in table
     params = ["--agent-params", '{"hold_steps": 2}']
     assert main(["benchmark", "--agent", "random", *common, *out, *params]) == 2
     assert "holds another benchmark run (different agent_params)" in capsys.readouterr().err
@@ -187,3 +193,14 @@ def test_another_agent_seed_runs_its_own_episodes(tmp_path):
     b = json.loads((tmp_path / "1" / "results.json").read_text())
     assert a["agent_seed"] == 0 and b["agent_seed"] == 1
     assert [r["coverage"] for r in a["episodes"]] != [r["coverage"] for r in b["episodes"]]
+
+
+def test_a_protocol_file_of_ones_own_runs_with_its_env_kwargs(tmp_path, capsys):
+    protocol = yaml.safe_load(data_path("envs", "benchmark-v1.yml").read_text(encoding="utf-8"))
+    protocol["envs"] = [{**protocol["envs"][0], "kwargs": {"max_steps": 7}}]
+    path = tmp_path / "short.yml"
+    path.write_text(yaml.safe_dump(protocol), encoding="utf-8")
+    results = bm.run_benchmark("random", protocol=path, out=tmp_path / "out", episodes=1)
+    assert [r["steps"] for r in results["episodes"]] == [7]  # the env's budget from kwargs
+    bar = capsys.readouterr().err  # the progress bar, on by default
+    assert "episodes" in bar and "1/1" in bar

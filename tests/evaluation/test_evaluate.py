@@ -71,6 +71,11 @@ def test_tiny_run_writes_table_curves_and_trajectories(tmp_path):
         "no_frontiers",
         "all_blacklisted",
     )
+    assert rec["terminated"] is False  # 40 steps do not reach the coverage target
+    # the map's entropy fell by the bits gained; per metre driven, what the reward pays for
+    assert rec["info_gain_total_bits"] > 0
+    gain = rec["info_gain_total_bits"] / rec["path_length_m"]
+    assert rec["info_gain_per_m"] == pytest.approx(gain)
 
 
 def test_menu_choosing_agents_report_through_one_decision_log(tmp_path):
@@ -180,6 +185,8 @@ def test_floorplan_folder_cycles_and_gif(tmp_path):
     import imageio.v3 as iio
 
     assert iio.imread(gif).ndim == 4  # several frames
+    assert iio.immeta(gif)["loop"] == 0  # played over and over, not once
+    assert [p.name for p in gif.parent.iterdir()] == ["random_0000.gif"]  # gif_episodes=1
 
 
 def test_bad_arguments_are_clear_errors(tmp_path):
@@ -299,6 +306,10 @@ def test_the_paired_ratio_of_means_resamples_the_pairs_together():
     assert d.low > 1.0 and d.resolved(+1) == "better" and d.text("{:.3f}").startswith("1.1")
     same = ev.compare_paired(a, a, ratio=True)
     assert (same.mean, same.low, same.high, same.resolved(+1)) == (1.0, 1.0, 1.0, "")
+    # two pairs already give an interval (the resamples: 12/10, 21/20 and the ratio of both)
+    two = ev.compare_paired([10.0, 20.0], [12.0, 21.0], ratio=True)
+    assert (two.low, two.mean, two.high) == pytest.approx((1.05, 1.1, 1.2))
+    assert ev.compare_paired([None], [1.0], ratio=True).ratio  # a ratio, even without pairs
 
 
 def test_one_metric_table_formats_every_table():

@@ -33,6 +33,9 @@ def test_resuming_with_other_settings_is_refused(tmp_path):
     more = ev.evaluate(["random", "frontier"], 2, seed=5, out=tmp_path, **TINY)  # extends the run
     assert len(more["records"]) == 4
     assert json.loads((tmp_path / "config.json").read_text())["agents"] == ["random", "frontier"]
+    ev.evaluate(["frontier"], 2, seed=5, out=tmp_path, **TINY)  # all ran: the manifest keeps both
+    config = json.loads((tmp_path / "config.json").read_text())
+    assert config["seed"] == 5 and config["agent_params"] == {"random": {}, "frontier": {}}
 
 
 def test_the_checkpoint_key_of_an_episode_is_the_one_earlier_runs_wrote():
