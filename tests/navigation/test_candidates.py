@@ -181,6 +181,49 @@ def test_exclusion_at_frontier_cells_equals_the_full_computation():
     assert np.array_equal(finder.excluded_at(view, flat), full)
 
 
+def test_pockets_given_up_and_walled_off_cells_are_no_goals_by_hand():
+    """A pocket is an 8-connected unknown region smaller than ``min_unknown_region_m2`` (one of
+    exactly that area is not); cells given up or walled off are excluded until their step."""
+    b = np.full((20, 30), U8_FREE, np.uint8)
+    b[2:4, 2:4] = U8_UNKNOWN  # 4 cells = 0.04 m²: a pocket
+    b[2:4, 10:15] = U8_UNKNOWN  # 10 cells = 0.1 m², the minimum: no pocket
+    b[8:10, 2:4] = U8_UNKNOWN  # 4 cells ...
+    b[10:13, 4:6] = U8_UNKNOWN  # ... and 6 touching them at a corner: one region of 10 cells
+    view = view_of(b, xy=(2.5, 1.5))
+    finder = GoalFinder(CandidateSettings(min_unknown_region_m2=0.1))
+    finder.reset(view)
+    finder.set_step(0)
+    finder.blacklist((16, 20), 1.0, until_step=5)  # the cell and its 4 neighbours
+    finder.mark_unreachable(np.array([[5, 25]]), until_step=5)
+    excluded = finder.exclusion(view)
+    assert excluded[2:4, 2:4].all() and not excluded[2:4, 10:15].any()
+    assert not excluded[8:13, 2:6].any()
+    assert excluded[16, 19:22].all() and excluded[15:18, 20].all() and not excluded[16, 22]
+    assert excluded[5, 25] and not excluded[5, 24]  # walled off: that cell alone
+    assert excluded.sum() == 4 + 5 + 1
+    assert np.array_equal(finder.excluded_at(view, np.arange(b.size)), excluded.ravel())
+    finder.set_step(5)  # their time is up; the pocket stays
+    after = finder.exclusion(view)
+    assert after.sum() == 4 and after[2:4, 2:4].all()
+
+
+def test_greedy_takes_the_valid_goal_with_the_most_bits_per_metre():
+    from dataclasses import replace
+
+    from sfw_gym.navigation.candidates import greedy_choice
+
+    menu = candidate_goals(view_of(corridor(), xy=(0.25, 0.65)), max_candidates=8)
+    features = np.zeros((3, len(FEATURES)))
+    features[:, FEATURES.index("expected_gain_bits")] = [10.0, 14.0, 100.0]
+    features[:, FEATURES.index("path_cost_m")] = [0.0, 0.3, 0.0]
+    rc = np.zeros((3, 2), np.int64)
+    hand = replace(menu, target_rc=rc, goal_rc=rc, source=np.zeros(3, np.int64), features=features)
+    # bits ÷ (path + 0.3 m): 10 / 0.3 = 33 beats 14 / 0.6 = 23 (with 1 m: 10 against 10.8)
+    assert greedy_choice(replace(hand, valid=np.array([True, True, False]))) == 0
+    assert greedy_choice(replace(hand, valid=np.array([True, True, False])), 1.0) == 1
+    assert greedy_choice(replace(hand, valid=np.zeros(3, bool))) is None  # nothing reachable
+
+
 def test_unknown_names_are_refused():
     view = view_of(corridor(), xy=(0.25, 0.65))
     finder = GoalFinder()
