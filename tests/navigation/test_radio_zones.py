@@ -9,7 +9,7 @@ from scipy.spatial import cKDTree
 
 from sfw_gym.core.constants import NOT_HEARD_DBM
 from sfw_gym.mapping.grid import GridSpec
-from sfw_gym.navigation.radio_zones import router_scores, wall_crossings
+from sfw_gym.navigation.radio_zones import dominance_bands, router_scores, wall_crossings
 
 
 def wall_crossings_numpy(grid, walls, sources_xy, points_xy):
@@ -134,3 +134,20 @@ def test_router_scores_equal_the_vectorised_computation_bit_for_bit(seed):
         expected = router_scores_numpy(grid, routers, samples, rssi, walls)
         got = router_scores(grid, routers, samples, rssi, walls=walls)
         assert got.tobytes() == expected.tobytes()
+
+
+@pytest.mark.parametrize("axis", [0, 1])
+def test_the_band_follows_a_zone_border_whichever_way_it_runs(axis):
+    """Two routers' zones split at row (or column) 10 of a 20 × 20 grid: the band holds every
+    cell within 3 cells of the border, along its whole length."""
+    near = np.zeros((20, 20))
+    near[10:] = 1.0  # router 1 strongest from row 10 on
+    scores = np.stack([near, 1.0 - near]) if axis else np.stack([1.0 - near, near])
+    if axis:
+        scores = scores.transpose(0, 2, 1)  # the border runs along a column instead
+    zone, band = dominance_bands(scores, band_cells=3)
+    lines = band if axis == 0 else band.T
+    assert (lines[6:14].all(axis=1)).all() and not lines[:6].any() and not lines[14:].any()
+    assert zone.max() == 1 and (zone == 1).sum() == 200
+    flat = np.stack([near, near])  # equal everywhere: one zone, no border, no band
+    assert not dominance_bands(flat, band_cells=3)[1].any()
