@@ -38,6 +38,9 @@ def test_every_decision_lasts_decision_steps_until_the_episode_ends():
     assert sum(steps) == infos[-1]["summary"]["steps"]
     assert all(s == 20 for s in steps[:-1]) and 1 <= steps[-1] <= 20
     assert len(infos) <= -(-300 // 20)  # ≤ 150 on the default 3,000-step episodes
+    # a goal chosen inside a decision is driven over several steps, not chosen again every step
+    micro = [i["micro_decisions"] for i in infos]
+    assert all(m >= 1 for m in micro) and sum(micro) < sum(steps)
 
 
 @pytest.mark.parametrize("teacher", ["explore_lite", "greedy"])
