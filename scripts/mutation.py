@@ -4,6 +4,8 @@ Not run in CI (it takes minutes to hours). Run it from the repository root, nice
 
     nice -n 10 .venv/bin/python scripts/mutation.py --modules mapper radio navigation
     nice -n 10 .venv/bin/python scripts/mutation.py --modules agents env cli
+    nice -n 10 .venv/bin/python scripts/mutation.py --modules navigation \
+        --files sfw_gym/navigation/planning.py sfw_gym/navigation/regions.py   # some modules only
     .venv/bin/python scripts/mutation.py --report-only     # rewrite the table from mutants/ only
 
 How long it took (x86_64, 2 cores shared with other work, load ≈ 2, 2 workers, niced):
@@ -12,6 +14,9 @@ groups take ~0.1 s per mutant); ``--survivors`` after adding tests: under 1 min.
 and cli groups run integration tests (episodes, PPO, the CLI) per mutant: expect seconds per
 mutant, i.e. hours for a group; run one group at a time and use ``--survivors`` afterwards.
 Stats collection (one run of the groups' test files with mutmut's trampolines) comes first.
+Issue 39 (2026-11-27, load 5-7 from other work): evaluation, 180 sampled mutants of its 9 slow
+modules, 26 min; navigation with the agents' unit tests, 10-35 mutants/min (a full run of the
+four issue-39 modules, 2,358 mutants, would have taken over an hour, hence ``--sample``).
 
 What it does
 ------------
@@ -39,12 +44,16 @@ there; decorated functions are not mutated (the numba ``@njit`` kernels: they ar
 the dense oracle and hand-computed cases instead); ``conftest.HOUSEEXPO_DIR`` resolves to
 ``mutants/../shared`` = ``<repo>/shared``, which does not exist, so the three HouseExpo tests of
 test_floorplan.py skip under mutmut (no group here relies on them). Two mutmut 3.8 quirks this
-script works around: a file copied unmutated by a run of other groups is newer than its source,
-and mutmut then never mutates it (the script deletes such copies); and mutmut reuses its stats
-when the test selection is unchanged, so functions of a newly mutated file get "no tests" (the
-script deletes ``mutants/mutmut-stats.json`` before each run). A change of the test selection
-(another set of groups) makes mutmut reset every verdict in mutants/; the numbers of groups run
-earlier stay in ``scripts/mutation_results.json``.
+script works around: a file copied unmutated by a run of other groups (or other ``--files``) is
+newer than its source, and mutmut then never mutates it again (the script deletes such copies
+before a run of that file; mutmut keeps the verdicts of its unchanged functions); and mutmut
+reuses its stats when the test selection is unchanged, so functions of a newly mutated file get
+"no tests" (the script deletes ``mutants/mutmut-stats.json`` before each run, so mutmut also
+never sees a change of the test selection: verdicts in mutants/ stay until a run names them).
+The numbers of every group stay in ``scripts/mutation_results.json``.
+
+``--files`` runs some modules of a group (the rest keep their stored numbers), e.g. a full run of
+the fast modules and ``--sample`` of the slow ones of the same group, as for ``evaluation``.
 """
 
 from __future__ import annotations
@@ -88,13 +97,20 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
         ],
     ),
     "radio": (["sfw_gym/world/radio.py"], ["tests/world/test_radio.py"]),
+    # the navigation unit tests, the region env's (the one user of regions.py) and the agents'
+    # unit tests (frontier's approach cells, greedy's choice, cross-pass's dominance bands); the
+    # whole-episode agent tests are left out (seconds per mutant)
     "navigation": (
         sorted(str(p.relative_to(ROOT)) for p in (ROOT / "sfw_gym" / "navigation").glob("*.py")),
         [
-            "tests/navigation/test_planning.py",
+            "-m",
+            "not slow",
+            *sorted(
+                str(p.relative_to(ROOT)) for p in (ROOT / "tests" / "navigation").glob("test_*.py")
+            ),
+            "tests/envs/test_regions.py",
             "tests/agents/test_agents.py",
             "tests/agents/test_agent_rules.py",
-            "tests/envs/test_waypoint.py",
         ],
     ),
     "agents": (
@@ -117,6 +133,21 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
         ],
     ),
     "cli": (["sfw_gym/cli.py"], ["tests/cli/test_cli.py", "tests/cli/test_demo.py"]),
+    # the evaluation tests but the slow ones (whole benchmark runs, worker pools, a resumed run
+    # killed five times: minutes per mutant on 2 cores); fingerprints.py is run from the CLI
+    "evaluation": (
+        sorted(str(p.relative_to(ROOT)) for p in (ROOT / "sfw_gym" / "evaluation").glob("*.py")),
+        [
+            "-m",
+            "not slow",
+            *sorted(
+                str(p.relative_to(ROOT))
+                for p in (ROOT / "tests" / "evaluation").glob("test_*.py")
+                if p.name != "test_compare_runs.py"  # it tests scripts/, which mutants/ lacks
+            ),
+            "tests/cli/test_fingerprints_cli.py",
+        ],
+    ),
 }
 
 COLUMNS = ["mutants", "killed", "survived", "timeout", "no tests", "other", "equivalent"]
@@ -140,20 +171,29 @@ def module_name(path: str) -> str:
 
 
 def forget_unmutated_copies(files: list[str]) -> None:
-    """Delete ``mutants/<file>`` where mutmut has no meta file for it.
+    """Delete ``mutants/<file>`` where it holds no mutants.
 
-    A run of other groups copies this file into mutants/ unmutated (it is not in only_mutate),
-    and the copy is newer than the source, so mutmut would take it for an up-to-date mutated
-    file and generate no mutants for it (mutmut 3.8 compares mtimes only).
+    A run of other groups (or of other ``--files``) copies this file into mutants/ unmutated
+    (it is not in only_mutate), and mutmut 3.8 takes a copy newer than its source for an
+    up-to-date mutated file (it compares mtimes only): it would generate no mutants for it.
+    Deleting the copy makes mutmut generate them again; the verdicts in the file's meta are
+    kept for the functions whose source did not change.
     """
     for f in files:
         copy = ROOT / "mutants" / f
-        if copy.exists() and not (ROOT / "mutants" / (f + ".meta")).exists():
+        if copy.exists() and (
+            not (ROOT / "mutants" / (f + ".meta")).exists()
+            or "__mutmut_" not in copy.read_text(encoding="utf-8")
+        ):
             copy.unlink()
 
 
 def run_mutmut(
-    files: list[str], tests: list[str], max_children: int, names: list[str] | None = None
+    files: list[str],
+    tests: list[str],
+    max_children: int,
+    names: list[str] | None = None,
+    check: bool = True,
 ) -> float:
     """Run mutmut on ``files`` (every mutant, or only ``names``); return the wall time."""
     forget_unmutated_copies(files)
@@ -167,7 +207,7 @@ def run_mutmut(
     start = time.perf_counter()
     proc = subprocess.run([sys.executable, "-c", _BOOTSTRAP, payload], cwd=ROOT, check=False)
     wall = time.perf_counter() - start
-    if proc.returncode not in (0, None):
+    if check and proc.returncode not in (0, None):
         sys.exit(f"mutmut run failed with exit code {proc.returncode}")
     return wall
 
@@ -175,7 +215,8 @@ def run_mutmut(
 def sample_mutants(files: list[str], n: int, tests: list[str], max_children: int) -> list[str]:
     """``n`` mutant names per file, drawn with seed 0 (mutmut generates them first if needed)."""
     if not all(statuses(f) for f in files):
-        run_mutmut(files, tests, max_children, names=["none.such.mutant"])  # generate only
+        # generate only: mutmut then stops, with an error, as no mutant has that name
+        run_mutmut(files, tests, max_children, names=["none.such.mutant"], check=False)
     rng = random.Random(0)
     names: list[str] = []
     for f in files:
@@ -248,19 +289,36 @@ def wilson(c: dict[str, int]) -> tuple[float, float]:
     return centre - half, centre + half
 
 
+def group_record(rec: dict) -> dict:
+    """A group's stored numbers as ``{"modules": {path: counts}, "runs": [run, ...]}``.
+
+    A sampled module's counts carry ``sample_of`` (its number of mutants); each run names the
+    ``files`` it ran. Records written before ``--files`` existed (one run per group, a
+    group-wide ``sample``) are converted.
+    """
+    if "runs" in rec:
+        return rec
+    run = {k: v for k, v in rec.items() if k not in ("modules", "sample", "population")}
+    run["files"] = list(rec.get("modules", {}))
+    modules = {}
+    for path, c in rec.get("modules", {}).items():
+        modules[path] = dict(c)
+        if rec.get("sample"):
+            modules[path]["sample_of"] = rec.get("population", {}).get(path, "?")
+    return {"modules": modules, "runs": [run]}
+
+
 def table(results: dict) -> str:
     head = ["group", "module", *COLUMNS, "score"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * 2 + "---:|" * (len(head) - 2)]
     for group in GROUPS:
         if group not in results["groups"]:
             continue
-        run = results["groups"][group]
-        for path, c in run["modules"].items():
+        for path, c in results["groups"][group]["modules"].items():
             cell = f"{score(c):.1%}"
-            if run.get("sample"):
+            if "sample_of" in c:
                 low, high = wilson(c)
-                of = run.get("population", {}).get(path, "?")
-                cell += f" (95 % CI {low:.0%}–{high:.0%}; sample of {of})"
+                cell += f" (95 % CI {low:.0%}–{high:.0%}; sample of {c['sample_of']})"
             cells = [group, f"`{path}`", *(str(c[k]) for k in COLUMNS), cell]
             lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
@@ -268,9 +326,11 @@ def table(results: dict) -> str:
 
 def section(results: dict) -> str:
     runs: dict[str, list[str]] = {}  # run description -> groups (groups run together share one)
-    for g, r in results["groups"].items():
+    for g, r in ((g, r) for g, rec in results["groups"].items() for r in rec["runs"]):
         line = f"{r.get('command', '?')}: {r.get('n_mutants', '?')} mutants,"
-        line += f" {r.get('wall_s', 0.0) / 60:.1f} min wall, {r.get('date', '?')}"
+        if "wall_s" in r:
+            line += f" {r['wall_s'] / 60:.1f} min wall,"
+        line += f" {r.get('date', '?')}"
         line += f", {r.get('machine', '?')}"
         if "rerun" in r:
             line += f"; after the review, {r['rerun']}"
@@ -340,17 +400,30 @@ def main(argv: list[str] | None = None) -> int:
         "table then gives the score's 95 %% Wilson interval (for groups whose tests run whole "
         "episodes: all of their mutants take hours on 2 cores)",
     )
+    ap.add_argument(
+        "--files",
+        nargs="+",
+        metavar="SOURCE",
+        help="only these source files of the chosen groups (e.g. sfw_gym/navigation/regions.py);"
+        " the group's other modules keep their stored numbers",
+    )
     args = ap.parse_args(argv)
 
     import mutmut
 
     results = json.loads(RESULTS_FILE.read_text()) if RESULTS_FILE.exists() else {"groups": {}}
+    results["groups"] = {g: group_record(r) for g, r in results["groups"].items()}
     results["mutmut"] = mutmut.__version__
     equivalent = load_equivalent()
 
+    files = [f for g in args.modules for f in GROUPS[g][0]]
+    if args.files:
+        unknown = sorted(set(args.files) - set(files))
+        if unknown:
+            ap.error(f"not a source file of the groups {args.modules}: {', '.join(unknown)}")
+        files = [f for f in files if f in args.files]
     wall = None
     if not args.report_only:
-        files = [f for g in args.modules for f in GROUPS[g][0]]
         tests = [t for g in args.modules for t in GROUPS[g][1]]
         names = None
         if args.survivors:
@@ -368,34 +441,51 @@ def main(argv: list[str] | None = None) -> int:
             wall = run_mutmut(files, tests, args.max_children, names)
 
     command = f"`nice -n 10 .venv/bin/python scripts/mutation.py --modules {' '.join(args.modules)}"
+    command += f" --files {' '.join(args.files)}" if args.files else ""
     command += f" --sample {args.sample}`" if args.sample else "`"
+    fresh = wall is not None and not args.survivors  # a new run, not a rerun of survivors
     for group in args.modules:
+        group_files = [f for f in GROUPS[group][0] if f in files]
+        record = results["groups"].get(group, {"modules": {}, "runs": []})
         modules, survivors = {}, []
-        for path in GROUPS[group][0]:
+        for path in group_files:
             counts, open_mutants, stale = tally(path, equivalent)
             if counts["mutants"]:
                 modules[path] = counts
+                earlier = record["modules"].get(path, {})
+                if fresh and args.sample:
+                    counts["sample_of"] = len(statuses(path))
+                elif not fresh and "sample_of" in earlier:
+                    counts["sample_of"] = earlier["sample_of"]
             survivors += open_mutants
             for name in stale:
                 print(f"warning: {name} is listed as equivalent but was killed", file=sys.stderr)
         checked = any(c["mutants"] > c["other"] for c in modules.values())
         if not modules or (wall is None and not checked):
             continue  # nothing measured (or verdicts reset by a later run of other groups)
-        run = dict(results["groups"].get(group, {}))
         if wall is not None and args.survivors:
-            run["rerun"] = (
+            rerun = (
                 f"{command[:-1]} --survivors`: {len(names or [])} mutants not killed before,"
                 f" {wall / 60:.1f} min, {date.today()}"
             )
-        elif wall is not None:
+            for run in record["runs"]:
+                if set(run.get("files", [])) & set(group_files):
+                    run["rerun"] = rerun
+        elif fresh:
             run = {"command": command, "wall_s": round(wall, 1), "date": str(date.today())}
-            run["n_mutants"] = len(names) if names else sum(len(statuses(f)) for f in files)
+            run["n_mutants"] = sum(c["mutants"] for c in modules.values())
             run["machine"] = machine()
-            if args.sample:
-                run["sample"] = args.sample
-                run["population"] = {f: len(statuses(f)) for f in GROUPS[group][0]}
-        run["modules"] = modules
-        results["groups"][group] = run
+            run["files"] = list(modules)
+            # the runs whose modules this one measured again are replaced
+            record["runs"] = [
+                r for r in record["runs"] if not set(r.get("files", [])) <= set(modules)
+            ]
+            record["runs"].append(run)
+        if fresh and not args.files:
+            record["modules"] = modules
+        else:
+            record["modules"].update(modules)
+        results["groups"][group] = record
         if args.list_survivors:
             print(f"# {group}: not killed, not equivalent")
             print("\n".join(survivors) or "(none)")
