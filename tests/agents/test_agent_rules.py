@@ -254,3 +254,20 @@ def test_a_bounded_first_search_makes_the_same_choices_as_a_full_one(seed):
     (bounded, full_searches, plans), (unbounded, _, _) = runs
     assert 0 < full_searches < plans  # both ways of choosing happened
     assert np.array_equal(bounded, unbounded)
+
+
+def test_without_replanning_on_resolution_the_frontier_agent_drives_on_to_its_goal():
+    """``replan_when_resolved=False`` (explore_lite's way): a resolved target no longer triggers
+    a replan, so the same episode prefix takes fewer replans than with the default."""
+    plans = {}
+    for flag in (True, False):
+        env = gym.make("SfW-Explore-v0", max_steps=300)
+        obs, _ = env.reset(seed=4)
+        agent = FrontierAgent(replan_when_resolved=flag)
+        agent.reset(env, seed=4)
+        for _ in range(300):
+            obs, _, terminated, truncated, _ = env.step(agent.act(obs))
+            if terminated or truncated:
+                break
+        plans[flag] = agent.n_plans
+    assert plans[False] < plans[True]  # 205 against 247

@@ -287,15 +287,36 @@ def test_a_proven_bounded_choice_is_the_full_searchs_choice():
 
 
 def test_a_large_cluster_beyond_the_bound_is_not_ruled_out():
-    """A 1-cell frontier next to the robot and a 4 m one 3 m away: searched to 1 m, the near one
-    is the only exact candidate, but the far one could be better: not proven."""
-    b = corridor(free_cols=40, length=60)
-    b[5, 3] = U8_UNKNOWN  # a pocket-free frontier cell by the robot would be excluded: open one
-    b[1:13, 2] = U8_UNKNOWN
-    view = view_of(b, (0.45, 0.65))
+    """A 1.2 m frontier by the robot (at the corridor's west end) and a 5.8 m one 3.5 m east
+    (a tall room's far side): searched to 1 m, the near one is exact and best so far, but the
+    far one could be better. Not proven; on the whole map, the near one wins."""
+    b = np.full((60, 60), U8_WALL, np.uint8)
+    b[1:13, :40] = U8_FREE  # the corridor, rows 1-12
+    b[1:13, :5] = U8_UNKNOWN  # its west end, unknown (60 cells: no pocket)
+    b[1:59, 25:40] = U8_FREE  # a tall room at the corridor's east end
+    b[1:59, 40:59] = U8_UNKNOWN  # unknown beyond the room: a 5.8 m frontier
+    view = view_of(b, (0.65, 0.65), heading=math.pi)
     finder = GoalFinder()
     finder.reset(view)
     full, _ = _micro_choice(finder, view, np.inf, None)
-    _, ok = _micro_choice(finder, view, 1.0, None)
+    near, ok = _micro_choice(finder, view, 1.0, None)
+    assert near is not None and near[1] < 10  # the near cluster is exact within the bound
     assert not ok
-    assert full is not None
+    assert full == near
+
+
+def test_a_selected_menus_clusters_belong_to_their_candidates():
+    """With ``max_candidates`` the menu keeps some candidates: each kept frontier candidate's
+    cluster holds its target cell, and the other sources have none."""
+    from sfw_gym.bench import synthetic_view
+
+    view = synthetic_view(96, seed=5)
+    finder = GoalFinder()
+    finder.reset(view)
+    paths = cost_field(finder.costs(view), view.cell, view.grid.resolution_m)
+    menu = finder.find(view, paths, max_candidates=12)
+    frontier = menu.of("frontier")
+    assert len(frontier) >= 2 and len(menu.clusters) == len(menu)
+    for i in range(len(menu)):
+        cells = {tuple(c) for c in np.asarray(menu.clusters[i]).tolist()}
+        assert (tuple(menu.target_rc[i]) in cells) == (i in frontier)

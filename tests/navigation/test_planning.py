@@ -468,3 +468,14 @@ def test_a_bounded_search_in_a_large_grid_is_the_full_searchs_prefix(start):
     assert np.array_equal(part.predecessor[known.ravel()], full.predecessor[known.ravel()])
     assert (part.predecessor[~known.ravel()] == -1).all()
     assert known[full.cumulative <= 1.2].all()
+
+
+def test_a_bounded_search_sees_expensive_cells_at_its_edge():
+    """Costly cells just inside the bound's reach must size the bucket ring: a search bounded at
+    1 m among cells of cost 40 one metre out gives the full search's costs where it settles."""
+    cost = np.ones((60, 60))
+    cost[:, 41:43] = 40.0  # a costly band 11-12 cells east of the start
+    full = cost_field(cost, (30, 30), 0.1)
+    part = cost_field(cost, (30, 30), 0.1, max_cost_m=1.0)
+    known = np.isfinite(part.cumulative)
+    assert np.array_equal(part.cumulative[known], full.cumulative[known])
