@@ -320,3 +320,31 @@ def test_a_selected_menus_clusters_belong_to_their_candidates():
     for i in range(len(menu)):
         cells = {tuple(c) for c in np.asarray(menu.clusters[i]).tolist()}
         assert (tuple(menu.target_rc[i]) in cells) == (i in frontier)
+
+
+def test_a_cluster_whose_turn_carries_it_past_the_bound_is_not_exact():
+    """On a menu searched to 1 m: a cluster 0.9 m away but behind the robot (its counted cost
+    0.9 + 0.3 π > 1 m) may cost less from another cell beyond the bound, so it only bounds the
+    choice from above (3 − 3 × 1 = 0 beats the near one's −0.5): not proven."""
+    from sfw_gym.navigation.candidates import (
+        FEATURES,
+        CandidateGoals,
+        explore_lite_utilities,
+        proven_on_bounded_paths,
+    )
+
+    paths = cost_field(np.ones((5, 5)), (2, 2), 1.0, max_cost_m=1.0)
+    feats = np.full((2, len(FEATURES)), np.nan)
+    columns = {name: i for i, name in enumerate(FEATURES)}
+    feats[:, columns["path_cost_m"]] = [0.5, 0.9]
+    feats[:, columns["heading_change_rad"]] = [0.0, math.pi]
+    feats[:, columns["cluster_size_m"]] = [1.0, 3.0]
+    cells = np.array([[2, 3], [2, 1]])
+    menu = CandidateGoals(
+        cells, cells, np.zeros(2, np.int64), feats, np.ones(2, bool), (), paths, cells[:0]
+    )
+    utility = explore_lite_utilities(menu)
+    assert utility[0] == pytest.approx(-0.5)
+    assert not proven_on_bounded_paths(menu, utility)
+    feats[1, columns["heading_change_rad"]] = 0.0  # in front: its cost 0.9 is exact, and worse
+    assert proven_on_bounded_paths(menu, explore_lite_utilities(menu))
