@@ -32,6 +32,8 @@ AGENTS: dict[str, str] = {
     "regions-ppo": "sfw_gym.rl.agent:RegionsPPOAgent",
     "goals-ppo": "sfw_gym.rl.agent:PPOAgent",
     "waypoint-ppo": "sfw_gym.rl.waypoint_agent:WaypointPPOAgent",
+    # privileged: they read the ground truth (sfw_gym.agents.oracles); run only when named
+    "oracle-coverage": "sfw_gym.agents.coverage_oracle:CoverageOracle",
 }
 #: Names of an earlier release, kept for one more: each warns (FutureWarning) and builds the
 #: agent it names now.

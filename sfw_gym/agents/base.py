@@ -155,6 +155,9 @@ class Agent(ABC):
     """
 
     name: ClassVar[str] = "agent"
+    #: Whether the agent reads the ground truth (an oracle, :mod:`sfw_gym.agents.oracles`):
+    #: never a default, never a robot's baseline.
+    privileged: ClassVar[bool] = False
     action_types: ClassVar[tuple[str, ...]] = ("continuous", "discrete")
     #: The frozen, checked parameters: ``Agent(**params)`` builds ``settings_class(**params)``.
     settings_class: ClassVar[type[AgentSettings]] = AgentSettings

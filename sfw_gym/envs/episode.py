@@ -53,6 +53,7 @@ class GroundTruth:
         grid: The belief map's geometry.
         radio: The radio model (routers, noise-free ``mean_rssi``).
         trajectory: ``(T, 2)`` true positions so far.
+        pose: The true pose now, ``(x, y, θ)`` (m, rad).
     """
 
     floorplan: Floorplan
@@ -60,6 +61,7 @@ class GroundTruth:
     grid: GridSpec
     radio: RadioModel
     trajectory: np.ndarray
+    pose: tuple[float, float, float]
 
 
 def resolve_floorplan(source: Any, generator_params: dict[str, Any] | None = None) -> Floorplan:

@@ -486,6 +486,7 @@ class SfWExploreEnv(gym.Env):
             grid=self.grid,
             radio=s.radio,
             trajectory=self.true_path.view.copy(),
+            pose=(float(s.robot.pose[0]), float(s.robot.pose[1]), float(s.robot.pose[2])),
         )
 
     # ------------------------------------------------------------------------------ rendering

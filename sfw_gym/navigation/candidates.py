@@ -721,7 +721,7 @@ def _fill(values: np.ndarray, compute) -> np.ndarray:
 
 
 @njit(cache=True)
-def _unknown_bits_at(log_odds, belief, r, c):  # pragma: no cover (compiled)
+def unknown_bits_at(log_odds, belief, r, c):  # pragma: no cover (compiled)
     """Entropy (bits) of cell (r, c) if the belief there is unknown, else 0."""
     b = belief[r, c]
     if b <= U8_WALL_MAX or b >= U8_FREE_MIN:
@@ -749,12 +749,12 @@ def _expected_gain(
             r = min(max(int(np.floor((y - origin[1]) / res)), 0), h - 1)
             c = min(max(int(np.floor((x - origin[0]) / res)), 0), w - 1)
             if r != last_r or c != last_c:  # a segment meets each cell in one run of samples
-                total += _unknown_bits_at(log_odds, belief, r, c)
+                total += unknown_bits_at(log_odds, belief, r, c)
                 last_r, last_c = r, c
         for k in range(len(offsets)):
             r, c = cells[i, 0] + offsets[k, 0], cells[i, 1] + offsets[k, 1]
             if 0 <= r < h and 0 <= c < w:
-                total += _unknown_bits_at(log_odds, belief, r, c)
+                total += unknown_bits_at(log_odds, belief, r, c)
         out[i] = total
     return out
 

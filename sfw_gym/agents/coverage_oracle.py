@@ -1,0 +1,197 @@
+"""The coverage oracle: a tour through the cells still unknown, planned on the true plan.
+
+Privileged (:mod:`sfw_gym.agents.oracles`): it reads the true plan, pose and radio. Every replan
+it scores candidate cells of the true free space (where the robot fits) by the bits the mapper
+could gain there, divided by the true shortest path's cost plus an offset, and drives the true
+shortest path to the best one with pure pursuit on the true pose: no bumps, no detours through
+believed walls, no goals behind unseen walls.
+
+The gain at a cell is the entropy of the belief's unknown cells the robot would resolve there:
+its footprint (the mapper's rule 1), and the stretch of the ray towards the router that is truly
+strongest there (the one the mapper updates), from the cell back to the first true wall: the
+cells that line-of-sight readings, or two readings with equal k on that ray, mark free.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from sfw_gym.agents.base import AgentSettings, RobotView
+from sfw_gym.agents.oracles import OracleAgent
+from sfw_gym.core.config import setting
+from sfw_gym.core.constants import U8_FREE_MIN
+from sfw_gym.navigation.candidates import unknown_bits_at
+from sfw_gym.navigation.planning import (
+    PurePursuit,
+    cells_to_world,
+    cost_field,
+    disk_offsets,
+    free_start,
+    mark_disk,
+    wall_cost_term,
+    wall_distance_m,
+)
+
+
+@dataclass(frozen=True)
+class CoverageOracleSettings(AgentSettings):
+    """The parameters of :class:`CoverageOracle`.
+
+    Attributes:
+        replan_every_steps: Choose the next target at least this often (and on arrival).
+        distance_offset_m: Added to a candidate's path cost (keeps near goals from dominating).
+        candidate_stride_cells: Candidates are the free cells of a lattice this many cells apart.
+        margin_m: Paths keep this much clearance beyond the robot's radius from true walls.
+        lookahead_m: Pure-pursuit carrot distance.
+    """
+
+    replan_every_steps: int = setting(10, integer=True, ge=1)
+    distance_offset_m: float = setting(1.0, ge=0.01)
+    candidate_stride_cells: int = setting(2, integer=True, ge=1)
+    margin_m: float = setting(0.05, ge=0.0)
+    lookahead_m: float = setting(0.4, ge=0.05)
+
+
+class CoverageOracle(OracleAgent):
+    """Expected bits per metre on the true plan, driven on true shortest paths (privileged).
+
+    Parameters: :class:`CoverageOracleSettings` (keyword arguments, checked).
+
+    A cell the robot has stood on (within its radius) is no candidate again: what a reading
+    there gives, it has given.
+
+    Attributes:
+        target_rc: The cell driven to (None: nothing left to gain).
+        n_plans: Replans this episode.
+    """
+
+    name = "oracle-coverage"
+
+    settings_class = CoverageOracleSettings
+    settings: CoverageOracleSettings
+
+    def _on_reset(self, view: RobotView) -> None:
+        truth = self.ground_truth()
+        grid = truth.grid
+        res = float(grid.resolution_m)
+        free = np.asarray(truth.truth_u8) >= U8_FREE_MIN
+        lethal = view.radius_m + self.settings.margin_m
+        self._cost = 1.0 + wall_cost_term(
+            wall_distance_m(~free, res), res, view.radius_m, lethal_radius_m=lethal
+        )
+        rows, cols = np.nonzero(free)
+        centres = grid.cell_to_world(np.stack([rows, cols], axis=1))
+        self._zone = np.full(free.shape, -1, np.int64)  # the truly strongest router; -1: wall
+        self._zone[rows, cols] = np.argmax(truth.radio.mean_rssi(centres), axis=1)
+        stride = self.settings.candidate_stride_cells
+        lattice = np.zeros(free.shape, bool)
+        lattice[::stride, ::stride] = True
+        self._candidates = np.argwhere(lattice & np.isfinite(self._cost))
+        self._routers = np.asarray(truth.radio.routers, np.float64)
+        self._origin = np.asarray(grid.origin_xy, np.float64)
+        self._res = res
+        self._footprint = disk_offsets(view.radius_m / res)
+        self._radius_m = float(view.radius_m)
+        self._grid = grid
+        self.follower = PurePursuit(lookahead_m=self.settings.lookahead_m, goal_tolerance_m=res)
+        self._visited = np.zeros(free.shape, bool)  # within the robot's radius of its path
+        self.target_rc: tuple[int, int] | None = None
+        self._since_plan = 0
+        self.n_plans = 0
+
+    def gains(self, view: RobotView, cells: np.ndarray) -> np.ndarray:
+        """Bits the mapper could gain with the robot at each of ``cells`` ``(N, 2)``."""
+        return _truth_gain(
+            view.log_odds,
+            view.belief_u8,
+            self._zone,
+            self._routers,
+            np.asarray(cells, np.int64).reshape(-1, 2),
+            self._footprint,
+            self._radius_m,
+            self._origin,
+            self._res,
+        )
+
+    def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
+        pose = self.ground_truth().pose
+        mark_disk(self._visited, self._cell(pose), self._radius_m / self._res)
+        if not self.follower.has_path or self._since_plan >= self.settings.replan_every_steps:
+            self._plan(view, pose)
+        self._since_plan += 1
+        linear, angular = self.follower.command(pose)
+        if not self.follower.has_path:  # arrived: on to the next target at once
+            self._plan(view, pose)
+            linear, angular = self.follower.command(pose)
+        return linear, angular
+
+    def _cell(self, pose: tuple[float, float, float]) -> tuple[int, int]:
+        """The grid cell of a pose (clipped into the grid)."""
+        h, w = self._cost.shape
+        r, c = self._grid.world_to_cell(np.array(pose[:2])).tolist()
+        return min(max(r, 0), h - 1), min(max(c, 0), w - 1)
+
+    def _plan(self, view: RobotView, pose: tuple[float, float, float]) -> None:
+        """Choose the target of most bits per metre on the true plan; set its true path."""
+        self.n_plans += 1
+        self._since_plan = 0
+        start = self._cell(pose)
+        paths = cost_field(free_start(self._cost, start), start, self._res)
+        cells = self._candidates
+        metres = paths.cumulative[cells[:, 0], cells[:, 1]]
+        fresh = np.isfinite(metres) & ~self._visited[cells[:, 0], cells[:, 1]]
+        cells, metres = cells[fresh], metres[fresh]
+        bits = self.gains(view, cells)
+        if not (bits > 0).any():
+            self._stop("no_frontiers")
+            self.target_rc = None
+            self.follower.set_path(np.zeros((0, 2)))
+            return
+        self._resume()
+        i = int(np.argmax(bits / (metres + self.settings.distance_offset_m)))
+        self.target_rc = (int(cells[i, 0]), int(cells[i, 1]))
+        route = paths.path(self.target_rc)
+        self.follower.set_path(cells_to_world(self._grid, route))
+
+
+@njit(cache=True)
+def _truth_gain(
+    log_odds, belief, zone, routers, cells, footprint, radius, origin, res
+):  # pragma: no cover (compiled)
+    """Per cell: the unknown bits of its footprint plus those on the ray towards its strongest
+    router, from beyond the footprint's ``radius`` to the first truly non-free cell."""
+    h, w = belief.shape
+    out = np.zeros(len(cells))
+    step = 0.5 * res
+    for i in range(len(cells)):
+        r0, c0 = cells[i, 0], cells[i, 1]
+        total = 0.0
+        for k in range(len(footprint)):
+            r, c = r0 + footprint[k, 0], c0 + footprint[k, 1]
+            if 0 <= r < h and 0 <= c < w:
+                total += unknown_bits_at(log_odds, belief, r, c)
+        x0 = origin[0] + (c0 + 0.5) * res
+        y0 = origin[1] + (r0 + 0.5) * res
+        router = routers[zone[r0, c0]]
+        dx, dy = router[0] - x0, router[1] - y0
+        length = np.hypot(dx, dy)
+        n = int(np.ceil(length / step))
+        last_r, last_c = r0, c0
+        for j in range(1, n + 1):
+            t = j / n
+            if t * length <= radius:
+                continue  # the footprint, counted above
+            r = int(np.floor((y0 + dy * t - origin[1]) / res))
+            c = int(np.floor((x0 + dx * t - origin[0]) / res))
+            if r == last_r and c == last_c:
+                continue
+            if not (0 <= r < h and 0 <= c < w) or zone[r, c] < 0:
+                break  # a true wall (or outside): the free stretch ends
+            total += unknown_bits_at(log_odds, belief, r, c)
+            last_r, last_c = r, c
+        out[i] = total
+    return out
