@@ -94,6 +94,12 @@ def agent_class(name: str) -> type[Agent]:
     return found
 
 
+def is_privileged(name: str) -> bool:
+    """Whether the agent ``name`` reads the ground truth: an oracle
+    (:mod:`sfw_gym.agents.oracles`), which runs only where it is named."""
+    return agent_class(name).privileged
+
+
 def make_agent(name: str, **params: Any) -> Agent:
     """Build the agent registered as ``name`` (see :data:`AGENTS`) with ``params``."""
     cls = agent_class(name)
@@ -116,6 +122,7 @@ __all__ = [
     "RobotView",
     "RobotViewHandle",
     "agent_class",
+    "is_privileged",
     "known_agent",
     "make_agent",
     "register_agent",

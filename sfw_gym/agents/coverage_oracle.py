@@ -47,13 +47,17 @@ class CoverageOracleSettings(AgentSettings):
         candidate_stride_cells: Candidates are the free cells of a lattice this many cells apart.
         margin_m: Paths keep this much clearance beyond the robot's radius from true walls.
         lookahead_m: Pure-pursuit carrot distance.
+        blocked_ray_weight: The weight of a ray's free stretch when a true wall stands between
+            the cell and the router (the mapper marks it free only where another reading on
+            that ray has the same k); 1 where the router is in sight.
     """
 
     replan_every_steps: int = setting(10, integer=True, ge=1)
     distance_offset_m: float = setting(1.0, ge=0.01)
-    candidate_stride_cells: int = setting(2, integer=True, ge=1)
-    margin_m: float = setting(0.05, ge=0.0)
+    candidate_stride_cells: int = setting(1, integer=True, ge=1)
+    margin_m: float = setting(0.0, ge=0.0)
     lookahead_m: float = setting(0.4, ge=0.05)
+    blocked_ray_weight: float = setting(0.3, ge=0.0, le=1.0)
 
 
 class CoverageOracle(OracleAgent):
@@ -61,8 +65,8 @@ class CoverageOracle(OracleAgent):
 
     Parameters: :class:`CoverageOracleSettings` (keyword arguments, checked).
 
-    A cell the robot has stood on (within its radius) is no candidate again: what a reading
-    there gives, it has given.
+    A cell the robot has stood on (within its radius) is no candidate again (what a reading
+    there gives, it has given) until no other cell has anything left to give.
 
     Attributes:
         target_rc: The cell driven to (None: nothing left to gain).
@@ -104,8 +108,8 @@ class CoverageOracle(OracleAgent):
         self.n_plans = 0
 
     def gains(self, view: RobotView, cells: np.ndarray) -> np.ndarray:
-        """Bits the mapper could gain with the robot at each of ``cells`` ``(N, 2)``."""
-        return _truth_gain(
+        """Bits the mapper could gain with the robot standing at each of ``cells`` ``(N, 2)``."""
+        return _gains(
             view.log_odds,
             view.belief_u8,
             self._zone,
@@ -115,6 +119,7 @@ class CoverageOracle(OracleAgent):
             self._radius_m,
             self._origin,
             self._res,
+            self.settings.blocked_ray_weight,
         )
 
     def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
@@ -143,9 +148,14 @@ class CoverageOracle(OracleAgent):
         paths = cost_field(free_start(self._cost, start), start, self._res)
         cells = self._candidates
         metres = paths.cumulative[cells[:, 0], cells[:, 1]]
-        fresh = np.isfinite(metres) & ~self._visited[cells[:, 0], cells[:, 1]]
+        reachable = np.isfinite(metres)
+        fresh = reachable & ~self._visited[cells[:, 0], cells[:, 1]]
+        bits = self.gains(view, cells[fresh])
+        if not (bits > 0).any():  # what is left lies where it has been: go round again
+            self._visited[:] = False
+            fresh = reachable
+            bits = self.gains(view, cells[fresh])
         cells, metres = cells[fresh], metres[fresh]
-        bits = self.gains(view, cells)
         if not (bits > 0).any():
             self._stop("no_frontiers")
             self.target_rc = None
@@ -154,44 +164,67 @@ class CoverageOracle(OracleAgent):
         self._resume()
         i = int(np.argmax(bits / (metres + self.settings.distance_offset_m)))
         self.target_rc = (int(cells[i, 0]), int(cells[i, 1]))
-        route = paths.path(self.target_rc)
-        self.follower.set_path(cells_to_world(self._grid, route))
+        self.follower.set_path(cells_to_world(self._grid, paths.path(self.target_rc)))
 
 
 @njit(cache=True)
-def _truth_gain(
-    log_odds, belief, zone, routers, cells, footprint, radius, origin, res
+def _gain_at(
+    log_odds, belief, zone, routers, r0, c0, footprint, radius, origin, res, seen, mark, weight
 ):  # pragma: no cover (compiled)
-    """Per cell: the unknown bits of its footprint plus those on the ray towards its strongest
-    router, from beyond the footprint's ``radius`` to the first truly non-free cell."""
+    """The unknown bits at the robot's footprint on cell (r0, c0) plus those on the ray towards
+    its strongest router, from beyond the footprint's ``radius`` to the first truly non-free
+    cell (times ``weight`` unless the ray reaches the router); each cell once (``seen`` holds
+    ``mark`` where counted)."""
     h, w = belief.shape
-    out = np.zeros(len(cells))
-    step = 0.5 * res
-    for i in range(len(cells)):
-        r0, c0 = cells[i, 0], cells[i, 1]
-        total = 0.0
-        for k in range(len(footprint)):
-            r, c = r0 + footprint[k, 0], c0 + footprint[k, 1]
-            if 0 <= r < h and 0 <= c < w:
-                total += unknown_bits_at(log_odds, belief, r, c)
-        x0 = origin[0] + (c0 + 0.5) * res
-        y0 = origin[1] + (r0 + 0.5) * res
-        router = routers[zone[r0, c0]]
-        dx, dy = router[0] - x0, router[1] - y0
-        length = np.hypot(dx, dy)
-        n = int(np.ceil(length / step))
-        last_r, last_c = r0, c0
-        for j in range(1, n + 1):
-            t = j / n
-            if t * length <= radius:
-                continue  # the footprint, counted above
-            r = int(np.floor((y0 + dy * t - origin[1]) / res))
-            c = int(np.floor((x0 + dx * t - origin[0]) / res))
-            if r == last_r and c == last_c:
-                continue
-            if not (0 <= r < h and 0 <= c < w) or zone[r, c] < 0:
-                break  # a true wall (or outside): the free stretch ends
+    total = 0.0
+    for k in range(len(footprint)):
+        r, c = r0 + footprint[k, 0], c0 + footprint[k, 1]
+        if 0 <= r < h and 0 <= c < w and seen[r, c] != mark:
+            seen[r, c] = mark
             total += unknown_bits_at(log_odds, belief, r, c)
-            last_r, last_c = r, c
-        out[i] = total
+    x0 = origin[0] + (c0 + 0.5) * res
+    y0 = origin[1] + (r0 + 0.5) * res
+    router = routers[zone[r0, c0]]
+    dx, dy = router[0] - x0, router[1] - y0
+    length = np.hypot(dx, dy)
+    n = int(np.ceil(length / (0.5 * res)))
+    ray = 0.0
+    for j in range(1, n + 1):
+        t = j / n
+        if t * length <= radius:
+            continue  # the footprint, counted above
+        r = int(np.floor((y0 + dy * t - origin[1]) / res))
+        c = int(np.floor((x0 + dx * t - origin[0]) / res))
+        if not (0 <= r < h and 0 <= c < w) or zone[r, c] < 0:
+            return total + weight * ray  # a true wall (or outside): the free stretch ends
+        if seen[r, c] != mark:
+            seen[r, c] = mark
+            ray += unknown_bits_at(log_odds, belief, r, c)
+    return total + ray
+
+
+@njit(cache=True)
+def _gains(
+    log_odds, belief, zone, routers, cells, footprint, radius, origin, res, weight
+):  # pragma: no cover (compiled)
+    """:func:`_gain_at` of each cell."""
+    seen = np.zeros(belief.shape, np.int64)
+    out = np.zeros(len(cells))
+    for i in range(len(cells)):
+        r, c = cells[i, 0], cells[i, 1]
+        out[i] = _gain_at(
+            log_odds,
+            belief,
+            zone,
+            routers,
+            r,
+            c,
+            footprint,
+            radius,
+            origin,
+            res,
+            seen,
+            i + 1,
+            weight,
+        )
     return out

@@ -24,7 +24,7 @@ from sfw_gym.core.errors import ConfigError
 from sfw_gym.evaluation.checkpoint import require_same_run
 from sfw_gym.evaluation.executor import Executor
 from sfw_gym.evaluation.metric_table import METRICS
-from sfw_gym.evaluation.report import paired_table
+from sfw_gym.evaluation.report import PRIVILEGED_NOTE, paired_table
 from sfw_gym.evaluation.stats import bootstrap_ci, paired_comparison
 
 SPLITS = ("train", "validation", "test")
@@ -117,6 +117,7 @@ def run_benchmark(
     ``episodes`` caps the episodes per env (a quick look; recorded in the results);
     ``workers``, ``backend`` and ``address`` as :func:`~sfw_gym.evaluation.evaluate`'s."""
     from sfw_gym import __version__
+    from sfw_gym.agents import agent_class
     from sfw_gym.evaluation.rollout import EpisodeSpec
     from sfw_gym.evaluation.runner import run_specs
 
@@ -165,6 +166,7 @@ def run_benchmark(
         "package_version": __version__,
         "agent": agent,
         "agent_params": dict(agent_params or {}),
+        "privileged": agent_class(agent).privileged,
         "agent_seed": agent_seed,
         "split": split,
         "episodes_cap": episodes,
@@ -244,6 +246,8 @@ def results_markdown(results: dict[str, Any]) -> str:
         f"sfw_gym {results['package_version']}, agent seed {results['agent_seed']}, "
         f"protocol sha256 {results['protocol_sha256'][:12]}; mean [95 % bootstrap interval].",
     ]
+    if results.get("privileged"):
+        lines += ["", PRIVILEGED_NOTE]
     for env_id, metrics in results["summary"].items():
         n = max((s["n"] for s in metrics.values()), default=0)
         lines += ["", f"## {env_id} ({n} episodes)", "", "| metric | value |", "|---|---:|"]

@@ -30,12 +30,19 @@ def results_csv(rows: list[dict[str, Any]]) -> str:
     return buf.getvalue()
 
 
+#: Under every table with an oracle's row (a privileged agent, marked †).
+PRIVILEGED_NOTE = (
+    "† privileged: an oracle that reads the ground truth (the true plan and pose); a ceiling "
+    "for comparison, not a result a robot could reach."
+)
+
+
 def results_markdown(rows: list[dict[str, Any]]) -> str:
-    """The summary rows as a Markdown table (mean ± 95 % CI)."""
+    """The summary rows as a Markdown table (mean ± 95 % CI); oracles' rows marked †."""
     head = ["agent", "episodes"] + [m.label for m in TABLE_METRICS] + ["≥ 90 % cov."]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for row in rows:
-        cells = [row["agent"], str(row["episodes"])]
+        cells = [row["agent"] + (" †" if row.get("privileged") else ""), str(row["episodes"])]
         for m in TABLE_METRICS:
             mean, ci, n = row[f"{m.key}_mean"], row[f"{m.key}_ci95"], row[f"{m.key}_n"]
             if n == 0:
@@ -47,6 +54,8 @@ def results_markdown(rows: list[dict[str, Any]]) -> str:
             cells.append(cell)
         cells.append(f"{row['episodes_coverage_ge_90']}/{row['episodes']}")
         lines.append("| " + " | ".join(cells) + " |")
+    if any(row.get("privileged") for row in rows):
+        lines += ["", PRIVILEGED_NOTE]
     return "\n".join(lines) + "\n"
 
 

@@ -146,6 +146,7 @@ class EpisodeRecord:
             "stop_reason": reason,
             "wall_s": time.perf_counter() - self.start,
             "agent_params": agent.params(),
+            "privileged": bool(agent.privileged),
             "decisions": len(agent.decisions),
             "curve": [list(map(_py, c)) for c in self.curve],
             **{k: _py(v) for k, v in summary.items()},

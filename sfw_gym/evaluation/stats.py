@@ -55,7 +55,11 @@ def summarize(records: list[dict[str, Any]], agents: Sequence[str]) -> list[dict
     rows = []
     for name in agents:
         recs = [r for r in records if r["agent"] == name]
-        row: dict[str, Any] = {"agent": name, "episodes": len(recs)}
+        row: dict[str, Any] = {
+            "agent": name,
+            "episodes": len(recs),
+            "privileged": any(r.get("privileged", False) for r in recs),
+        }
         for m in TABLE_METRICS:
             vals = [r.get(m.key) for r in recs]
             if m.key in REACHED_METRICS:

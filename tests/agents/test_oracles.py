@@ -1,0 +1,166 @@
+"""The oracles (issue 40): privileged explorers that read the ground truth, marked as such and run
+only where they are named; the coverage oracle's gain on cases computed by hand, and its tour
+covering a small plan within its budget."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+from types import SimpleNamespace
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from shapely.geometry import Polygon
+
+import sfw_gym  # noqa: F401  (registration)
+from sfw_gym.agents import AGENTS, agent_class, is_privileged, make_agent
+from sfw_gym.agents.oracles import ORACLE_PREFIX
+from sfw_gym.cli import build_parser
+from sfw_gym.core.constants import U8_FREE, U8_UNKNOWN
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.demo import DEMO_AGENTS
+from sfw_gym.envs.robot_view_info import RobotViewInInfo
+from sfw_gym.evaluation.benchmark import results_markdown as benchmark_markdown
+from sfw_gym.evaluation.report import PRIVILEGED_NOTE, results_markdown
+from sfw_gym.world.floorplan import Floorplan
+from tests.agents.test_agents import _reachable
+
+ROOT = Path(__file__).resolve().parents[2]
+ORACLES = sorted(n for n in AGENTS if agent_class(n).privileged)
+
+
+def two_rooms() -> Floorplan:
+    """Two 4 x 4 m rooms; the 0.2 m brick wall between them (x 4.0-4.2) has a door at y 1.5-2.5."""
+    left = [(0, 0), (4, 0), (4, 1.5), (4.2, 1.5), (4.2, 0)]
+    right = [(8.2, 0), (8.2, 4), (4.2, 4), (4.2, 2.5), (4, 2.5), (4, 4), (0, 4)]
+    free = Polygon([*left, *right])
+    shell = Polygon([(-0.2, -0.2), (8.4, -0.2), (8.4, 4.2), (-0.2, 4.2)])
+    return Floorplan(free, shell, ("brick",) * 12, name="two-rooms")
+
+
+def test_every_oracle_is_named_and_marked_as_one():
+    assert "oracle-coverage" in ORACLES
+    for name in AGENTS:
+        assert agent_class(name).privileged == name.startswith(ORACLE_PREFIX), name
+        assert is_privileged(name) == name.startswith(ORACLE_PREFIX)
+
+
+@pytest.mark.parametrize("name", ORACLES)
+def test_an_oracle_needs_the_env_itself(name):
+    env = RobotViewInInfo(gym.make("SfW-ExploreSmall-v0"))
+    _, info = env.reset(seed=0)
+    with pytest.raises(ConfigError, match="oracle"):
+        make_agent(name).reset(info=info, seed=0)
+    with pytest.raises(ConfigError, match="oracle"):  # a stand-in with only robot_view()
+        make_agent(name).reset(SimpleNamespace(robot_view=env.unwrapped.robot_view), seed=0)
+
+
+@pytest.mark.parametrize("name", ORACLES)
+def test_an_oracle_holds_the_ground_truth_that_robot_agents_may_not(name):
+    """The object-graph check that keeps the robot agents from the ground truth sees an
+    oracle's: so it would see a robot agent's."""
+    env = gym.make("SfW-ExploreSmall-v0")
+    obs, _ = env.reset(seed=3)
+    agent = make_agent(name)
+    agent.reset(env, seed=3)
+    for _ in range(3):
+        obs, *_ = env.step(agent.act(obs))
+    held = {id(o) for o in _reachable(agent, stop=())}
+    assert id(env.unwrapped) in held
+    assert id(env.unwrapped.scene.floorplan) in held
+
+
+def test_no_default_runs_an_oracle():
+    assert not any(is_privileged(a) for a in DEMO_AGENTS)
+    evaluate = build_parser().parse_args(["evaluate"])
+    assert not any(is_privileged(a) for a in evaluate.agents.split(","))
+    spec = importlib.util.spec_from_file_location("shipped", ROOT / "scripts/benchmark_shipped.py")
+    assert spec and spec.loader
+    shipped = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(shipped)
+    assert set(shipped.shipped_agents()) == {n for n in AGENTS if n not in ORACLES}
+
+
+def test_tables_mark_an_oracle_as_privileged():
+    row = {"agent": "oracle-coverage", "episodes": 0, "episodes_coverage_ge_90": 0}
+    from sfw_gym.evaluation.metric_table import TABLE_METRICS
+
+    for m in TABLE_METRICS:
+        row |= {f"{m.key}_mean": 0.0, f"{m.key}_ci95": 0.0, f"{m.key}_n": 0}
+    assert PRIVILEGED_NOTE not in results_markdown([row | {"privileged": False}])
+    table = results_markdown([row | {"privileged": True}])
+    assert "| oracle-coverage † |" in table and PRIVILEGED_NOTE in table
+    results = {
+        "agent": "oracle-coverage",
+        "protocol": "benchmark-v1",
+        "split": "test",
+        "package_version": "0",
+        "agent_seed": 0,
+        "protocol_sha256": "0" * 64,
+        "summary": {},
+    }
+    assert PRIVILEGED_NOTE not in benchmark_markdown(results | {"privileged": False})
+    assert PRIVILEGED_NOTE in benchmark_markdown(results | {"privileged": True})
+
+
+# ------------------------------------------------------------------------- the coverage oracle
+def oracle_on_two_rooms(router_xy, **params):
+    """The coverage oracle reset on the two rooms with one router."""
+    env = gym.make("SfW-Explore-v0", n_routers=1)
+    env.reset(seed=0, options={"floorplan": two_rooms(), "routers": [router_xy]})
+    agent = make_agent("oracle-coverage", **params)
+    agent.reset(env, seed=0)
+    return env, agent
+
+
+def hand_view(env, unknown_xy):
+    """The robot's view with a belief that is free everywhere but at ``unknown_xy`` (log-odds
+    0 there: one bit each)."""
+    view = env.unwrapped.robot_view()
+    belief = np.full(view.belief_u8.shape, U8_FREE, np.uint8)
+    log_odds = np.full(view.log_odds.shape, -4.0, np.float32)
+    for rc in view.grid.world_to_cell(np.asarray(unknown_xy, np.float64)):
+        belief[tuple(rc)], log_odds[tuple(rc)] = U8_UNKNOWN, 0.0
+    return type(view)(**{**vars(view), "belief_u8": belief, "log_odds": log_odds})
+
+
+def cell(env, xy):
+    return env.unwrapped.grid.world_to_cell(np.asarray(xy, np.float64))
+
+
+def test_gain_counts_the_unknown_cells_on_the_ray_to_a_router_in_sight():
+    env, oracle = oracle_on_two_rooms((0.55, 2.05))
+    at = cell(env, (3.05, 2.05))[None]
+    # one unknown cell on the ray, halfway: one bit; two: two bits; one off the ray: none
+    assert oracle.gains(hand_view(env, [(1.85, 2.05)]), at)[0] == pytest.approx(1.0)
+    two = [(1.85, 2.05), (2.45, 2.05)]
+    assert oracle.gains(hand_view(env, two), at)[0] == pytest.approx(2.0)
+    assert oracle.gains(hand_view(env, [(1.85, 3.05)]), at)[0] == 0.0
+    # beyond the router (the ray ends there) and behind the robot: none
+    assert oracle.gains(hand_view(env, [(0.25, 2.05), (3.65, 2.05)]), at)[0] == 0.0
+    # in the robot's footprint: one bit
+    assert oracle.gains(hand_view(env, [(3.15, 2.05)]), at)[0] == pytest.approx(1.0)
+
+
+def test_a_wall_between_cell_and_router_weighs_its_free_stretch_and_ends_it():
+    env, oracle = oracle_on_two_rooms((0.55, 3.05), blocked_ray_weight=0.25)
+    at = cell(env, (6.05, 3.05))[None]  # the wall at x 4.0-4.2 stands between
+    near, far = (5.05, 3.05), (2.05, 3.05)  # the free stretch on this side; beyond the wall
+    assert oracle.gains(hand_view(env, [near]), at)[0] == pytest.approx(0.25)
+    assert oracle.gains(hand_view(env, [far]), at)[0] == 0.0
+    assert oracle.gains(hand_view(env, [(6.15, 3.05)]), at)[0] == pytest.approx(1.0)  # footprint
+
+
+def test_the_coverage_oracle_covers_a_small_plan_within_its_budget():
+    for seed in (1, 2):  # on seed 2 the tour goes round again
+        env = gym.make("SfW-Explore-v0", max_steps=1500)
+        obs, info = env.reset(seed=seed, options={"floorplan": two_rooms()})
+        target = env.unwrapped.config.reward.coverage_target
+        agent = make_agent("oracle-coverage")
+        agent.reset(env, seed=seed)
+        terminated = truncated = False
+        while not (terminated or truncated):
+            obs, _, terminated, truncated, info = env.step(agent.act(obs))
+        assert terminated and info["coverage"] >= target, (seed, info["coverage"])
+        assert agent.stop_reason is None
