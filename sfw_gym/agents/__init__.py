@@ -34,6 +34,7 @@ AGENTS: dict[str, str] = {
     "waypoint-ppo": "sfw_gym.rl.waypoint_agent:WaypointPPOAgent",
     # privileged: they read the ground truth (sfw_gym.agents.oracles); run only when named
     "oracle-coverage": "sfw_gym.agents.coverage_oracle:CoverageOracle",
+    "oracle-regions": "sfw_gym.agents.region_oracle:RegionOracle",
 }
 #: Names of an earlier release, kept for one more: each warns (FutureWarning) and builds the
 #: agent it names now.
