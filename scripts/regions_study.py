@@ -1,16 +1,21 @@
-"""The learned region explorer against frontier and the tuned heuristics (issue 30).
+"""The learned region explorer against frontier, the tuned heuristics and the oracles (issues
+30 and 40: the benchmark's ceiling).
 
 Runs ``sfw-gym evaluate`` (resuming what is done) with every agent of the comparison on the same
 plans and seeds, then prints each agent's bits per metre and coverage as ratios to default
 frontier's (ratio of the means, 95 % interval by a paired bootstrap over episodes: the package's
-paired comparison, ``compare_paired(..., ratio=True)``), the decisions
-per episode and the wall time per step relative to frontier's.
+paired comparison, ``compare_paired(..., ratio=True)``), the decisions per episode, the wall
+time per step relative to frontier's and per episode. Oracles (privileged) are marked †.
+``--budgets`` adds coverage at those step counts (read off each episode's coverage curve; an
+episode that ended earlier keeps its final coverage): run with ``--max-steps`` the largest.
 
     python scripts/regions_study.py --episodes 50 --seed 2000000 --out runs/study_test
     python scripts/regions_study.py --episodes 11 --floorplans ../shared/floorplans/houseexpo \
         --out runs/study_hx
     python scripts/regions_study.py --agents frontier,region-teacher --episodes 20 \
         --seed 3000000 --out runs/teacher20      # the teacher before any cloning
+    python scripts/regions_study.py --agents frontier,oracle-coverage --episodes 20 \
+        --max-steps 10000 --budgets 1000,3000,10000 --out runs/ceiling_budgets
 """
 
 from __future__ import annotations
@@ -21,6 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
+from sfw_gym.agents import is_privileged
+from sfw_gym.evaluation.report import PRIVILEGED_NOTE
 from sfw_gym.evaluation.runner import evaluate
 from sfw_gym.evaluation.stats import compare_paired
 
@@ -54,6 +61,8 @@ def main() -> None:
     p.add_argument("--agent-params", default="{}", help="more per-agent parameters (JSON)")
     p.add_argument("--out", default="runs/regions_study")
     p.add_argument("--workers", type=int, default=2)
+    p.add_argument("--max-steps", type=int, default=None, help="the episodes' step budget")
+    p.add_argument("--budgets", default="", help="comma-separated steps: coverage at each")
     args = p.parse_args()
 
     agents, params, label = [], json.loads(args.agent_params), {}
@@ -65,7 +74,7 @@ def main() -> None:
             label[entry] = label_text
         else:
             agents.append(name)
-            label[name] = name
+            label[name] = name + (" †" if is_privileged(name) else "")
     if args.model and "regions-ppo" in agents:
         params.setdefault("regions-ppo", {})["path"] = args.model
     result = evaluate(
@@ -74,6 +83,7 @@ def main() -> None:
         args.seed,
         out=args.out,
         floorplans=args.floorplans,
+        env_kwargs={"max_steps": args.max_steps} if args.max_steps else None,
         agent_params=params,
         workers=args.workers,
         progress=False,
@@ -96,8 +106,8 @@ def main() -> None:
         f"{len(episodes)} paired episodes, ratios to {label[ref_name]} (95 % paired bootstrap)",
         "",
         "| agent | bits/m ratio | coverage ratio | bits/m | coverage | decisions / episode "
-        "(steps each) | ms / step (× ref) |",
-        "|---|---|---|---:|---:|---:|---:|",
+        "(steps each) | ms / step (× ref) | s / episode |",
+        "|---|---|---|---:|---:|---:|---:|---:|",
     ]
     ref_ms = per_step_ms(ref_name)
     for agent in agents:
@@ -107,14 +117,47 @@ def main() -> None:
         decisions = np.mean([records[agent][i]["decisions"] for i in episodes])
         steps = np.mean([records[agent][i]["steps"] for i in episodes])
         ms = per_step_ms(agent)
+        seconds = np.mean([records[agent][i]["wall_s"] for i in episodes])
         lines.append(
             f"| {label[agent]} | {rb.text('{:.3f}')} | "
             f"{rc.text('{:.3f}')} | {bits.mean():.1f} | {cov.mean():.3f} | "
-            f"{decisions:.0f} ({steps / max(decisions, 1):.1f}) | {ms:.2f} ({ms / ref_ms:.2f}×) |"
+            f"{decisions:.0f} ({steps / max(decisions, 1):.1f}) | {ms:.2f} ({ms / ref_ms:.2f}×) "
+            f"| {seconds:.1f} |"
         )
+    budgets = [int(b) for b in args.budgets.split(",") if b]
+    if budgets:
+        lines += [
+            "",
+            f"Coverage at each step budget: mean, and ratio to {label[ref_name]} (95 % paired "
+            "bootstrap)",
+            "",
+            "| agent | " + " | ".join(f"{b:,} steps" for b in budgets) + " |",
+            "|---|" + "---|" * len(budgets),
+        ]
+        at = {
+            (a, b): np.array([coverage_at(records[a][i]["curve"], b) for i in episodes])
+            for a in agents
+            for b in budgets
+        }
+        for agent in agents:
+            cells = [
+                f"{at[agent, b].mean():.3f} "
+                f"({compare_paired(at[ref_name, b], at[agent, b], ratio=True).text('{:.3f}')})"
+                for b in budgets
+            ]
+            lines.append(f"| {label[agent]} | " + " | ".join(cells) + " |")
+    if any(is_privileged(a) for a in agents if ":" not in a):
+        lines += ["", PRIVILEGED_NOTE]
     text = "\n".join(lines)
     Path(args.out, "ratios.md").write_text(text + "\n", encoding="utf-8")
     print(text)
+
+
+def coverage_at(curve: list[list[float]], step: int) -> float:
+    """Coverage at ``step`` from an episode's curve (``[step, coverage, …]`` rows): the last
+    sample at or before it (an episode that ended earlier keeps its final coverage)."""
+    covered = [c for s, c, *_ in curve if s <= step]
+    return float(covered[-1])
 
 
 if __name__ == "__main__":

@@ -20,11 +20,11 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from sfw_gym.agents.base import AgentSettings, RobotView
+from sfw_gym.agents.base import AgentSettings, Decision, RobotView
 from sfw_gym.agents.oracles import OracleAgent
 from sfw_gym.core.config import setting
 from sfw_gym.core.constants import U8_FREE_MIN
-from sfw_gym.navigation.candidates import unknown_bits_at
+from sfw_gym.navigation.candidates import FEATURES, unknown_bits_at
 from sfw_gym.navigation.planning import (
     PurePursuit,
     cells_to_world,
@@ -35,6 +35,10 @@ from sfw_gym.navigation.planning import (
     wall_cost_term,
     wall_distance_m,
 )
+
+#: The oracle's decisions carry no menu features.
+NO_FEATURES = np.full(len(FEATURES), np.nan)
+NO_FEATURES.flags.writeable = False
 
 
 @dataclass(frozen=True)
@@ -70,7 +74,8 @@ class CoverageOracle(OracleAgent):
 
     Attributes:
         target_rc: The cell driven to (None: nothing left to gain).
-        n_plans: Replans this episode.
+        n_plans: Replans this episode (each choice of a target is also logged in
+            :attr:`decisions`, without menu features).
     """
 
     name = "oracle-coverage"
@@ -164,6 +169,7 @@ class CoverageOracle(OracleAgent):
         self._resume()
         i = int(np.argmax(bits / (metres + self.settings.distance_offset_m)))
         self.target_rc = (int(cells[i, 0]), int(cells[i, 1]))
+        self.decisions.append(Decision(self.steps, self.target_rc, len(cells), NO_FEATURES))
         self.follower.set_path(cells_to_world(self._grid, paths.path(self.target_rc)))
 
 

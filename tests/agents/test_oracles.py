@@ -164,3 +164,7 @@ def test_the_coverage_oracle_covers_a_small_plan_within_its_budget():
             obs, _, terminated, truncated, info = env.step(agent.act(obs))
         assert terminated and info["coverage"] >= target, (seed, info["coverage"])
         assert agent.stop_reason is None
+        # every target is logged, and each lies in the true free space
+        assert len(agent.decisions) == agent.n_plans
+        truth = env.unwrapped.ground_truth().truth_u8
+        assert all(truth[d.target_rc] == U8_FREE for d in agent.decisions)
