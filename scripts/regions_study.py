@@ -95,7 +95,8 @@ def main() -> None:
     episodes = sorted(set.intersection(*(set(v) for v in records.values())))
 
     def column(agent: str, key: str) -> np.ndarray:
-        return np.array([float(records[agent][i][key]) for i in episodes])
+        values = [records[agent][i].get(key) for i in episodes]
+        return np.array([np.nan if v is None else float(v) for v in values])
 
     def per_step_ms(agent: str) -> float:
         rows = [records[agent][i] for i in episodes]
@@ -105,9 +106,10 @@ def main() -> None:
     lines = [
         f"{len(episodes)} paired episodes, ratios to {label[ref_name]} (95 % paired bootstrap)",
         "",
-        "| agent | bits/m ratio | coverage ratio | bits/m | coverage | decisions / episode "
-        "(steps each) | ms / step (× ref) | s / episode |",
-        "|---|---|---|---:|---:|---:|---:|---:|",
+        "| agent | bits/m ratio | coverage ratio | bits/m | coverage | free IoU | wall precision "
+        "| wall recall | collisions | decisions / episode (steps each) | ms / step (× ref) "
+        "| s / episode |",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     ref_ms = per_step_ms(ref_name)
     for agent in agents:
@@ -121,6 +123,10 @@ def main() -> None:
         lines.append(
             f"| {label[agent]} | {rb.text('{:.3f}')} | "
             f"{rc.text('{:.3f}')} | {bits.mean():.1f} | {cov.mean():.3f} | "
+            f"{np.nanmean(column(agent, 'free_iou')):.3f} | "
+            f"{np.nanmean(column(agent, 'wall_precision')):.3f} | "
+            f"{np.nanmean(column(agent, 'interior_wall_recall')):.3f} | "
+            f"{column(agent, 'collisions').mean():.0f} | "
             f"{decisions:.0f} ({steps / max(decisions, 1):.1f}) | {ms:.2f} ({ms / ref_ms:.2f}×) "
             f"| {seconds:.1f} |"
         )
