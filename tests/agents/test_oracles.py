@@ -168,3 +168,26 @@ def test_the_coverage_oracle_covers_a_small_plan_within_its_budget():
         assert len(agent.decisions) == agent.n_plans
         truth = env.unwrapped.ground_truth().truth_u8
         assert all(truth[d.target_rc] == U8_FREE for d in agent.decisions)
+
+
+def test_the_shipped_region_actor_reads_no_true_plan():
+    """No learned agent reads an oracle's input: on the privileged regions env (its observation
+    holds the true plan, for the critic), the shipped actor's logits are the same whatever true
+    plan the observation carries."""
+    torch = pytest.importorskip("torch")
+    from sfw_gym.rl.agent import RegionsPPOAgent
+
+    policy = RegionsPPOAgent().model.policy
+    assert "true_map" not in policy.actor_keys
+    env = gym.make("SfW-ExploreRegions-v0", privileged=True)
+    obs, _ = env.reset(seed=2_000_000)
+    other, _ = gym.make("SfW-ExploreRegions-v0", privileged=True).reset(seed=2_000_001)
+    assert not np.array_equal(obs["true_map"], other["true_map"])
+    for _ in range(3):
+        with torch.no_grad():
+            logits = [
+                policy.actor_logits({k: torch.as_tensor(o[k])[None] for k in o})
+                for o in (obs, {**obs, "true_map": other["true_map"]})
+            ]
+        assert torch.equal(*logits)
+        obs, *_ = env.step(env.unwrapped.teacher_action())
