@@ -3,7 +3,7 @@ what is done) and writes the table into docs/benchmark.md between its markers; `
 runs the oracles (privileged, never among the shipped agents) into the oracles' table.
 
     python scripts/benchmark_shipped.py [--workers 2] [--out runs/benchmark]
-    python scripts/benchmark_shipped.py --oracles     # oracle-regions: 10 episodes per env
+    python scripts/benchmark_shipped.py --oracles     # oracle-regions: 5 episodes per env
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ COLUMNS = ("coverage", "info_gain_per_m", "path_length_m", "free_iou", "wall_pre
 
 
 #: Episodes per env of the agents too slow for the whole split (~1 min an episode).
-EPISODE_CAPS = {"oracle-regions": 10}
+EPISODE_CAPS = {"oracle-regions": 5}
 
 
 def shipped_agents() -> list[str]:
