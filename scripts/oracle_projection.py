@@ -9,7 +9,7 @@ budget the script prints bits per metre and coverage as ratios to frontier's, pa
 (95 % bootstrap). If the projection keeps the oracle's gain, distilling it is worth a training
 run; if it does not, no region policy can learn it.
 
-    python scripts/oracle_projection.py --seeds 10 --budgets 3000,10000
+    python scripts/oracle_projection.py --seeds 5 --budgets 1000,3000,10000
 """
 
 from __future__ import annotations
@@ -80,7 +80,7 @@ def main() -> None:
     p.add_argument("--budgets", default="3000,10000")
     args = p.parse_args()
     budgets = sorted(int(b) for b in args.budgets.split(","))
-    names = ("frontier", "oracle-coverage", "oracle-projected", "region-teacher")
+    names = ("frontier", "oracle-coverage", "oracle-projected")
     results: dict[str, list[dict[int, tuple[float, float]]]] = {n: [] for n in names}
     for seed in range(2_000_000, 2_000_000 + args.seeds):
         for name in names:
