@@ -3,13 +3,17 @@
 Privileged (:mod:`sfw_gym.agents.oracles`): it reads the true plan, pose and radio. Every replan
 it scores candidate cells of the true free space (where the robot fits) by the bits the mapper
 could gain there, divided by the true shortest path's cost plus an offset, and drives the true
-shortest path to the best one with pure pursuit on the true pose: no bumps, no detours through
-believed walls, no goals behind unseen walls.
+shortest path to the best one with pure pursuit on the true pose: no searching, no detours
+through believed walls, no goals behind unseen walls. Its paths may run a robot's radius from a
+wall (``margin_m`` 0), where the footprint reaches the cells along it; it brushes walls there, a
+third as often as frontier bumps (BENCHMARKS.md, issue 40). On a drifting-odometry env it is
+no ceiling: the belief it reads is drawn in the drifting frame, and it plans in the true one.
 
 The gain at a cell is the entropy of the belief's unknown cells the robot would resolve there:
 its footprint (the mapper's rule 1), and the stretch of the ray towards the router that is truly
 strongest there (the one the mapper updates), from the cell back to the first true wall: the
-cells that line-of-sight readings, or two readings with equal k on that ray, mark free.
+cells that line-of-sight readings, or two readings with equal k on that ray, mark free (a
+stretch with a wall between it and the router counts ``blocked_ray_weight`` of its bits).
 """
 
 from __future__ import annotations
