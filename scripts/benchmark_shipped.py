@@ -15,7 +15,7 @@ from pathlib import Path
 from sfw_gym.agents import AGENTS, is_privileged
 from sfw_gym.evaluation.benchmark import format_interval, run_benchmark
 from sfw_gym.evaluation.metric_table import METRICS
-from sfw_gym.evaluation.report import PRIVILEGED_NOTE
+from sfw_gym.evaluation.report import PRIVILEGED_NOTE, agent_label
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "benchmark.md"
 COLUMNS = ("coverage", "info_gain_per_m", "path_length_m", "free_iou", "wall_precision", "ate_m")
@@ -80,7 +80,7 @@ def table(results: dict[str, dict]) -> list[str]:
         for name, r in results.items():
             stats = r["summary"][env_id]
             cells = [format_interval(stats[c], c) if c in stats else "–" for c in columns]
-            label = name + (" †" if r.get("privileged") else "")
+            label = agent_label(name, r.get("privileged", False))
             n = stats["coverage"]["n"]
             lines.append(f"| {label} | {n} | " + " | ".join(cells) + " |")
     return lines

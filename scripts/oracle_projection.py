@@ -47,7 +47,7 @@ class ProjectedOracle(OracleAgent, RegionAgent):
     def choose(
         self, view: RobotView, obs: Any, menu: CandidateGoals, extra: dict[str, np.ndarray]
     ) -> int:
-        self.tour._plan(view, self.ground_truth().pose)
+        self.tour.plan(view, self.ground_truth().pose)
         valid = np.flatnonzero(menu.valid[: self.config.max_candidates])
         if self.tour.target_rc is None or not len(valid):
             return super().choose(view, obs, menu, extra)

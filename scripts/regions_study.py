@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from sfw_gym.agents import is_privileged
-from sfw_gym.evaluation.report import PRIVILEGED_NOTE
+from sfw_gym.evaluation.report import PRIVILEGED_NOTE, agent_label
 from sfw_gym.evaluation.runner import evaluate
 from sfw_gym.evaluation.stats import compare_paired
 
@@ -74,7 +74,7 @@ def main() -> None:
             label[entry] = label_text
         else:
             agents.append(name)
-            label[name] = name + (" †" if is_privileged(name) else "")
+            label[name] = agent_label(name, is_privileged(name))
     if args.model and "regions-ppo" in agents:
         params.setdefault("regions-ppo", {})["path"] = args.model
     result = evaluate(
@@ -152,7 +152,7 @@ def main() -> None:
                 for b in budgets
             ]
             lines.append(f"| {label[agent]} | " + " | ".join(cells) + " |")
-    if any(is_privileged(a) for a in agents if ":" not in a):
+    if any(is_privileged(a) for a in agents):
         lines += ["", PRIVILEGED_NOTE]
     text = "\n".join(lines)
     Path(args.out, "ratios.md").write_text(text + "\n", encoding="utf-8")

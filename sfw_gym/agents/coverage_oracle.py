@@ -50,7 +50,8 @@ class CoverageOracleSettings(AgentSettings):
     """The parameters of :class:`CoverageOracle`.
 
     Attributes:
-        replan_every_steps: Choose the next target at least this often (and on arrival).
+        replan_every_steps: Choose the next target after this many steps on one (one more when
+            it was chosen on arrival, mid-step), and on arrival.
         distance_offset_m: Added to a candidate's path cost (keeps near goals from dominating).
         candidate_stride_cells: Candidates are the free cells of a lattice this many cells apart.
         margin_m: Paths keep this much clearance beyond the robot's radius from true walls.
@@ -133,27 +134,22 @@ class CoverageOracle(OracleAgent):
 
     def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
         pose = self.ground_truth().pose
-        mark_disk(self._visited, self._cell(pose), self._radius_m / self._res)
+        mark_disk(self._visited, self._grid.clipped_cell(pose), self._radius_m / self._res)
         if not self.follower.has_path or self._since_plan >= self.settings.replan_every_steps:
-            self._plan(view, pose)
+            self.plan(view, pose)
         self._since_plan += 1
         linear, angular = self.follower.command(pose)
         if not self.follower.has_path:  # arrived: on to the next target at once
-            self._plan(view, pose)
+            self.plan(view, pose)
             linear, angular = self.follower.command(pose)
         return linear, angular
 
-    def _cell(self, pose: tuple[float, float, float]) -> tuple[int, int]:
-        """The grid cell of a pose (clipped into the grid)."""
-        h, w = self._cost.shape
-        r, c = self._grid.world_to_cell(np.array(pose[:2])).tolist()
-        return min(max(r, 0), h - 1), min(max(c, 0), w - 1)
-
-    def _plan(self, view: RobotView, pose: tuple[float, float, float]) -> None:
-        """Choose the target of most bits per metre on the true plan; set its true path."""
+    def plan(self, view: RobotView, pose: tuple[float, float, float]) -> None:
+        """Choose the target of most bits per metre on the true plan from the true ``pose`` and
+        set its true path (:attr:`target_rc`; None when nothing is left to gain)."""
         self.n_plans += 1
         self._since_plan = 0
-        start = self._cell(pose)
+        start = self._grid.clipped_cell(pose)
         paths = cost_field(free_start(self._cost, start), start, self._res)
         cells = self._candidates
         metres = paths.cumulative[cells[:, 0], cells[:, 1]]

@@ -38,7 +38,7 @@ from sfw_gym.agents.regions import RegionAgent, RegionAgentSettings
 from sfw_gym.core.config import setting
 from sfw_gym.envs.goals import menu_observation
 from sfw_gym.envs.regions import region_anchor
-from sfw_gym.navigation.candidates import CandidateGoals, bits_per_metre
+from sfw_gym.navigation.candidates import GREEDY_OFFSET_M, CandidateGoals, bits_per_metre
 
 #: What a simulation is scored by (see :class:`RegionOracleSettings`).
 SCORES = ("bits", "bits_per_metre", "coverage")
@@ -102,7 +102,7 @@ class RegionOracle(OracleAgent, RegionAgent):
         """The candidates simulated, best first: the teacher's choice, then the other valid
         candidates by expected bits per metre (the greedy teacher's score), at most
         ``candidates``."""
-        score = bits_per_metre(menu, 0.3)
+        score = bits_per_metre(menu, GREEDY_OFFSET_M)
         others = [
             int(i) for i in np.argsort(-score, kind="stable") if menu.valid[i] and i != teacher
         ]
@@ -134,7 +134,7 @@ class RegionOracle(OracleAgent, RegionAgent):
         cfg, s = self.config, self.settings
         env, finder, steering = copy.deepcopy((self._env, self.finder, self.steering))
         entropy0, metres0 = env.mapper.entropy_bits, env.path_length_m
-        coverage0 = env.tracker.metrics()["coverage"]
+        coverage_before = env.tracker.metrics()["coverage"] if s.score == "coverage" else 0.0
         info: dict[str, Any] = {}
         steps, decisions = self.steps, 1
         max_steps = s.max_steps if s.max_steps is not None else np.inf
@@ -164,5 +164,5 @@ class RegionOracle(OracleAgent, RegionAgent):
         if s.score == "bits_per_metre":
             return bits / (info["path_length_m"] - metres0 + s.distance_offset_m)
         if s.score == "coverage":
-            return float(info["coverage"] - coverage0)
+            return float(info["coverage"] - coverage_before)
         return float(bits)

@@ -117,7 +117,7 @@ def run_benchmark(
     ``episodes`` caps the episodes per env (a quick look; recorded in the results);
     ``workers``, ``backend`` and ``address`` as :func:`~sfw_gym.evaluation.evaluate`'s."""
     from sfw_gym import __version__
-    from sfw_gym.agents import agent_class
+    from sfw_gym.agents import is_privileged
     from sfw_gym.evaluation.rollout import EpisodeSpec
     from sfw_gym.evaluation.runner import run_specs
 
@@ -166,7 +166,7 @@ def run_benchmark(
         "package_version": __version__,
         "agent": agent,
         "agent_params": dict(agent_params or {}),
-        "privileged": agent_class(agent).privileged,
+        "privileged": is_privileged(agent),
         "agent_seed": agent_seed,
         "split": split,
         "episodes_cap": episodes,

@@ -37,12 +37,17 @@ PRIVILEGED_NOTE = (
 )
 
 
+def agent_label(name: str, privileged: bool) -> str:
+    """An agent's name in a table: an oracle's marked † (:data:`PRIVILEGED_NOTE`)."""
+    return f"{name} †" if privileged else name
+
+
 def results_markdown(rows: list[dict[str, Any]]) -> str:
     """The summary rows as a Markdown table (mean ± 95 % CI); oracles' rows marked †."""
     head = ["agent", "episodes"] + [m.label for m in TABLE_METRICS] + ["≥ 90 % cov."]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for row in rows:
-        cells = [row["agent"] + (" †" if row.get("privileged") else ""), str(row["episodes"])]
+        cells = [agent_label(row["agent"], row.get("privileged", False)), str(row["episodes"])]
         for m in TABLE_METRICS:
             mean, ci, n = row[f"{m.key}_mean"], row[f"{m.key}_ci95"], row[f"{m.key}_n"]
             if n == 0:

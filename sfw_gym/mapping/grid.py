@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -149,6 +150,11 @@ class GridSpec:
         """
         g = np.floor(self.world_to_grid(xy)).astype(np.int64)
         return g[..., ::-1].copy()
+
+    def clipped_cell(self, xy: Any) -> tuple[int, int]:
+        """The cell ``(row, col)`` of one world point ``(x, y)``, clipped into the grid."""
+        r, c = self.world_to_cell(np.asarray(xy, np.float64)[:2])
+        return min(max(int(r), 0), self.n_rows - 1), min(max(int(c), 0), self.n_cols - 1)
 
     def cell_to_world(self, rc: np.ndarray) -> np.ndarray:
         """World ``(x, y)`` of cell centres.

@@ -200,7 +200,11 @@ def bits_per_metre(menu: CandidateGoals, distance_offset_m: float = 1.0) -> np.n
     return menu.feature("expected_gain_bits") / (menu.feature("path_cost_m") + distance_offset_m)
 
 
-def greedy_choice(menu: CandidateGoals, distance_offset_m: float = 0.3) -> int | None:
+#: The tuned greedy agent's distance offset (DESIGN.md's sweep): the greedy teacher's.
+GREEDY_OFFSET_M = 0.3
+
+
+def greedy_choice(menu: CandidateGoals, distance_offset_m: float = GREEDY_OFFSET_M) -> int | None:
     """The index of the valid candidate with the most expected bits per metre
     (:func:`bits_per_metre`; the tuned greedy agent's offset), None when none is valid."""
     score = np.where(menu.valid, bits_per_metre(menu, distance_offset_m), -np.inf)

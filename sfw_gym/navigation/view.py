@@ -106,6 +106,4 @@ class RobotView:
     @cached_property
     def cell(self) -> tuple[int, int]:
         """Grid cell ``(row, col)`` of the odometry position (clipped into the grid)."""
-        r, c = self.grid.world_to_cell(self.xy)
-        h, w = self.grid.shape
-        return min(max(int(r), 0), h - 1), min(max(int(c), 0), w - 1)
+        return self.grid.clipped_cell(self.xy)

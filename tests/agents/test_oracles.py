@@ -11,6 +11,7 @@ from types import ModuleType, SimpleNamespace
 import gymnasium as gym
 import numpy as np
 import pytest
+import yaml
 from shapely.geometry import Polygon
 
 import sfw_gym  # noqa: F401  (registration)
@@ -18,11 +19,16 @@ from sfw_gym.agents import AGENTS, agent_class, is_privileged, make_agent
 from sfw_gym.agents.oracles import ORACLE_PREFIX
 from sfw_gym.cli import build_parser
 from sfw_gym.core.constants import U8_FREE, U8_UNKNOWN
+from sfw_gym.core.data import data_path
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.demo import DEMO_AGENTS
 from sfw_gym.envs.robot_view_info import RobotViewInInfo
+from sfw_gym.evaluation import benchmark as bm
+from sfw_gym.evaluation import evaluate
 from sfw_gym.evaluation.benchmark import results_markdown as benchmark_markdown
+from sfw_gym.evaluation.metric_table import TABLE_METRICS
 from sfw_gym.evaluation.report import PRIVILEGED_NOTE, results_markdown
+from sfw_gym.navigation.planning import wall_distance_m
 from sfw_gym.world.floorplan import Floorplan
 from tests.agents.test_agents import _reachable
 
@@ -84,8 +90,6 @@ def test_no_default_runs_an_oracle():
 
 def test_tables_mark_an_oracle_as_privileged():
     row = {"agent": "oracle-coverage", "episodes": 0, "episodes_coverage_ge_90": 0}
-    from sfw_gym.evaluation.metric_table import TABLE_METRICS
-
     for m in TABLE_METRICS:
         row |= {f"{m.key}_mean": 0.0, f"{m.key}_ci95": 0.0, f"{m.key}_n": 0}
     assert PRIVILEGED_NOTE not in results_markdown([row | {"privileged": False}])
@@ -102,6 +106,47 @@ def test_tables_mark_an_oracle_as_privileged():
     }
     assert PRIVILEGED_NOTE not in benchmark_markdown(results | {"privileged": False})
     assert PRIVILEGED_NOTE in benchmark_markdown(results | {"privileged": True})
+
+
+def test_an_evaluation_and_a_benchmark_record_and_mark_an_oracle(tmp_path):
+    short = {"max_steps": 20}
+    result = evaluate(
+        ["frontier", "oracle-coverage"],
+        1,
+        out=tmp_path / "ev",
+        env_id="SfW-ExploreSmall-v0",
+        env_kwargs=short,
+        workers=1,
+        progress=False,
+    )
+    assert {r["agent"]: r["privileged"] for r in result["records"]} == {
+        "frontier": False,
+        "oracle-coverage": True,
+    }
+    table = (tmp_path / "ev" / "results.md").read_text(encoding="utf-8")
+    assert "| oracle-coverage † |" in table and "| frontier |" in table
+    assert PRIVILEGED_NOTE in table
+    protocol = yaml.safe_load(data_path("envs", "benchmark-v1.yml").read_text(encoding="utf-8"))
+    protocol["envs"] = [{**protocol["envs"][0], "kwargs": short}]
+    path = tmp_path / "short.yml"
+    path.write_text(yaml.safe_dump(protocol), encoding="utf-8")
+    for name, privileged in (("oracle-coverage", True), ("random", False)):
+        results = bm.run_benchmark(
+            name, protocol=path, out=tmp_path / name, episodes=1, progress=False
+        )
+        assert results["privileged"] is privileged
+        assert (PRIVILEGED_NOTE in (tmp_path / name / "results.md").read_text()) is privileged
+
+
+def test_coverage_at_a_budget_reads_the_last_sample_at_or_before_it():
+    spec = importlib.util.spec_from_file_location("study", ROOT / "scripts/regions_study.py")
+    assert spec and spec.loader
+    study = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(study)
+    curve = [[0, 0.0, 0.0, 0.0], [10, 0.2, 0.0, 1.0], [20, 0.5, 0.0, 2.0], [25, 0.6, 0.0, 2.5]]
+    assert study.coverage_at(curve, 10) == 0.2
+    assert study.coverage_at(curve, 19) == 0.2
+    assert study.coverage_at(curve, 1000) == 0.6  # ended earlier: its final coverage
 
 
 # ------------------------------------------------------------------------- the coverage oracle
@@ -191,3 +236,47 @@ def test_the_shipped_region_actor_reads_no_true_plan():
             ]
         assert torch.equal(*logits)
         obs, *_ = env.step(env.unwrapped.teacher_action())
+
+
+def test_its_settings_shape_where_it_goes():
+    """Targets keep ``margin_m`` clear of true walls beyond the radius and lie on the
+    ``candidate_stride_cells`` lattice; the follower takes ``lookahead_m``; it replans at least
+    ``replan_every_steps`` steps (one more after a target chosen on arrival, mid-step)."""
+    env = gym.make("SfW-Explore-v0", max_steps=200)
+    obs, _ = env.reset(seed=1, options={"floorplan": two_rooms()})
+    params = {"margin_m": 0.2, "candidate_stride_cells": 3, "lookahead_m": 0.7}
+    agent = make_agent("oracle-coverage", replan_every_steps=4, **params)
+    agent.reset(env, seed=1)
+    for _ in range(200):
+        obs, *_ = env.step(agent.act(obs))
+    truth = env.unwrapped.ground_truth()
+    clear = wall_distance_m(truth.truth_u8 < U8_FREE, truth.grid.resolution_m)
+    targets = np.array([d.target_rc for d in agent.decisions])
+    assert (clear[targets[:, 0], targets[:, 1]] > 0.17 + 0.2).all()
+    assert (targets % 3 == 0).all()
+    assert agent.follower.lookahead_m == 0.7
+    assert agent.n_plans >= 200 / 4
+    steps = np.diff([d.step for d in agent.decisions])
+    assert steps.max() <= 4 + 1
+
+
+def two_cells_with_bits(bits):
+    """A stand-in for the oracle's gains: ``bits`` at those cells, none elsewhere."""
+    return lambda view, cells: np.array([bits.get(tuple(c), 0.0) for c in cells])
+
+
+def test_it_chooses_by_bits_per_metre_with_the_offset(monkeypatch):
+    """Two cells with something to gain: a near one with 1 bit and a far one with 3. Without
+    an offset the near one has more bits per metre; with a large offset the far one does."""
+    env, _ = oracle_on_two_rooms((0.55, 2.05))
+    start = env.unwrapped.ground_truth().pose
+    at = tuple(cell(env, start[:2]))
+    near, far = (at[0], at[1] + 5), (at[0], at[1] - 25)
+    chosen = {}
+    for offset in (0.01, 100.0):
+        oracle = make_agent("oracle-coverage", distance_offset_m=offset, candidate_stride_cells=1)
+        oracle.reset(env, seed=0)
+        monkeypatch.setattr(oracle, "gains", two_cells_with_bits({near: 1.0, far: 3.0}))
+        oracle.plan(env.unwrapped.robot_view(), start)
+        chosen[offset] = oracle.target_rc
+    assert chosen == {0.01: near, 100.0: far}

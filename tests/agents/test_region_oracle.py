@@ -93,7 +93,7 @@ def test_same_seeds_give_the_same_actions():
         np.testing.assert_array_equal(a, b)
 
 
-@pytest.mark.parametrize("score", ["bits", "coverage"])
+@pytest.mark.parametrize("score", ["bits", "bits_per_metre", "coverage"])
 def test_its_choice_is_the_best_of_the_simulations_each_rescored_on_a_fresh_env(score):
     """Each simulated candidate's score equals a fresh env driven by the teacher forced to that
     candidate for the first decision (then its own for the horizon); the oracle takes the best."""
@@ -109,11 +109,13 @@ def test_its_choice_is_the_best_of_the_simulations_each_rescored_on_a_fresh_env(
         forced.reset(env, seed=0)
         for _ in range(steps):
             obs, _, _, _, info = env.step(forced.act(obs))
-        got = (
-            info0["entropy_bits"] - info["entropy_bits"]
-            if score == "bits"
-            else info["coverage"] - info0["coverage"]
-        )
+        bits = info0["entropy_bits"] - info["entropy_bits"]
+        metres = info["path_length_m"] - info0["path_length_m"] + oracle.settings.distance_offset_m
+        got = {
+            "bits": bits,
+            "bits_per_metre": bits / metres,
+            "coverage": info["coverage"] - info0["coverage"],
+        }[score]
         assert got == pytest.approx(expected, rel=1e-12, abs=1e-12), i
     assert scores[oracle.choices[0]] == max(scores.values())
 

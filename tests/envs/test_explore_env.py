@@ -108,6 +108,15 @@ def test_robot_view_holds_no_ground_truth():
     assert view.rssi_history.shape == (31, 2)
 
 
+def test_the_ground_truth_holds_the_true_pose_now():
+    env = gym.make("SfW-Explore-v0", robot={"odometry_translation_std": 0.05})
+    env.reset(seed=0)
+    info = drive(env, 30)[4]
+    truth = env.unwrapped.ground_truth()
+    assert truth.pose == tuple(info["true_pose"])
+    assert truth.pose[:2] == tuple(truth.trajectory[-1])
+
+
 def test_robot_view_is_read_only_views_not_copies():
     """robot_view() is O(1): read-only views of the env's arrays, whatever the episode length."""
     env = gym.make("SfW-ExploreSmall-v0", max_steps=1100)

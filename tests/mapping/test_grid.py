@@ -32,6 +32,15 @@ def test_rows_are_y_and_cols_are_x():
     assert g.n_rows == 10 and g.n_cols == 20
 
 
+def test_a_point_s_clipped_cell_is_its_cell_inside_and_the_nearest_edge_cell_outside():
+    g = GridSpec((-3.0, 4.5), 0.05, (40, 70))
+    assert g.clipped_cell((-2.97, 4.58)) == (1, 0)
+    assert g.clipped_cell((-2.97, 4.58, 1.0)) == (1, 0)  # a pose: its heading is ignored
+    assert g.clipped_cell((-9.0, 0.0)) == (0, 0)
+    assert g.clipped_cell((9.0, 99.0)) == (39, 69)
+    assert all(type(v) is int for v in g.clipped_cell((0.0, 5.0)))
+
+
 def test_round_trip_over_all_cells():
     g = GridSpec((-3.0, 4.5), 0.05, (40, 70))
     rr, cc = np.meshgrid(np.arange(40), np.arange(70), indexing="ij")
