@@ -30,7 +30,7 @@ ENV_IDS: dict[str, dict[str, Any]] = {
     # steering drives towards it (≤ 150 decisions an episode; sfw_gym.envs.regions).
     "SfW-ExploreRegions-v0": {},
     # Drifting odometry (5 % of each step's travel, 0.02 rad of heading per step: about 1 m of
-    # ATE over 1,500 frontier steps, scripts/slam_study.py) and 16 background access
+    # ATE over 1,500 frontier steps, scripts/studies/slam_study.py) and 16 background access
     # points whose fingerprint Radio SLAM (sfw_gym.slam.radio_slam) can close loops with.
     "SfW-ExploreDrift-v0": {
         "robot": {"odometry_translation_std": 0.05, "odometry_heading_std_rad": 0.02},

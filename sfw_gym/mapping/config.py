@@ -45,7 +45,7 @@ class MapperConfig(Config):
         min_cluster_gap_db: Adjacent sorted centroids closer than this are merged (so data with
             fewer than K + 1 levels is not split); 0 keeps exactly K + 1 clusters as the paper.
             The default, 0.7 of the default wall loss, also keeps k-means from cutting one level
-            broadened by shadowing into two (measured in scripts/bench_mapper_quality.py:
+            broadened by shadowing into two (measured in scripts/benchmarks/bench_mapper_quality.py:
             k-accuracy 0.66 -> 0.72 with the default radio noise, noise-off maps unchanged).
         min_level_fraction: Clusters holding less than this fraction of the samples are merged
             into their nearest neighbour (outliers, e.g. right beside a router, must not

@@ -30,7 +30,7 @@ MIN_EXTENT_M, MAX_EXTENT_M = 1.0, 500.0
 #: A free space smaller than this cannot hold a robot: rejected as absurd.
 MIN_AREA_M2 = 0.5
 #: A free space with more vertices than this is refused (HouseExpo's have tens to hundreds; a
-#: reset costs about 25 ms per 1,000 vertices: scripts/bench_plan_size.py).
+#: reset costs about 25 ms per 1,000 vertices: scripts/benchmarks/bench_plan_size.py).
 MAX_VERTICES = 50_000
 #: A floorplan file larger than this is refused before it is read (HouseExpo's are ~10 kB).
 MAX_FILE_BYTES = 50_000_000

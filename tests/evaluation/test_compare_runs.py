@@ -1,4 +1,4 @@
-"""``scripts/compare_runs.py``: two runs' episodes paired by seed, through the package's one
+"""``scripts/studies/compare_runs.py``: two runs' episodes paired by seed, through the package's one
 paired comparison and its table."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "compare_runs.py"
+SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "studies" / "compare_runs.py"
 
 
 def _script():

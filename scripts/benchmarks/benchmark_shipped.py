@@ -1,0 +1,90 @@
+"""The shipped agents on benchmark-v1 / test: runs each through `sfw-gym benchmark` (resuming
+what is done) and writes the table into docs/benchmark.md between its markers; ``--oracles``
+runs the oracles (privileged, never among the shipped agents) into the oracles' table.
+
+    python scripts/benchmarks/benchmark_shipped.py [--workers 2] [--out runs/benchmark]
+    python scripts/benchmarks/benchmark_shipped.py --oracles     # oracle-regions: 5 episodes per env
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+from pathlib import Path
+
+from sfw_gym.agents import AGENTS, is_privileged
+from sfw_gym.evaluation.benchmark import format_interval, run_benchmark
+from sfw_gym.evaluation.metric_table import METRICS
+from sfw_gym.evaluation.report import PRIVILEGED_NOTE, agent_label
+
+DOC = Path(__file__).resolve().parents[2] / "docs" / "benchmark.md"
+COLUMNS = ("coverage", "info_gain_per_m", "path_length_m", "free_iou", "wall_precision", "ate_m")
+
+
+#: Episodes per env of the agents too slow for the whole split (~1 min an episode).
+EPISODE_CAPS = {"oracle-regions": 5}
+
+
+def shipped_agents() -> list[str]:
+    """Every registered agent but the oracles (privileged: run them by name)."""
+    return [name for name in AGENTS if not is_privileged(name)]
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--workers", type=int, default=2)
+    p.add_argument("--out", default="runs/benchmark")
+    p.add_argument("--split", default="test")
+    p.add_argument(
+        "--oracles",
+        action="store_true",
+        help="run the oracles instead (privileged) into the doc's oracle table",
+    )
+    args = p.parse_args()
+    names = [n for n in AGENTS if is_privileged(n)] if args.oracles else shipped_agents()
+    results = {
+        name: run_benchmark(
+            name,
+            split=args.split,
+            out=Path(args.out) / name,
+            workers=args.workers,
+            episodes=EPISODE_CAPS.get(name),
+        )
+        for name in names
+    }
+    lines = table(results)
+    if args.oracles:
+        lines += ["", PRIVILEGED_NOTE]
+    marker = "oracles" if args.oracles else "benchmark"
+    text = DOC.read_text(encoding="utf-8")
+    block = f"<!-- {marker}:begin -->\n" + "\n".join(lines) + f"\n<!-- {marker}:end -->"
+    pattern = f"<!-- {marker}:begin -->.*<!-- {marker}:end -->"
+    DOC.write_text(re.sub(pattern, lambda _: block, text, flags=re.S))
+    print("\n".join(lines))
+
+
+def table(results: dict[str, dict]) -> list[str]:
+    """The results as a Markdown table per env (oracles marked †)."""
+    first = next(iter(results.values()))
+    flags = " --oracles" if first.get("privileged") else ""
+    lines = [
+        f"`python scripts/benchmarks/benchmark_shipped.py{flags}` (sfw_gym {first['package_version']}, "
+        f"{first['protocol']} / {first['split']}, agent seed 0; mean [95 % bootstrap interval]; "
+        "`sfw-gym benchmark compare` gives any pair's paired differences).",
+    ]
+    for env_id in first["summary"]:
+        columns = [c for c in COLUMNS if any(c in r["summary"][env_id] for r in results.values())]
+        lines += ["", f"**{env_id}**", ""]
+        lines.append("| agent | episodes | " + " | ".join(METRICS[c].label for c in columns) + " |")
+        lines.append("|---|---:|" + "---:|" * len(columns))
+        for name, r in results.items():
+            stats = r["summary"][env_id]
+            cells = [format_interval(stats[c], c) if c in stats else "–" for c in columns]
+            label = agent_label(name, r.get("privileged", False))
+            n = stats["coverage"]["n"]
+            lines.append(f"| {label} | {n} | " + " | ".join(cells) + " |")
+    return lines
+
+
+if __name__ == "__main__":
+    main()
