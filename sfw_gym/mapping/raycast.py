@@ -47,6 +47,18 @@ def _clip_to_box(x0, y0, dx, dy, w, h):
 
 
 @njit(cache=True)
+def _axis_steps(p0, d, cell):
+    """One axis of the traversal from ``p0`` moving ``d`` per unit ``t``, in ``cell``: the step
+    (+1, -1 or 0), the ``t`` one cell takes and the ``t`` at which the first cell border is
+    crossed (``inf`` when the segment does not move along the axis)."""
+    if d > 0.0:
+        return 1, 1.0 / d, (cell + 1 - p0) / d
+    if d < 0.0:
+        return -1, -1.0 / d, (cell - p0) / d
+    return 0, np.inf, np.inf
+
+
+@njit(cache=True)
 def traverse_grid(x0, y0, x1, y1, n_rows, n_cols, out_rows, out_cols, out_t0, out_t1):
     """Cells crossed by a segment, in order, clipped to the grid.
 
@@ -72,31 +84,8 @@ def traverse_grid(x0, y0, x1, y1, n_rows, n_cols, out_rows, out_cols, out_t0, ou
     row = int(np.floor(py))
     col = min(max(col, 0), n_cols - 1)
     row = min(max(row, 0), n_rows - 1)
-    inf = np.inf
-    if dx > 0.0:
-        sx = 1
-        t_dx = 1.0 / dx
-        t_max_x = (col + 1 - x0) / dx
-    elif dx < 0.0:
-        sx = -1
-        t_dx = -1.0 / dx
-        t_max_x = (col - x0) / dx
-    else:
-        sx = 0
-        t_dx = inf
-        t_max_x = inf
-    if dy > 0.0:
-        sy = 1
-        t_dy = 1.0 / dy
-        t_max_y = (row + 1 - y0) / dy
-    elif dy < 0.0:
-        sy = -1
-        t_dy = -1.0 / dy
-        t_max_y = (row - y0) / dy
-    else:
-        sy = 0
-        t_dy = inf
-        t_max_y = inf
+    sx, t_dx, t_max_x = _axis_steps(x0, dx, col)
+    sy, t_dy, t_max_y = _axis_steps(y0, dy, row)
     n = 0
     t_cur = t_lo
     while n < cap:

@@ -207,10 +207,13 @@ def _wall_candidates(j0, j1, dk, s_mid, ray, l_tot, cls, n_cols):
 
 
 @njit(cache=True)
-def _push_anchors(
-    raster_r, rows, cols, t0, t1, l_tot, thresholds_r, n_thr_r, lo, hi, anc_j, anc_s, anc_k, n_anc
-):
-    """Append the visited ray cells lo..hi-1 (trajectory points) as anchors with their k."""
+def _push_anchors(traj, ray, l_tot, lo, hi, anchors, n_anc):
+    """Append the visited ray cells lo..hi-1 (trajectory points) as anchors with their k.
+
+    ``traj`` is one router's trajectory raster, its k thresholds and their count."""
+    raster_r, thresholds_r, n_thr_r = traj
+    rows, cols, t0, t1 = ray
+    anc_j, anc_s, anc_k = anchors
     for j in range(lo, hi):
         f = raster_r[rows[j], cols[j]]
         if f == f:  # visited (not NaN)
@@ -222,30 +225,16 @@ def _push_anchors(
 
 
 @njit(cache=True)
-def _ray_update(
-    r,
-    k_robot,
-    gx,
-    gy,
-    rgx,
-    rgy,
-    extend,
-    params,
-    raster,
-    thresholds,
-    n_thr,
-    maps,
-    track,
-    ray,
-    anchors,
-):
-    """Segment the ray of router ``r`` at earlier trajectory points and update every piece."""
+def _ray_update(k_robot, gx, gy, router_g, extend, params, traj, maps, track, ray, anchors):
+    """Segment the ray from the router at ``router_g`` at earlier trajectory points (``traj``:
+    that router's, as :func:`_push_anchors` reads it) and update every piece."""
     rows, cols, t0, t1 = ray
     anc_j, anc_s, anc_k = anchors
     lo = maps[0]
     cls = maps[3]
-    n_rows = raster.shape[1]
-    n_cols = raster.shape[2]
+    n_rows, n_cols = traj[0].shape
+    rgx = router_g[0]
+    rgy = router_g[1]
     dx = gx - rgx
     dy = gy - rgy
     dist = np.sqrt(dx * dx + dy * dy)
@@ -272,48 +261,18 @@ def _ray_update(
     anc_s[0] = 0.0
     anc_k[0] = 0
     n_anc = 1
-    n_anc = _push_anchors(
-        raster[r],
-        rows,
-        cols,
-        t0,
-        t1,
-        l_tot,
-        thresholds[r],
-        n_thr[r],
-        0,
-        i_r,
-        anc_j,
-        anc_s,
-        anc_k,
-        n_anc,
-    )
+    n_anc = _push_anchors(traj, ray, l_tot, 0, i_r, anchors, n_anc)
     anc_j[n_anc] = i_r
     anc_s[n_anc] = dist
     anc_k[n_anc] = k_robot
     n_anc += 1
     if extend:
-        n_anc = _push_anchors(
-            raster[r],
-            rows,
-            cols,
-            t0,
-            t1,
-            l_tot,
-            thresholds[r],
-            n_thr[r],
-            i_r + 1,
-            n,
-            anc_j,
-            anc_s,
-            anc_k,
-            n_anc,
-        )
+        n_anc = _push_anchors(traj, ray, l_tot, i_r + 1, n, anchors, n_anc)
     rad = params[_P_RADIUS] / params[_P_RES]
     lmin = params[_P_LMIN]
     lmax = params[_P_LMAX]
     free = params[_P_FREE]
-    k_sat = thresholds.shape[1]
+    k_sat = traj[1].shape[0]
     gain = 0.0
     for a in range(n_anc - 1):
         j0 = anc_j[a] + 1
@@ -429,22 +388,9 @@ def _update_kernel(
             n_sel = 1
     for q in range(n_sel):
         r = selected[q]
+        traj = (raster[r], thresholds[r], n_thr[r])
         gain += _ray_update(
-            r,
-            k_out[r],
-            gx,
-            gy,
-            routers_g[r, 0],
-            routers_g[r, 1],
-            extend,
-            params,
-            raster,
-            thresholds,
-            n_thr,
-            maps,
-            track,
-            ray,
-            anchors,
+            k_out[r], gx, gy, routers_g[r], extend, params, traj, maps, track, ray, anchors
         )
     # Trajectory raster (after the rays, so this reading is not its own anchor).
     n_traj = 0
