@@ -40,19 +40,23 @@ def _insert_sorted(ts: np.ndarray, ids: np.ndarray, n: int, t: float, edge: int)
 
 
 @njit(cache=True)
+def edge_offset(edges, e, x, y):
+    """The vector from (x, y) to the nearest point of edge ``e`` (a closed segment)."""
+    px = edges[e, 0]
+    py = edges[e, 1]
+    ex = edges[e, 2] - px
+    ey = edges[e, 3] - py
+    len2 = ex * ex + ey * ey
+    u = 0.0 if len2 == 0.0 else min(1.0, max(0.0, ((x - px) * ex + (y - py) * ey) / len2))
+    return px + u * ex - x, py + u * ey - y
+
+
+@njit(cache=True)
 def _on_boundary(edges, near, lo, hi, x, y):
     """Whether (x, y) lies on one of the edges ``near[lo:hi]`` (within 1e-9 m): a segment running
     along a wall face."""
     for j in range(lo, hi):
-        e = near[j]
-        px = edges[e, 0]
-        py = edges[e, 1]
-        ex = edges[e, 2] - px
-        ey = edges[e, 3] - py
-        len2 = ex * ex + ey * ey
-        u = 0.0 if len2 == 0.0 else min(1.0, max(0.0, ((x - px) * ex + (y - py) * ey) / len2))
-        cx = px + u * ex - x
-        cy = py + u * ey - y
+        cx, cy = edge_offset(edges, near[j], x, y)
         if cx * cx + cy * cy < 1e-18:
             return True
     return False

@@ -26,7 +26,7 @@ import math
 import numpy as np
 from numba import njit
 
-from sfw_gym.world.wall_crossing import _walls_crossed
+from sfw_gym.world.wall_crossing import _walls_crossed, edge_offset
 
 #: Buckets of directions over [0, π) per router.
 DEFAULT_BUCKETS = 256
@@ -39,13 +39,8 @@ NEAR_ROUTER_M = 1e-3
 @njit(cache=True)
 def _distance_to_edge(edges, e, x, y):
     """Distance from (x, y) to edge ``e`` (a closed segment)."""
-    px = edges[e, 0]
-    py = edges[e, 1]
-    ex = edges[e, 2] - px
-    ey = edges[e, 3] - py
-    len2 = ex * ex + ey * ey
-    u = 0.0 if len2 == 0.0 else min(1.0, max(0.0, ((x - px) * ex + (y - py) * ey) / len2))
-    return math.hypot(px + u * ex - x, py + u * ey - y)
+    cx, cy = edge_offset(edges, e, x, y)
+    return math.hypot(cx, cy)
 
 
 @njit(cache=True)
