@@ -300,7 +300,7 @@ def sense_and_map(
         cc = min(max(int((px - c[GX0]) / c[GRID_RES]), 0), cols - 1)
         copy_into(obs_map[i, 0], belief_px)
         draw_rest_into(
-            maps[2].reshape((rows, cols)), trajectory, router_px, pr, pc, cr, cc,
+            maps[2].reshape((rows, cols)), trajectory, router_px, (pr, pc, cr, cc),
             int(c[OBS_CROP]), obs_map[i], obs_local[i],
         )  # fmt: skip
         out = obs_state[i]

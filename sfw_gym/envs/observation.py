@@ -142,7 +142,7 @@ class ObservationBuilder:
         cc = min(max(int((x - self._ox) / self._res), 0), self._cols - 1)
         image, local = _draw(
             belief_u8, self._src_r, self._src_c, self._pad, self._trajectory, self._routers,
-            r, c, cr, cc, self.crop_px,
+            (r, c, cr, cc), self.crop_px,
         )  # fmt: skip
 
         slots = self.n_router_slots
@@ -170,15 +170,13 @@ def _draw(
     pad: np.ndarray,
     trajectory: np.ndarray,
     routers: np.ndarray,
-    r: int,
-    c: int,
-    cr: int,
-    cc: int,
+    robot_at: tuple[int, int, int, int],
     crop: int,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The ``map`` image (the belief sampled at ``src_r × src_c``, unknown on ``pad``; the
-    trajectory with the robot's 3 × 3 square at pixel (r, c); the routers) and the ``local`` crop
-    of the belief centred on cell (cr, cc) (unknown outside the grid), in one pass."""
+    trajectory with the robot's 3 × 3 square at its pixel; the routers) and the ``local`` crop
+    of the belief centred on its cell (unknown outside the grid), in one pass. ``robot_at``:
+    the robot's map-image pixel (row, col) and belief cell (row, col)."""
     m = src_r.shape[0]
     image = np.empty((3, m, m), np.uint8)
     local = np.empty((1, crop, crop), np.uint8)
@@ -188,7 +186,7 @@ def _draw(
         padded = pad[i]
         for j in range(m):
             out[j] = U8_UNKNOWN if padded[j] else row[src_c[j]]
-    draw_rest_into(belief, trajectory, routers, r, c, cr, cc, crop, image, local)
+    draw_rest_into(belief, trajectory, routers, robot_at, crop, image, local)
     return image, local
 
 
@@ -197,16 +195,14 @@ def draw_rest_into(
     belief: np.ndarray,
     trajectory: np.ndarray,
     routers: np.ndarray,
-    r: int,
-    c: int,
-    cr: int,
-    cc: int,
+    robot_at: tuple[int, int, int, int],
     crop: int,
     image: np.ndarray,
     local: np.ndarray,
 ) -> None:
     """Write every part of :func:`_draw`'s ``map`` image but its belief channel ``image[0]``
     (the caller's), and the ``local`` crop."""
+    r, c, cr, cc = robot_at
     copy_into(image[1], trajectory)
     copy_into(image[2], routers)
     image[1, max(r - 1, 0) : r + 2, max(c - 1, 0) : c + 2] = ROBOT_U8
