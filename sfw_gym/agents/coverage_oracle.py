@@ -31,6 +31,7 @@ from sfw_gym.core.constants import U8_FREE_MIN
 from sfw_gym.navigation.candidates import FEATURES, unknown_bits_at
 from sfw_gym.navigation.planning import (
     PurePursuit,
+    WallBand,
     cells_to_world,
     cost_field,
     disk_offsets,
@@ -94,9 +95,8 @@ class CoverageOracle(OracleAgent):
         res = float(grid.resolution_m)
         free = np.asarray(truth.truth_u8) >= U8_FREE_MIN
         lethal = view.radius_m + self.settings.margin_m
-        self._cost = 1.0 + wall_cost_term(
-            wall_distance_m(~free, res), res, view.radius_m, lethal_radius_m=lethal
-        )
+        band = WallBand(view.radius_m, lethal_radius_m=lethal)
+        self._cost = 1.0 + wall_cost_term(wall_distance_m(~free, res), res, band)
         rows, cols = np.nonzero(free)
         centres = grid.cell_to_world(np.stack([rows, cols], axis=1))
         self._zone = np.full(free.shape, -1, np.int64)  # the truly strongest router; -1: wall

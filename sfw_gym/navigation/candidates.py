@@ -43,6 +43,7 @@ from sfw_gym.navigation.frontiers import (
 from sfw_gym.navigation.planning import (
     FREE_START_COST,
     CostField,
+    WallBand,
     cost_field,
     disk_cells,
     disk_offsets,
@@ -341,14 +342,15 @@ class GoalFinder:
         cells that changed since the last call (one distance transform when many did)."""
         seen, term = self._wall_terms.get(name, (np.zeros_like(walls), np.zeros(walls.shape)))
         changed = np.flatnonzero(walls != seen)
+        band = WallBand(radius)
         if len(changed) > walls.size // 20:
             term = (
-                wall_cost_term(wall_distance_m(walls, res), res, radius)
+                wall_cost_term(wall_distance_m(walls, res), res, band)
                 if walls.any()
                 else np.zeros(walls.shape)
             )
         elif len(changed):
-            update_wall_cost_term(term, walls, changed, res, radius)
+            update_wall_cost_term(term, walls, changed, res, band)
         self._wall_terms[name] = (walls, term)
         return term
 

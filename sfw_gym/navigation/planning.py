@@ -23,6 +23,34 @@ from sfw_gym.core.angles import wrap_angle_compiled
 from sfw_gym.core.exact_math import hypot as exact_hypot
 from sfw_gym.mapping.grid import GridSpec, belief_classes
 
+#: Defaults of :class:`WallBand`: the extra cost of a cell within the robot's radius of a wall,
+#: and the width (m) of the band beyond the radius where that cost falls to 0.
+INFLATION_COST, CLEARANCE_M = 8.0, 0.2
+
+
+@dataclass(frozen=True)
+class WallBand:
+    """How walls raise the cost of the cells around them (:func:`traversal_costs`).
+
+    Cells within ``radius_m`` of a wall cost ``inflation_cost`` more, falling linearly to 0 at
+    ``radius_m + clearance_m``; cells within ``lethal_radius_m`` of a wall are obstacles
+    (default: half a cell, i.e. only the wall cells themselves).
+    """
+
+    radius_m: float
+    inflation_cost: float = INFLATION_COST
+    clearance_m: float = CLEARANCE_M
+    lethal_radius_m: float | None = None
+
+    @property
+    def outer_m(self) -> float:
+        """Where the band ends: no extra cost this far from a wall or farther."""
+        return self.radius_m + self.clearance_m
+
+    def lethal_m(self, resolution_m: float) -> float:
+        """The lethal radius on cells of ``resolution_m``."""
+        return 0.5 * resolution_m if self.lethal_radius_m is None else self.lethal_radius_m
+
 
 def traversal_costs(
     belief_u8: np.ndarray,
@@ -30,8 +58,8 @@ def traversal_costs(
     radius_m: float,
     *,
     unknown_cost: float = 1.5,
-    inflation_cost: float = 8.0,
-    clearance_m: float = 0.2,
+    inflation_cost: float = INFLATION_COST,
+    clearance_m: float = CLEARANCE_M,
     lethal_radius_m: float | None = None,
     blocked: np.ndarray | None = None,
     wall_distance: np.ndarray | None = None,
@@ -66,48 +94,34 @@ def traversal_costs(
     cost = np.where(unknown, float(unknown_cost), 1.0)
     if wall.any():
         dist = wall_distance_m(wall, resolution_m) if wall_distance is None else wall_distance
-        cost += wall_cost_term(
-            dist, resolution_m, radius_m, inflation_cost, clearance_m, lethal_radius_m
-        )
+        band = WallBand(radius_m, inflation_cost, clearance_m, lethal_radius_m)
+        cost += wall_cost_term(dist, resolution_m, band)
     return cost
 
 
-def wall_cost_term(
-    wall_distance: np.ndarray,
-    resolution_m: float,
-    radius_m: float,
-    inflation_cost: float = 8.0,
-    clearance_m: float = 0.2,
-    lethal_radius_m: float | None = None,
-) -> np.ndarray:
+def wall_cost_term(wall_distance: np.ndarray, resolution_m: float, band: WallBand) -> np.ndarray:
     """The part of :func:`traversal_costs` that depends on the walls alone (added to the cell's
-    own cost): the inflation band, and ``inf`` within the lethal radius."""
-    outer = radius_m + clearance_m
-    term = inflation_cost * np.clip((outer - wall_distance) / clearance_m, 0.0, 1.0)
-    lethal = 0.5 * resolution_m if lethal_radius_m is None else lethal_radius_m
-    term[wall_distance <= lethal] = np.inf
+    own cost): the inflation ``band``, and ``inf`` within its lethal radius."""
+    outer = band.outer_m
+    clearance = band.clearance_m
+    term = band.inflation_cost * np.clip((outer - wall_distance) / clearance, 0.0, 1.0)
+    term[wall_distance <= band.lethal_m(resolution_m)] = np.inf
     return term
 
 
 def update_wall_cost_term(
-    term: np.ndarray,
-    walls: np.ndarray,
-    changed: np.ndarray,
-    resolution_m: float,
-    radius_m: float,
-    inflation_cost: float = 8.0,
-    clearance_m: float = 0.2,
-    lethal_radius_m: float | None = None,
+    term: np.ndarray, walls: np.ndarray, changed: np.ndarray, resolution_m: float, band: WallBand
 ) -> None:
     """Bring ``term`` (:func:`wall_cost_term` of an earlier ``walls``) up to date in place, where
     the cells ``changed`` (flat indices) became or stopped being walls: only the cells within
     the band's reach of them are recomputed, with the same formula (the same values as a full
     recomputation)."""
-    outer = radius_m + clearance_m
-    lethal = 0.5 * resolution_m if lethal_radius_m is None else lethal_radius_m
+    outer = band.outer_m
+    lethal = band.lethal_m(resolution_m)
     reach, offsets, dist = _band_offsets(float(resolution_m), float(outer))
+    clearance, inflation = band.clearance_m, band.inflation_cost
     _update_wall_term(
-        term, walls, changed, offsets, dist, reach, outer, clearance_m, inflation_cost, lethal
+        term, walls, changed, offsets, dist, reach, outer, clearance, inflation, lethal
     )
 
 
