@@ -2,8 +2,10 @@
 goals) on a few fresh plans → a report.
 
 Everything comes with the package: procedural floorplans, the default radio, the shipped policies.
-The report folder holds ``index.md`` (what ran, the results table, the figures), the evaluation's
-table and curves, trajectory overlays per floorplan and one GIF per agent.
+The report folder holds ``index.md`` (what ran, the results table, the figures) and
+``index.html``, the same page rendered for a browser (open it by double-clicking; its images are
+relative links, so the folder can be moved), beside the evaluation's tables and curves,
+trajectory overlays per floorplan and one GIF per agent.
 """
 
 from __future__ import annotations
@@ -12,10 +14,10 @@ import time
 from pathlib import Path
 from typing import Any
 
-from sfw_gym.core.atomic import write_text_atomic
 from sfw_gym.core.data import scenario
-from sfw_gym.evaluation import evaluate, results_markdown
+from sfw_gym.evaluation import evaluate
 from sfw_gym.evaluation.metric_table import METRICS
+from sfw_gym.evaluation.report import report_markdown, write_report
 
 DEMO_AGENTS = ("frontier", "cross-pass", "regions-ppo")
 DEMO_ENV = "SfW-Explore-v0"  # the shipped policy's env
@@ -34,7 +36,8 @@ def run_demo(
     progress: bool = True,
     model: str | Path | None = None,
 ) -> Path:
-    """Run the demo (resumable, like any evaluation) and write ``OUT/index.md``; return its path.
+    """Run the demo (resumable, like any evaluation) and write ``OUT/index.md`` and
+    ``OUT/index.html`` (the same page for a browser); return the Markdown page's path.
 
     ``model``: a ``sfw-gym train ppo_mask`` folder (or a ``.zip`` in it) instead of the shipped
     policy.
@@ -55,7 +58,7 @@ def run_demo(
     index = out / "index.md"
     wall_s = time.perf_counter() - start
     policy = str(model) if model is not None else "agents/ppo_mask/SfW-ExploreRegions-v0_1"
-    write_text_atomic(index, _index_markdown(out, result, seed, wall_s, policy))
+    write_report(index, _index_markdown(out, result, seed, wall_s, policy))
     return index
 
 
@@ -80,25 +83,10 @@ def _index_markdown(
         "|---|---|---|",
         *[f"| {i} | {plans[i][0]} | {plans[i][1]:.0f} m² |" for i in episodes],
         "",
-        "## Results (mean ± 95 % CI over episodes)",
-        "",
-        results_markdown(result["rows"]).rstrip(),
-        "",
-        f"*{METRICS['info_gain_per_m'].label}*: the map's entropy decrease per metre driven, what "
-        "the reward pays for per unit of effort. Full table: [results.csv](results.csv); "
-        "per-episode records: [episodes.jsonl](episodes.jsonl).",
-        "",
-        "## Curves",
-        "",
-        "![coverage vs steps](coverage_vs_steps.png)",
-        "![IoU vs path length](iou_vs_path.png)",
-        "",
-        "## Trajectories (left: the true plan; right: each agent's final belief map)",
-        "",
     ]
-    for path in sorted((out / "trajectories").glob("*.png")):
-        lines.append(f"![{path.stem}](trajectories/{path.name})")
-    lines += ["", "## Episode 0, animated", ""]
-    for path in sorted((out / "gifs").glob("*.gif")):
-        lines.append(f"![{path.stem}](gifs/{path.name})")
+    note = (
+        f"*{METRICS['info_gain_per_m'].label}*: the map's entropy decrease per metre driven, what "
+        "the reward pays for per unit of effort."
+    )
+    lines += report_markdown(out, result["rows"], result["files"], note=note)
     return "\n".join(lines) + "\n"

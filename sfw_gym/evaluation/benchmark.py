@@ -4,7 +4,8 @@ protocol, package and agent; and the paired comparison of two results files.
 
 A results file (``OUT/results.json``) holds everything but timing fields under keys that do not
 change between runs of the same agent, protocol and split, so that two runs give the same bytes
-apart from ``timing``; ``OUT/results.md`` has no timing at all.
+apart from ``timing``; ``OUT/results.md`` has no timing at all, nor has ``OUT/index.html``, the
+same tables rendered for a browser.
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from sfw_gym.core.errors import ConfigError
 from sfw_gym.evaluation.checkpoint import require_same_run
 from sfw_gym.evaluation.executor import Executor
 from sfw_gym.evaluation.metric_table import METRICS
-from sfw_gym.evaluation.report import PRIVILEGED_NOTE, paired_table
+from sfw_gym.evaluation.report import PRIVILEGED_NOTE, paired_table, write_report
 from sfw_gym.evaluation.stats import bootstrap_ci, paired_comparison
 
 SPLITS = ("train", "validation", "test")
@@ -113,7 +114,8 @@ def run_benchmark(
     progress: bool = True,
 ) -> dict[str, Any]:
     """Run ``agent`` (a shipped name or ``package.module:Class``) through the protocol's
-    ``split``; writes ``OUT/results.json`` and ``OUT/results.md`` and returns the results.
+    ``split``; writes ``OUT/results.json``, ``OUT/results.md`` and ``OUT/index.html`` (the same
+    tables for a browser) and returns the results.
     ``episodes`` caps the episodes per env (a quick look; recorded in the results);
     ``workers``, ``backend`` and ``address`` as :func:`~sfw_gym.evaluation.evaluate`'s."""
     from sfw_gym import __version__
@@ -176,7 +178,7 @@ def run_benchmark(
     }
     results["summary"] = summarize_results(results, proto)
     write_text_atomic(out / "results.json", json.dumps(results, indent=1, sort_keys=True) + "\n")
-    write_text_atomic(out / "results.md", results_markdown(results))
+    write_report(out / "results.md", results_markdown(results))  # and index.html
     return results
 
 

@@ -17,7 +17,10 @@ stopped. Outputs, every file written atomically (a temp file and ``os.replace``)
 - ``coverage_vs_steps.png`` and ``iou_vs_path.png``: mean curves with 95 % CI bands;
 - ``trajectories/<i>_<plan>.png``: per floorplan, every agent's path over the ground truth and
   its final belief;
-- optionally ``gifs/<agent>_<i>.gif`` (``render_mode="rgb_array"`` frames).
+- optionally ``gifs/<agent>_<i>.gif`` (``render_mode="rgb_array"`` frames);
+- ``index.md`` and ``index.html``: the report page (the tables, the curves, the trajectory
+  overlays and the GIFs), the HTML rendered from the Markdown for a browser, with relative links
+  so the folder can be moved.
 """
 
 from __future__ import annotations
@@ -38,7 +41,13 @@ from sfw_gym.evaluation.checkpoint import (
 )
 from sfw_gym.evaluation.executor import BACKENDS, Bar, Executor
 from sfw_gym.evaluation.plots import plot_curves, plot_trajectories
-from sfw_gym.evaluation.report import paired_markdown, results_csv, results_markdown
+from sfw_gym.evaluation.report import (
+    paired_markdown,
+    report_markdown,
+    results_csv,
+    results_markdown,
+    write_report,
+)
 from sfw_gym.evaluation.rollout import EpisodeSpec, run_episode, zone_band_unknown
 from sfw_gym.evaluation.stats import paired_differences, summarize
 from sfw_gym.evaluation.vector import check_native_vector_env, run_vector
@@ -117,7 +126,8 @@ def evaluate(
     address: str | None = None,
     vector_envs: int = 1,
 ) -> dict[str, Any]:
-    """Run (or resume) an evaluation and write its table, curves and trajectory figures.
+    """Run (or resume) an evaluation and write its tables, curves, trajectory figures and report
+    page (``index.md``, and ``index.html`` for a browser).
 
     Args:
         agents: Agent names (see :data:`sfw_gym.agents.AGENTS`).
@@ -211,11 +221,23 @@ def evaluate(
         write_text_atomic(out / "results.csv", results_csv(rows)),
         write_text_atomic(out / "results.md", results_markdown(rows)),
     ]
+    paired = ""
     if len(agents) > 1:  # every other agent against the first, episode by episode
-        paired = paired_differences(mine, agents, reference=agents[0])
-        files.append(write_text_atomic(out / "paired.md", paired_markdown(paired)))
+        paired = paired_markdown(paired_differences(mine, agents, reference=agents[0]))
+        files.append(write_text_atomic(out / "paired.md", paired))
     else:  # not a stale table of an earlier run in the same folder
         (out / "paired.md").unlink(missing_ok=True)
     files += plot_curves(mine, agents, out)
     files += plot_trajectories(mine, agents, out)
+    files += [Path(s.gif_path) for s in specs if s.gif_path and Path(s.gif_path).is_file()]
+    seeds = f"seed {seed}" if episodes == 1 else f"seeds {seed}–{seed + episodes - 1}"
+    head = [
+        f"# sfw_gym evaluation: {', '.join(agents)} on `{env_id}`",
+        "",
+        f"{episodes} episode(s) per agent; episode i of every agent on the same floorplan, "
+        f"routers and start pose ({seeds}).",
+        "",
+    ]
+    body = report_markdown(out, rows, files, paired=paired)
+    files += write_report(out / "index.md", "\n".join(head + body) + "\n")
     return {"rows": rows, "records": mine, "files": files}

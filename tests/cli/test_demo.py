@@ -33,7 +33,7 @@ def test_the_report_shows_the_results_table_of_the_one_metric_table(tmp_path):
         {"agent": "frontier", "episode": 0, "floorplan": "gen-7", "area_m2": 80.0,
          "coverage": 0.9, "info_gain_per_m": 21.25, "stop_reason": "max_steps"},
     ]  # fmt: skip
-    result = {"records": records, "rows": summarize(records, ["frontier"])}
+    result = {"records": records, "rows": summarize(records, ["frontier"]), "files": []}
     index = _index_markdown(tmp_path, result, 7, 1.0, "shipped")
     assert results_markdown(result["rows"]).rstrip() in index
     assert "| frontier | 1 | 0.900 |" in index and "| 21.2 |" in index  # the table's formats
