@@ -34,7 +34,7 @@ import numpy as np
 
 from sfw_gym.core.config import Config, setting
 from sfw_gym.core.errors import ConfigError
-from sfw_gym.navigation.candidates import FEATURES, CandidateGoals
+from sfw_gym.navigation.menu import FEATURES, CandidateGoals
 from sfw_gym.navigation.view import RobotView
 
 #: Why an exploring agent stopped looking for goals.
@@ -50,7 +50,7 @@ class Decision:
         step: The agent's step count when it chose.
         target_rc: The chosen candidate's target cell.
         n_candidates: How many candidates the menu held.
-        features: The chosen candidate's :data:`~sfw_gym.navigation.candidates.FEATURES`
+        features: The chosen candidate's :data:`~sfw_gym.navigation.menu.FEATURES`
             (NaN where that agent's menu does not compute one).
     """
 

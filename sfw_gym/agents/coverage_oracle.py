@@ -28,7 +28,8 @@ from sfw_gym.agents.base import AgentSettings, Decision, RobotView
 from sfw_gym.agents.oracles import OracleAgent
 from sfw_gym.core.config import setting
 from sfw_gym.core.constants import U8_FREE_MIN
-from sfw_gym.navigation.candidates import FEATURES, unknown_bits_at
+from sfw_gym.navigation.candidates import unknown_bits_at
+from sfw_gym.navigation.menu import FEATURES
 from sfw_gym.navigation.planning import (
     PurePursuit,
     WallBand,

@@ -48,12 +48,11 @@ from scipy import ndimage
 from sfw_gym.agents.base import Agent, AgentSettings, RobotView
 from sfw_gym.core.config import setting, setting_of
 from sfw_gym.core.constants import U8_FREE_MIN, U8_WALL_MAX
-from sfw_gym.navigation.candidates import (
+from sfw_gym.navigation.candidates import CandidateSettings, GoalFinder
+from sfw_gym.navigation.menu import (
     GAIN_SCALE,
     POTENTIAL_SCALE,
     CandidateGoals,
-    CandidateSettings,
-    GoalFinder,
     explore_lite_choice,  # noqa: F401  (re-exported: the teacher's choice, by its old home)
 )
 from sfw_gym.navigation.planning import (

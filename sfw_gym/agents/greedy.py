@@ -9,10 +9,8 @@ import numpy as np
 from sfw_gym.agents.base import RobotView
 from sfw_gym.agents.frontier import FrontierAgent, FrontierSettings, Goal
 from sfw_gym.core.config import setting
-from sfw_gym.navigation.candidates import (
-    CandidateSettings,
-    bits_per_metre,
-)
+from sfw_gym.navigation.candidates import CandidateSettings
+from sfw_gym.navigation.menu import bits_per_metre
 from sfw_gym.navigation.planning import CostField
 
 

@@ -38,7 +38,7 @@ from sfw_gym.agents.regions import RegionAgent, RegionAgentSettings
 from sfw_gym.core.config import setting
 from sfw_gym.envs.goals import menu_observation
 from sfw_gym.envs.regions import region_anchor
-from sfw_gym.navigation.candidates import GREEDY_OFFSET_M, CandidateGoals, bits_per_metre
+from sfw_gym.navigation.menu import GREEDY_OFFSET_M, CandidateGoals, bits_per_metre
 
 #: What a simulation is scored by (see :class:`RegionOracleSettings`).
 SCORES = ("bits", "bits_per_metre", "coverage")

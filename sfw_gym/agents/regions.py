@@ -19,8 +19,9 @@ from sfw_gym.agents.base import Agent, AgentSettings, RobotView
 from sfw_gym.core.config import setting
 from sfw_gym.envs.goals import action_masks, menu_observation
 from sfw_gym.envs.regions import RegionsConfig, region_anchor
-from sfw_gym.navigation.candidates import TEACHERS, CandidateGoals, GoalFinder
+from sfw_gym.navigation.candidates import GoalFinder
 from sfw_gym.navigation.goal_driver import GoalDriver
+from sfw_gym.navigation.menu import TEACHERS, CandidateGoals
 from sfw_gym.navigation.regions import RegionSteering
 
 
@@ -30,7 +31,7 @@ class RegionAgentSettings(AgentSettings):
 
     Attributes:
         regions: :class:`~sfw_gym.envs.regions.RegionsConfig` fields (dict), as the env's.
-        teacher: Whose choice on the menu (:data:`~sfw_gym.navigation.candidates.TEACHERS`):
+        teacher: Whose choice on the menu (:data:`~sfw_gym.navigation.menu.TEACHERS`):
             ``greedy`` (expected bits per metre, the tuned greedy agent's offset: the region
             teacher, level with frontier) or ``explore_lite`` (the frontier agent's utility,
             which lost coverage on region actions).

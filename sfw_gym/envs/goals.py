@@ -22,13 +22,9 @@ from sfw_gym.core.config import Config, setting
 from sfw_gym.core.constants import NOT_HEARD_DBM
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.explore import SfWExploreEnv
-from sfw_gym.navigation.candidates import (
-    FEATURES,
-    TEACHERS,
-    CandidateGoals,
-    GoalFinder,
-)
+from sfw_gym.navigation.candidates import GoalFinder
 from sfw_gym.navigation.goal_driver import GoalDriver
+from sfw_gym.navigation.menu import FEATURES, TEACHERS, CandidateGoals
 from sfw_gym.navigation.planning import cost_field, to_discrete
 from sfw_gym.navigation.view import RobotView
 
@@ -65,7 +61,7 @@ class SfWGoalsEnv(gym.Env):
     """``SfW-ExploreGoals-v0``: ``Discrete(K)`` actions over the candidate-goal menu.
 
     The observation is the explore env's, plus ``candidates`` (``(K, F)`` features of
-    :data:`~sfw_gym.navigation.candidates.FEATURES`, each divided by its
+    :data:`~sfw_gym.navigation.menu.FEATURES`, each divided by its
     :data:`FEATURE_SCALES` entry; 0 for empty slots) and ``candidate_mask`` (1 where the goal is
     reachable). :meth:`action_masks` gives the mask to sb3-contrib's ``MaskablePPO``.
 

@@ -26,7 +26,7 @@ from sfw_gym.core.config import check, setting
 from sfw_gym.envs.goals import GoalsConfig, SfWGoalsEnv
 from sfw_gym.envs.observation import map_pixels
 from sfw_gym.mapping import GridSpec
-from sfw_gym.navigation.candidates import CandidateGoals
+from sfw_gym.navigation.menu import CandidateGoals
 from sfw_gym.navigation.regions import RegionSteering
 
 

@@ -5,15 +5,9 @@ never the world.
 
 from __future__ import annotations
 
-from sfw_gym.navigation.candidates import (
-    FEATURES,
-    SOURCES,
-    CandidateGoals,
-    CandidateSettings,
-    GoalFinder,
-    candidate_goals,
-)
+from sfw_gym.navigation.candidates import CandidateSettings, GoalFinder, candidate_goals
 from sfw_gym.navigation.frontiers import Frontier, find_frontiers, frontier_mask, hidden_rooms
+from sfw_gym.navigation.menu import FEATURES, SOURCES, CandidateGoals
 from sfw_gym.navigation.planning import (
     CostField,
     PurePursuit,

@@ -16,13 +16,18 @@ failed and unreachable goals and how often a place was tried, and it caches what
 (frontier cells are updated only where the belief changed since the last call; the distance to
 walls only when the walls change). One shortest-path field (:func:`cost_field`) per replan
 serves every candidate.
+
+The menu itself (:class:`~sfw_gym.navigation.menu.CandidateGoals`) and the choices made on it
+(explore_lite's utility, the greedy bits per metre, the teachers) are in
+:mod:`sfw_gym.navigation.menu`, re-exported here by their old home; the compiled frontier
+analysis the menu starts from (open frontier cells, their clusters and best cells, pockets) is in
+:mod:`sfw_gym.navigation.frontiers`.
 """
 
 from __future__ import annotations
 
 import functools
-import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -30,15 +35,34 @@ import numpy as np
 from numba import njit
 from scipy import ndimage
 
-from sfw_gym.core.angles import wrap_angle, wrap_angle_compiled
+from sfw_gym.core.angles import wrap_angle
 from sfw_gym.core.config import Config, setting
 from sfw_gym.core.constants import NOT_HEARD_DBM, U8_FREE_MIN, U8_WALL_MAX
 from sfw_gym.mapping.grid import belief_classes
+from sfw_gym.mapping.sparse import cell_entropy_bits
 from sfw_gym.navigation.frontiers import (
     EIGHT_CONNECTED,
-    _clusters,
+    excluded_cells,
     frontier_mask,
+    frontier_menu,
     hidden_rooms,
+    update_frontier,
+)
+from sfw_gym.navigation.menu import (
+    _F,
+    FEATURES,
+    GAIN_SCALE,
+    GREEDY_OFFSET_M,
+    POTENTIAL_SCALE,
+    SOURCES,
+    TEACHERS,
+    TURN_COST_M_PER_RAD,
+    CandidateGoals,
+    bits_per_metre,
+    explore_lite_choice,
+    explore_lite_utilities,
+    greedy_choice,
+    proven_on_bounded_paths,
 )
 from sfw_gym.navigation.planning import (
     FREE_START_COST,
@@ -49,6 +73,7 @@ from sfw_gym.navigation.planning import (
     disk_offsets,
     free_start,
     mark_contact,
+    min_over_offsets,
     update_wall_cost_term,
     wall_cost_term,
     wall_distance_m,
@@ -56,27 +81,25 @@ from sfw_gym.navigation.planning import (
 from sfw_gym.navigation.radio_zones import router_scores
 from sfw_gym.navigation.view import RobotView
 
-#: Columns of :attr:`CandidateGoals.features`, units in the names.
-FEATURES = (
-    "path_cost_m",  # planner cost of the path to the goal cell (metres on free cells; inf: none)
-    "distance_m",  # straight line from the robot to the target
-    "cluster_size_m",  # frontier cluster length (cells × resolution); 0 for other sources
-    "expected_gain_bits",  # entropy of the cells the mapper would update with the robot there
-    "unknown_area_m2",  # unknown area within near_radius_m of the target
-    "heading_change_rad",  # |bearing to the target − heading|, in [0, π]
-    "times_tried",  # goals chosen near this target so far in the episode
-    "times_blacklisted",  # goals given up near this target so far
-    "is_hidden_room",  # 1.0 for a hidden-room target, else 0.0
-    "strongest_rssi_dbm",  # strongest router heard within near_radius_m (NOT_HEARD_DBM: never)
-)
-SOURCES = ("frontier", "hidden_room", "info_gain")
-_F = {name: i for i, name in enumerate(FEATURES)}
-_LN2 = float(np.log(2.0))
-
-
-#: explore_lite's utility of a frontier cluster: GAIN_SCALE × size (m) − POTENTIAL_SCALE × cost
-#: (m), the cost being the path plus TURN_COST_M_PER_RAD × the heading change (rad).
-GAIN_SCALE, POTENTIAL_SCALE, TURN_COST_M_PER_RAD = 1.0, 3.0, 0.3
+__all__ = [
+    "FEATURES",
+    "GAIN_SCALE",
+    "GREEDY_OFFSET_M",
+    "POTENTIAL_SCALE",
+    "SOURCES",
+    "TEACHERS",
+    "TURN_COST_M_PER_RAD",
+    "CandidateGoals",
+    "CandidateSettings",
+    "GoalFinder",
+    "bits_per_metre",
+    "candidate_goals",
+    "explore_lite_choice",
+    "explore_lite_utilities",
+    "greedy_choice",
+    "proven_on_bounded_paths",
+    "unknown_bits_at",
+]
 
 
 @dataclass(frozen=True)
@@ -93,130 +116,6 @@ class CandidateSettings(Config):
     info_gain_samples: int = setting(300, integer=True, ge=1)
     near_radius_m: float = setting(1.0, gt=0.0)
     zones_every_steps: int = setting(25, integer=True, ge=1)
-
-
-@dataclass(frozen=True)
-class CandidateGoals:
-    """A menu of goals (K rows). Deterministic for the same view and memory.
-
-    Attributes:
-        target_rc: ``(K, 2)`` the cell each candidate means to resolve.
-        goal_rc: ``(K, 2)`` where the robot drives: the cheapest reachable cell whose footprint
-            covers the target (the target itself when none is reachable).
-        source: ``(K,)`` index into :data:`SOURCES`.
-        features: ``(K, len(FEATURES))`` float64, columns named by :data:`FEATURES`.
-        valid: ``(K,)`` whether the goal is reachable on the belief map.
-        clusters: Per candidate, the ``(N, 2)`` cells of its frontier cluster (empty otherwise).
-        paths: The shortest-path field the costs come from; ``paths.path(goal_rc[i])``.
-        walled_off_rc: ``(M, 2)`` frontier cells (not excluded) that no path reaches.
-    """
-
-    target_rc: np.ndarray
-    goal_rc: np.ndarray
-    source: np.ndarray
-    features: np.ndarray
-    valid: np.ndarray
-    clusters: Sequence[np.ndarray]
-    paths: CostField
-    walled_off_rc: np.ndarray
-
-    def __len__(self) -> int:
-        return len(self.target_rc)
-
-    def feature(self, name: str) -> np.ndarray:
-        """The column ``name`` of :attr:`features`."""
-        return self.features[:, _F[name]]
-
-    def of(self, source: str) -> np.ndarray:
-        """Indices of the candidates from ``source``."""
-        return np.flatnonzero(self.source == SOURCES.index(source))
-
-    def path(self, i: int) -> np.ndarray:
-        """``(N, 2)`` cells from the robot to candidate ``i``'s goal cell (empty if invalid)."""
-        return self.paths.path(tuple(self.goal_rc[i]))
-
-
-def explore_lite_utilities(
-    menu: CandidateGoals,
-    anchor_rc: tuple[int, int] | None = None,
-    anchor_cost_per_m: float = 0.0,
-    resolution_m: float = 1.0,
-) -> np.ndarray:
-    """explore_lite's utility of each of the menu's candidates (with the frontier agent's
-    default scales; ``-inf`` for those that are no reachable frontier candidate).
-
-    With ``anchor_rc`` (a region chosen higher up: :mod:`sfw_gym.navigation.regions`), each
-    candidate's utility also loses ``anchor_cost_per_m`` per metre between its target and the
-    anchor cell (cells of ``resolution_m``)."""
-    f = menu.feature
-    cost = f("path_cost_m") + TURN_COST_M_PER_RAD * f("heading_change_rad")
-    utility = GAIN_SCALE * f("cluster_size_m") - POTENTIAL_SCALE * cost
-    if np.isnan(utility[menu.valid]).any():
-        raise ValueError(
-            "explore_lite_choice needs the menu's path_cost_m, heading_change_rad and "
-            "cluster_size_m features (GoalFinder.find(features=...) left one out)"
-        )
-    if anchor_rc is not None and anchor_cost_per_m > 0 and len(menu):
-        offset_m = (menu.target_rc - np.asarray(anchor_rc)) * resolution_m
-        utility = utility - anchor_cost_per_m * np.hypot(offset_m[:, 0], offset_m[:, 1])
-    ok = menu.valid & (menu.source == SOURCES.index("frontier"))
-    return np.where(ok, utility, -np.inf)
-
-
-def explore_lite_choice(
-    menu: CandidateGoals,
-    anchor_rc: tuple[int, int] | None = None,
-    anchor_cost_per_m: float = 0.0,
-    resolution_m: float = 1.0,
-) -> int | None:
-    """The index of the menu's frontier candidate of best explore_lite utility (the first of
-    equal ones; None when no frontier candidate is reachable): the frontier agent's choice on
-    a K-candidate menu, the teacher of the learned explorer. The arguments are those of
-    :func:`explore_lite_utilities`."""
-    utility = explore_lite_utilities(menu, anchor_rc, anchor_cost_per_m, resolution_m)
-    return int(np.argmax(utility)) if np.isfinite(utility).any() else None
-
-
-def proven_on_bounded_paths(menu: CandidateGoals, utility: np.ndarray) -> bool:
-    """Whether the best of ``utility`` (:func:`explore_lite_utilities` of a menu of frontier
-    clusters built on a bounded :func:`cost_field`) is the choice a search of the whole map
-    would make: a cluster whose cost counted in the utility (path, turn and anchor terms: the
-    cluster's size less its utility, over ``POTENTIAL_SCALE``) lies within the bound has that
-    exact cost (each cell beyond costs at least the bound), and any other cluster has a utility
-    below its size less ``POTENTIAL_SCALE`` × the bound. The best exact one must beat those."""
-    paths = menu.paths
-    if paths.complete:
-        return True
-    size = menu.feature("cluster_size_m")
-    cost = (GAIN_SCALE * size - utility) / POTENTIAL_SCALE
-    exact = cost <= paths.max_cost_m
-    best = utility[exact].max(initial=-np.inf)
-    beyond = (GAIN_SCALE * size - POTENTIAL_SCALE * paths.max_cost_m)[~exact]
-    return bool(np.isfinite(best) and best > beyond.max(initial=-np.inf))
-
-
-def bits_per_metre(menu: CandidateGoals, distance_offset_m: float = 1.0) -> np.ndarray:
-    """The greedy agent's score of each candidate: expected gain (bits) ÷ (path cost +
-    ``distance_offset_m``)."""
-    return menu.feature("expected_gain_bits") / (menu.feature("path_cost_m") + distance_offset_m)
-
-
-#: The tuned greedy agent's distance offset (DESIGN.md's sweep): the greedy teacher's.
-GREEDY_OFFSET_M = 0.3
-
-
-def greedy_choice(menu: CandidateGoals, distance_offset_m: float = GREEDY_OFFSET_M) -> int | None:
-    """The index of the valid candidate with the most expected bits per metre
-    (:func:`bits_per_metre`; the tuned greedy agent's offset), None when none is valid."""
-    score = np.where(menu.valid, bits_per_metre(menu, distance_offset_m), -np.inf)
-    return int(np.argmax(score)) if menu.valid.any() else None
-
-
-#: Teachers on a full menu (every feature computed), by name: each returns a candidate or None.
-TEACHERS: dict[str, Callable[[CandidateGoals], int | None]] = {
-    "explore_lite": explore_lite_choice,
-    "greedy": greedy_choice,
-}
 
 
 def candidate_goals(view: RobotView, max_candidates: int = 32, **settings) -> CandidateGoals:
@@ -317,7 +216,7 @@ class GoalFinder:
         """Frontier cells of ``view``'s belief (read-only; updated where the belief changed)."""
         changed = np.flatnonzero(self._belief.ravel() != view.belief_u8.ravel())
         if len(changed):
-            _update_frontier(view.belief_u8, self._belief, changed, self._frontier)
+            update_frontier(view.belief_u8, self._belief, changed, self._frontier)
         return self._frontier
 
     def costs(self, view: RobotView, escape_wall_cost: float | None = None) -> np.ndarray:
@@ -373,7 +272,7 @@ class GoalFinder:
     def approach_at(self, paths: CostField, targets: np.ndarray) -> np.ndarray:
         """:meth:`approach` at ``targets`` ``(N, 2)`` only."""
         cells = np.asarray(targets, np.int64).reshape(-1, 2)
-        return _min_over_offsets(paths.cumulative, cells, self.reach_offsets)[0]
+        return min_over_offsets(paths.cumulative, cells, self.reach_offsets)[0]
 
     def approach_cells(self, paths: CostField, targets: np.ndarray) -> np.ndarray:
         """:meth:`approach_cell` of each of ``targets`` ``(N, 2)`` (the target where none is
@@ -383,7 +282,7 @@ class GoalFinder:
     def _approach(self, paths: CostField, targets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`approach_at` and :meth:`approach_cells` of ``targets`` in one pass."""
         cells = np.asarray(targets, np.int64).reshape(-1, 2)
-        cost, best = _min_over_offsets(paths.cumulative, cells, self.reach_offsets)
+        cost, best = min_over_offsets(paths.cumulative, cells, self.reach_offsets)
         out = cells + self.reach_offsets[best]
         out[~np.isfinite(cost)] = cells[~np.isfinite(cost)]
         return cost, out
@@ -412,7 +311,7 @@ class GoalFinder:
     def excluded_at(self, view: RobotView, flat: np.ndarray) -> np.ndarray:
         """:meth:`exclusion` at the cells ``flat`` (flat indices) only: the pockets are flood-filled
         from those cells alone (bounded fills, much cheaper than labelling the whole map)."""
-        return _excluded(
+        return excluded_cells(
             np.ascontiguousarray(view.belief_u8),
             np.asarray(flat, np.int64),
             self._near_bump,
@@ -513,7 +412,7 @@ class GoalFinder:
         res = view.grid.resolution_m
         frontier = self.frontier(view)
         x, y, heading = view.odometry_pose
-        open_cells, open_cost, members, bounds, best = _frontier_menu(
+        open_cells, open_cost, members, bounds, best = frontier_menu(
             np.ascontiguousarray(view.belief_u8),
             np.flatnonzero(frontier),
             self._near_bump,
@@ -732,9 +631,7 @@ def unknown_bits_at(log_odds, belief, r, c):  # pragma: no cover (compiled)
     b = belief[r, c]
     if b <= U8_WALL_MAX or b >= U8_FREE_MIN:
         return 0.0
-    lo = abs(np.float64(log_odds[r, c]))
-    e = np.exp(-lo)
-    return (np.log1p(e) + lo * e / (1.0 + e)) / _LN2
+    return cell_entropy_bits(np.float64(log_odds[r, c]))
 
 
 @njit(cache=True)
@@ -766,156 +663,6 @@ def _expected_gain(
 
 
 @njit(cache=True)
-def _update_frontier(belief, seen, changed, frontier):  # pragma: no cover (compiled)
-    """Copy the changed cells of ``belief`` into ``seen`` and recompute ``frontier`` (unknown
-    cells 8-adjacent to a believed-free cell) around them."""
-    h, w = belief.shape
-    for i in changed:
-        seen.flat[i] = belief.flat[i]
-    for i in changed:
-        r0 = i // w
-        c0 = i - r0 * w
-        for r in range(max(r0 - 1, 0), min(r0 + 2, h)):
-            for c in range(max(c0 - 1, 0), min(c0 + 2, w)):
-                v = belief[r, c]
-                is_frontier = False
-                if U8_WALL_MAX < v < U8_FREE_MIN:
-                    for rr in range(max(r - 1, 0), min(r + 2, h)):
-                        for cc in range(max(c - 1, 0), min(c + 2, w)):
-                            if belief[rr, cc] >= U8_FREE_MIN:
-                                is_frontier = True
-                frontier[r, c] = is_frontier
-
-
-@njit(cache=True)
-def _small_pockets(belief, seeds, n_big):  # pragma: no cover (compiled)
-    """Per seed cell (flat indices): whether it is an unknown cell of ``belief`` whose
-    8-connected unknown component has fewer than ``n_big`` cells. Each flood fill stops at
-    ``n_big`` cells or at a cell known to lie in a big component, so every cell is visited at
-    most once."""
-    h, w = belief.shape
-    b = belief.ravel()
-    state = np.zeros(h * w, np.int8)  # 0 unseen, 1 being filled, 2 small, 3 big
-    queue = np.empty(max(n_big, 1), np.int64)
-    for i0 in seeds:
-        if state[i0] != 0 or not U8_WALL_MAX < b[i0] < U8_FREE_MIN:
-            continue
-        state[i0] = 1
-        queue[0] = i0
-        n, head, big = 1, 0, n_big <= 1
-        while head < n and not big:
-            i = queue[head]
-            head += 1
-            r = i // w
-            c = i - r * w
-            for rr in range(max(r - 1, 0), min(r + 2, h)):
-                for cc in range(max(c - 1, 0), min(c + 2, w)):
-                    j = rr * w + cc
-                    if not U8_WALL_MAX < b[j] < U8_FREE_MIN or state[j] == 1 or state[j] == 2:
-                        continue
-                    if state[j] == 3 or n == n_big:
-                        big = True
-                        break
-                    state[j] = 1
-                    queue[n] = j
-                    n += 1
-                if big:
-                    break
-        mark = 3 if big or n >= n_big else 2
-        for k in range(n):
-            state[queue[k]] = mark
-    out = np.zeros(len(seeds), np.bool_)
-    for k in range(len(seeds)):
-        out[k] = state[seeds[k]] == 2
-    return out
-
-
-@njit(cache=True)
-def _excluded(
-    belief, flat, near_bump, failed_until, unreachable_until, step, n_big
-):  # pragma: no cover (compiled)
-    """Per cell ``flat``: near a bump, failed or walled off at ``step``, or (``n_big`` > 0) in an
-    unknown pocket of fewer than ``n_big`` cells."""
-    out = np.empty(len(flat), np.bool_)
-    bump, failed, walled = near_bump.ravel(), failed_until.ravel(), unreachable_until.ravel()
-    for k in range(len(flat)):
-        out[k] = bump[flat[k]] or failed[flat[k]] > step or walled[flat[k]] > step
-    if n_big > 0:
-        out |= _small_pockets(belief, flat, n_big)
-    return out
-
-
-@njit(cache=True)
-def _frontier_menu(
-    belief,
-    frontier_flat,
-    near_bump,
-    failed_until,
-    unreachable_until,
-    step,
-    n_big,
-    cum,
-    offsets,
-    row_y,
-    col_x,
-    x,
-    y,
-    heading,
-    turn,
-    min_cells,
-    anchor_r,
-    anchor_c,
-    anchor_cost,
-):  # pragma: no cover (compiled)
-    """The frontier part of a menu in one pass: the open frontier cells (not excluded),
-    ``(N, 2)``, with their approach costs on ``cum``; their clusters of ``min_cells`` or more
-    (cells flat, grouped as :func:`~sfw_gym.navigation.frontiers.cluster_cells` groups them,
-    and the groups' bounds); and per cluster the index of its cheapest cell to resolve
-    (approach + ``turn`` × heading change + ``anchor_cost`` × the distance to the anchor cell
-    ``(anchor_r, anchor_c)`` when ``anchor_r >= 0``)."""
-    h, w = belief.shape
-    open_flat = frontier_flat[
-        ~_excluded(belief, frontier_flat, near_bump, failed_until, unreachable_until, step, n_big)
-    ]
-    cells = np.empty((len(open_flat), 2), np.int64)
-    mask = np.zeros((h, w), np.bool_)
-    for k in range(len(open_flat)):
-        cells[k, 0] = open_flat[k] // w
-        cells[k, 1] = open_flat[k] - cells[k, 0] * w
-        mask[cells[k, 0], cells[k, 1]] = True
-    open_cost = _min_over_offsets(cum, cells, offsets)[0]
-    members, bounds = _clusters(mask, open_flat, min_cells)
-    cost = open_cost[np.searchsorted(open_flat, members)]
-    if turn > 0:
-        for k in range(len(members)):
-            r = members[k] // w
-            c = members[k] - r * w
-            bearing = math.atan2(row_y[r] - y, col_x[c] - x) - heading
-            cost[k] = cost[k] + turn * abs(wrap_angle_compiled(bearing))
-    if anchor_r >= 0 and anchor_cost > 0:
-        for k in range(len(members)):
-            r = members[k] // w
-            c = members[k] - r * w
-            dist = math.hypot(row_y[r] - row_y[anchor_r], col_x[c] - col_x[anchor_c])
-            cost[k] = cost[k] + anchor_cost * dist
-    return cells, open_cost, members, bounds, _first_argmin_per_group(cost, bounds)
-
-
-@njit(cache=True)
-def _first_argmin_per_group(values, bounds):  # pragma: no cover (compiled)
-    """Per group ``values[bounds[k]:bounds[k + 1]]``: the index (into ``values``) of its first
-    minimum, as ``np.argmin`` picks it."""
-    out = np.empty(len(bounds) - 1, np.int64)
-    for k in range(len(bounds) - 1):
-        best = bounds[k]
-        for i in range(bounds[k] + 1, bounds[k + 1]):
-            if values[i] < values[best]:
-                best = i
-        out[k] = best
-    return out
-
-
-@njit(cache=True)
 def _known_wall_costs(belief, wall_term, unknown_cost, r0, c0):  # pragma: no cover (compiled)
     """``free_start(where(unknown, unknown_cost, 1) + wall_term, (r0, c0))`` in one pass."""
     h, w = belief.shape
@@ -929,20 +676,3 @@ def _known_wall_costs(belief, wall_term, unknown_cost, r0, c0):  # pragma: no co
             if not np.isfinite(out[r, c]):
                 out[r, c] = FREE_START_COST
     return out
-
-
-@njit(cache=True)
-def _min_over_offsets(values, cells, offsets):  # pragma: no cover (compiled)
-    """Per cell ``(N, 2)``: the minimum of ``values`` over ``cell + offsets`` inside the grid,
-    and the index of the first offset that attains it (0 where none is finite)."""
-    h, w = values.shape
-    out = np.full(len(cells), np.inf)
-    arg = np.zeros(len(cells), np.int64)
-    for i in range(len(cells)):
-        for k in range(len(offsets)):
-            r = cells[i, 0] + offsets[k, 0]
-            c = cells[i, 1] + offsets[k, 1]
-            if 0 <= r < h and 0 <= c < w and values[r, c] < out[i]:
-                out[i] = values[r, c]
-                arg[i] = k
-    return out, arg

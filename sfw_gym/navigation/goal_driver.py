@@ -14,7 +14,8 @@ from __future__ import annotations
 import numpy as np
 
 from sfw_gym.core.constants import U8_FREE_MIN, U8_WALL_MAX
-from sfw_gym.navigation.candidates import CandidateGoals, GoalFinder
+from sfw_gym.navigation.candidates import GoalFinder
+from sfw_gym.navigation.menu import CandidateGoals
 from sfw_gym.navigation.planning import PurePursuit, simplify_path
 from sfw_gym.navigation.view import RobotView
 

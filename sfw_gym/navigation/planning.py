@@ -568,3 +568,20 @@ def mark_contact(
     reach = radius_m + 0.5 * grid.resolution_m
     contact = np.array([x + reach * np.cos(theta), y + reach * np.sin(theta)])
     mark_disk(mask, tuple(grid.world_to_cell(contact)), 1.0)
+
+
+@njit(cache=True)
+def min_over_offsets(values, cells, offsets):  # pragma: no cover (compiled)
+    """Per cell ``(N, 2)``: the minimum of ``values`` over ``cell + offsets`` inside the grid,
+    and the index of the first offset that attains it (0 where none is finite)."""
+    h, w = values.shape
+    out = np.full(len(cells), np.inf)
+    arg = np.zeros(len(cells), np.int64)
+    for i in range(len(cells)):
+        for k in range(len(offsets)):
+            r = cells[i, 0] + offsets[k, 0]
+            c = cells[i, 1] + offsets[k, 1]
+            if 0 <= r < h and 0 <= c < w and values[r, c] < out[i]:
+                out[i] = values[r, c]
+                arg[i] = k
+    return out, arg

@@ -3,7 +3,7 @@
 A decision of ``SfW-ExploreRegions-v0`` (and of the learned agent trained on it) picks a region
 — the target cell of one candidate of the menu, its *anchor* — and then :class:`RegionSteering`
 drives for a fixed number of steps with the classical rule: explore_lite's choice among the
-frontier clusters (:func:`~sfw_gym.navigation.candidates.explore_lite_choice`), each cluster's
+frontier clusters (:func:`~sfw_gym.navigation.menu.explore_lite_choice`), each cluster's
 utility lowered by ``anchor_cost_per_m`` per metre between it and the anchor, each goal driven
 by :class:`~sfw_gym.navigation.goal_driver.GoalDriver`. The high level says where to explore;
 the low level keeps collecting the information that lies along the way (on an RSSI map it comes
@@ -15,13 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from sfw_gym.navigation.candidates import (
-    POTENTIAL_SCALE,
-    GoalFinder,
-    explore_lite_utilities,
-    proven_on_bounded_paths,
-)
+from sfw_gym.navigation.candidates import GoalFinder
 from sfw_gym.navigation.goal_driver import TURN, GoalDriver, resolved
+from sfw_gym.navigation.menu import POTENTIAL_SCALE, explore_lite_utilities, proven_on_bounded_paths
 from sfw_gym.navigation.planning import SEARCH_RADIUS_M, cost_field
 from sfw_gym.navigation.view import RobotView
 

@@ -26,8 +26,9 @@ from sfw_gym.core.data import DEFAULT_MODEL_DIR, DEFAULT_REGIONS_MODEL_DIR
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.goals import GoalsConfig, action_masks, menu_observation
 from sfw_gym.envs.regions import RegionsConfig, candidate_pixels
-from sfw_gym.navigation.candidates import CandidateGoals, GoalFinder
+from sfw_gym.navigation.candidates import GoalFinder
 from sfw_gym.navigation.goal_driver import GoalDriver
+from sfw_gym.navigation.menu import CandidateGoals
 from sfw_gym.rl.runs import find_model
 
 

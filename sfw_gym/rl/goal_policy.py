@@ -168,7 +168,7 @@ def teacher_decisions(
 ) -> tuple[list[dict[str, np.ndarray]], np.ndarray, np.ndarray]:
     """Observations, choices and masks of the env's ``teacher`` (``teacher_action(teacher)``; by
     default the frontier agent's choice on the menu,
-    :func:`~sfw_gym.navigation.candidates.explore_lite_choice`) over one episode per seed. The
+    :func:`~sfw_gym.navigation.menu.explore_lite_choice`) over one episode per seed. The
     teacher drives, or the ``learner`` (its most likely choice, among the valid ones if
     ``learner_masked``) does: DAgger's states, labelled with the teacher's choices."""
     observations, actions, masks = [], [], []

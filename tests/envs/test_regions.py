@@ -175,7 +175,7 @@ def test_the_teachers_choose_by_their_own_scores():
 def test_explore_lite_refuses_a_menu_without_its_features():
     """A menu computed without cluster sizes would make every utility NaN (and the first
     candidate the choice every time): an error instead."""
-    from sfw_gym.navigation.candidates import explore_lite_choice
+    from sfw_gym.navigation.menu import explore_lite_choice
     from sfw_gym.navigation.planning import cost_field
 
     env = make()

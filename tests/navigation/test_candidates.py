@@ -10,14 +10,9 @@ import pytest
 from sfw_gym.core.constants import NOT_HEARD_DBM, U8_FREE, U8_UNKNOWN, U8_WALL
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.mapping.grid import GridSpec
-from sfw_gym.navigation.candidates import (
-    FEATURES,
-    SOURCES,
-    CandidateSettings,
-    GoalFinder,
-    candidate_goals,
-)
+from sfw_gym.navigation.candidates import CandidateSettings, GoalFinder, candidate_goals
 from sfw_gym.navigation.frontiers import frontier_mask
+from sfw_gym.navigation.menu import FEATURES, SOURCES
 from sfw_gym.navigation.planning import SEARCH_RADIUS_M, cost_field
 from sfw_gym.navigation.view import RobotView
 
@@ -210,7 +205,7 @@ def test_pockets_given_up_and_walled_off_cells_are_no_goals_by_hand():
 def test_greedy_takes_the_valid_goal_with_the_most_bits_per_metre():
     from dataclasses import replace
 
-    from sfw_gym.navigation.candidates import greedy_choice
+    from sfw_gym.navigation.menu import greedy_choice
 
     menu = candidate_goals(view_of(corridor(), xy=(0.25, 0.65)), max_candidates=8)
     features = np.zeros((3, len(FEATURES)))
@@ -239,7 +234,7 @@ def test_unknown_names_are_refused():
 
 def _micro_choice(finder, view, bound, anchor):
     """explore_lite's choice (and whether it is proven) on a field searched up to ``bound``."""
-    from sfw_gym.navigation.candidates import explore_lite_utilities, proven_on_bounded_paths
+    from sfw_gym.navigation.menu import explore_lite_utilities, proven_on_bounded_paths
 
     res = view.grid.resolution_m
     paths = cost_field(finder.costs(view), view.cell, res, max_cost_m=bound)
@@ -326,7 +321,7 @@ def test_a_cluster_whose_turn_carries_it_past_the_bound_is_not_exact():
     """On a menu searched to 1 m: a cluster 0.9 m away but behind the robot (its counted cost
     0.9 + 0.3 π > 1 m) may cost less from another cell beyond the bound, so it only bounds the
     choice from above (3 − 3 × 1 = 0 beats the near one's −0.5): not proven."""
-    from sfw_gym.navigation.candidates import (
+    from sfw_gym.navigation.menu import (
         FEATURES,
         CandidateGoals,
         explore_lite_utilities,
