@@ -11,6 +11,9 @@ thread): on a machine shared with other jobs, a wall-clock ratio moves with thei
 
 Run it from another checkout (``PYTHONPATH=/path/to/checkout``) to get the "before" table: the
 timing loop lives here, not in the package, so that it runs unchanged on older code.
+
+Results: docs/results/agents.md#cost-per-step (the agents) and
+docs/results/ceiling.md#what-the-oracles-cost (the oracles).
 """
 
 from __future__ import annotations

@@ -7,6 +7,9 @@ plus a figure of tracked walks on the layout.
 Errors are in each dataset's units: UJIIndoorLoc's Web-Mercator metres (ground ≈ 0.77 ×), as the
 literature reports them; WiFine's metres. The tracker's odometry is synthetic (the true positions
 plus the drift env's noise, seeded).
+
+Results: docs/results/localization.md#fingerprints-on-real-data; writes
+docs/figures/wifine_tracking.png (``--figure``).
 """
 
 from __future__ import annotations

@@ -4,6 +4,8 @@ Usage:
     python scripts/benchmarks/bench_generator.py [--seeds 100] [--kind random|apartment|office]
 
 Prints the median and 95th-percentile milliseconds per plan and the range of free areas.
+
+Results: docs/results/speed.md#the-simulated-worlds-parts.
 """
 
 from __future__ import annotations

@@ -1,12 +1,15 @@
 """What a decision of a learned menu explorer costs on CPU, beside frontier's steps.
 
-    python scripts/benchmarks/bench_goals_agent.py [--agent ppo|ppo-goals] [--model PATH] [--seeds 3]
+    python scripts/benchmarks/bench_goals_agent.py [--agent regions-ppo|goals-ppo] [--model PATH]
+        [--seeds 3]
 
-Runs the learned agent (``ppo``: ``RegionsPPOAgent``, a region every 20 steps; ``ppo-goals``:
-``PPOAgent``, candidate goals; the shipped model by default) on ``SfW-Explore-v0``
-held-out seeds and times each decision's two parts, the candidate menu (``menu_observation``) and
-the policy's choice, then the whole episode per step beside ``FrontierAgent``'s on the same seeds
-(one process, side by side).
+Runs the learned agent (``regions-ppo``: ``RegionsPPOAgent``, a region every 20 steps;
+``goals-ppo``: ``PPOAgent``, candidate goals; the shipped model by default; the old names ``ppo``
+and ``ppo-goals`` still work) on ``SfW-Explore-v0`` held-out seeds and times each decision's two
+parts, the candidate menu (``menu_observation``) and the policy's choice, then the whole episode
+per step beside ``FrontierAgent``'s on the same seeds (one process, side by side).
+
+Results: docs/results/training.md#what-a-learned-decision-costs.
 """
 
 from __future__ import annotations
@@ -47,15 +50,18 @@ def episode_seconds(agent, seed: int) -> tuple[float, int]:
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--agent", choices=("ppo", "ppo-goals"), default="ppo")
+    p.add_argument(
+        "--agent", choices=("regions-ppo", "goals-ppo", "ppo", "ppo-goals"), default="regions-ppo"
+    )
     p.add_argument("--model", default=None, help="a trained folder (default: the shipped one)")
     p.add_argument("--seeds", type=int, default=3)
     args = p.parse_args()
     parts: dict[str, list[float]] = {"menu": [], "policy": []}
     menu = timed(parts, "menu", goals.menu_observation)
     goal_agent.menu_observation = region_agent.menu_observation = menu  # type: ignore[assignment]
+    args.agent = {"ppo": "regions-ppo", "ppo-goals": "goals-ppo"}.get(args.agent, args.agent)
     learned = make_agent(args.agent, **({"path": args.model} if args.model else {}))
-    choose = "_choose" if args.agent == "ppo-goals" else "choose"
+    choose = "_choose" if args.agent == "goals-ppo" else "choose"
     setattr(learned, choose, timed(parts, "policy", getattr(learned, choose)))
     frontier = make_agent("frontier")
     episode_seconds(learned, 0)  # warm-up: compiled kernels, torch

@@ -8,6 +8,8 @@ up to 15° away, ICP from the true delta off by the given translation (random di
 rotation (random sign). Prints, per beams × method × initial error: ms per ICP, the success
 rate (error < 5 cm and < 0.5°), the paper's acceptance rate, and the median error of the
 successes.
+
+Results: docs/results/slam.md#radiolidar-slam.
 """
 
 from __future__ import annotations

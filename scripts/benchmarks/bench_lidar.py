@@ -10,6 +10,8 @@ size the simulation takes). The env loop is ``SfW-Explore-v0`` with random actio
 with one scan per step at the true pose, in alternating rounds of ``--steps`` steps (each from
 ``reset(seed=0)``), so that the ratio compares like with like; the map update is
 :meth:`~sfw_gym.mapping.lidar_map.LidarOccupancyMap.integrate` on the env's grid.
+
+Results: docs/results/slam.md#radiolidar-slam.
 """
 
 from __future__ import annotations

@@ -6,6 +6,8 @@ Writes a synthetic log of ``--rows`` rows (a random walk in a 40 m x 30 m buildi
 of 0.0115 m, the four band columns and the strongest as the unnamed 7th), then runs ``sfw-gym
 map`` on it in a child process and prints the file size, the child's peak resident memory and
 its wall time.
+
+Results: docs/results/mapping.md#what-mapping-costs.
 """
 
 from __future__ import annotations

@@ -23,9 +23,11 @@ K means "K or more walls" (the paper's rule), so a reading of K where the truth 
 right (``k_value_accuracy(..., max_k=K)``). ``k_exact`` compares with the uncapped truth.
 
 Usage:
-    python scripts/benchmarks/bench_mapper_quality.py --noise off                # every plan, noise off
-    python scripts/benchmarks/bench_mapper_quality.py --noise default --table    # estimators x policies
-    python scripts/benchmarks/bench_mapper_quality.py --noise off --oracle       # + dense-oracle bounds
+    python scripts/benchmarks/bench_mapper_quality.py --noise off             # every plan
+    python scripts/benchmarks/bench_mapper_quality.py --noise default --table # estimator x policy
+    python scripts/benchmarks/bench_mapper_quality.py --noise off --oracle    # + dense-oracle bound
+
+Results: docs/results/mapping.md#map-quality-on-a-dense-survey.
 """
 
 from __future__ import annotations

@@ -17,6 +17,8 @@ shorter than 30,000 samples are repeated (fresh mapper each time) to about 30,00
 
 Usage: python scripts/benchmarks/bench_mapper_refits.py [--seed 0] [--sizes 300 3000 30000]
                                              [--min-updates 30000] [--policy strongest]
+
+Results: docs/results/mapping.md#what-mapping-costs.
 """
 
 from __future__ import annotations

@@ -14,6 +14,8 @@ Rows "+k0" give the distance-aware estimator its calibration (``k0_level_dbm = P
 
 Usage: python scripts/benchmarks/bench_mapper_speed.py [--seed 0] [--repeats 3] [--noise-db 2]
                                             [--clearance 0.1] [--spacing 0.3]
+
+Results: docs/results/mapping.md#what-mapping-costs.
 """
 
 from __future__ import annotations

@@ -7,6 +7,8 @@ Each plan is a round 16 m hall whose wall is serrated (radius 8 m, every other v
 further out, so the outline keeps its vertices when simplified to 1 cm), written as a HouseExpo
 file and reset on ``SfW-Explore-v0`` with ``options={"floorplan": path}``; the median of
 ``--resets`` resets after a warm-up, and the ratio to the smallest plan's.
+
+Results: docs/results/speed.md#reset-time-and-memory.
 """
 
 from __future__ import annotations

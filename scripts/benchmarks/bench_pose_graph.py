@@ -1,11 +1,14 @@
 """Time the Radio SLAM pose graph (issue 15: 2,000 poses with their closures in <= 1 s).
 
-    python scripts/benchmarks/bench_pose_graph.py [--poses 2000] [--laps 5] [--closure-m 1.5] [--every 1]
+    python scripts/benchmarks/bench_pose_graph.py [--poses 2000] [--laps 5] [--closure-m 1.5]
+        [--every 1]
 
 A walk of ``--laps`` laps around a 50 m x 30 m ellipse with drifting odometry (1 % scale noise,
 0.003 rad heading bias per step); range closures between poses of different laps within
 ``--closure-m`` (the true distance, sigma 0.3 m; ``--every k`` keeps every k-th), found with a
 KD-tree. Prints the optimisation time and the ATE before and after.
+
+Results: docs/results/slam.md#radio-slam-in-the-simulated-env.
 """
 
 from __future__ import annotations

@@ -1,6 +1,7 @@
 """Evaluation throughput against Ray workers (issue 17), and an estimate for a large cluster.
 
-    python scripts/benchmarks/bench_ray.py [--plans 12] [--env SfW-Explore-v0] [--nodes 100 --cores 16]
+    python scripts/benchmarks/bench_ray.py [--plans 12] [--env SfW-Explore-v0]
+        [--nodes 100 --cores 16]
 
 Needs ``pip install 'sfw-gym[ray]'``. One workload (frontier and random on ``--plans`` plans,
 whole episodes) run side by side: the local backend with 1 and 2 workers, the Ray backend with
@@ -12,6 +13,8 @@ The cluster estimate assumes: episodes independent and CPU-bound (no shared data
 generated from seeds); one worker per core; the per-core rate of the 1-worker Ray run; the
 parallel efficiency of this machine's 2-worker run (pessimistic: here the driver shares the 2
 cores); and a ceiling of one record per driver cost. It is an estimate, not a measurement.
+
+Results: docs/results/speed.md#scale-out-on-ray.
 """
 
 from __future__ import annotations

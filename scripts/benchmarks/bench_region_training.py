@@ -2,7 +2,8 @@
 ppo_mask --env SfW-ExploreRegions-v0``, two code trees run alternately in one session, so a
 neighbour's load falls on both alike.
 
-    python scripts/benchmarks/bench_region_training.py --before /tmp/before --timesteps 600 --rounds 3
+    python scripts/benchmarks/bench_region_training.py --before /tmp/before --timesteps 600 \
+        --rounds 3
 
 Each run is ``sfw-gym train`` (``sfw_gym.cli.main``) in a fresh process whose ``PYTHONPATH`` is
 the tree (started outside the repository, so that the tree, not the working directory, is
@@ -14,6 +15,8 @@ policy. Two figures per run: decisions per second of the learn call's wall time 
 around ``MaskablePPO.learn``), which a neighbour's load on a shared machine moves far less (with
 ``--vec-env subproc`` the workers' CPU is not in it). ``--before-args``/``--after-args`` add
 ``sfw-gym train`` options to one side (``--after-args "--vec-env subproc"``).
+
+Results: docs/results/training.md#training-throughput.
 """
 
 from __future__ import annotations

@@ -7,6 +7,8 @@ a closed 4-segment outline) with a 0.9 m doorway in every wall; n = 3 gives 100 
 gives 324. A bump-aware random walk drives the robot (full speed ahead, random turns, back off and
 turn after a bump), so a realistic share of steps is spent in wall contact. For scale, the same run
 measures CartPole-v1 through ``gym.make`` when gymnasium is installed.
+
+Results: docs/results/speed.md#the-simulated-worlds-parts.
 """
 
 from __future__ import annotations

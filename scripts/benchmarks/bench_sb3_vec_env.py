@@ -2,6 +2,8 @@
 ``sfw-gym train`` default, beside the native vector env through ``SB3VecEnv`` (issue 33).
 
     python scripts/benchmarks/bench_sb3_vec_env.py --env SfW-ExploreDiscrete-v0 --timesteps 4096
+
+Results: docs/results/speed.md#training-and-evaluation-on-the-native-env.
 """
 
 from __future__ import annotations

@@ -7,8 +7,17 @@ and prints the median of the per-round ratios (a neighbour's load hits both side
 ``--against DIR`` times the code in DIR (say, a worktree of an older commit) in the same rounds.
 
     python scripts/benchmarks/bench_vector_envs.py --env SfW-Explore-v0 --num-envs 16 --steps 200
-    python scripts/benchmarks/bench_vector_envs.py --floorplan ../shared/floorplans/houseexpo/PLAN.json
-    python scripts/benchmarks/bench_vector_envs.py --rounds 15 --steps 150 --clock cpu --against /tmp/before
+    python scripts/benchmarks/bench_vector_envs.py --floorplan ../shared/floorplans/houseexpo/P.json
+    python scripts/benchmarks/bench_vector_envs.py --rounds 15 --steps 150 --clock cpu \
+        --against /tmp/before
+    python scripts/benchmarks/bench_vector_envs.py --rounds 15 --steps 150 --clock cpu --write-docs
+    python scripts/benchmarks/bench_vector_envs.py --steps 200 --write-docs
+
+Results: docs/results/speed.md#the-native-vector-env (the headline "16 native envs ÷ one env"
+figure). ``--write-docs`` writes the table, with the command, the date and the machine, into
+that page: the ``--rounds`` run between ``<!-- bench_vector_envs:begin -->`` and
+``<!-- bench_vector_envs:end -->``, the run without ``--rounds`` (every vectorisation beside
+one env) between ``<!-- bench_vector_envs_table:begin -->`` and ``:end -->``.
 """
 
 from __future__ import annotations
@@ -24,8 +33,12 @@ from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
+from _docs import RESULTS, command_line, machine, machine_short, write_block
 
 import sfw_gym  # noqa: F401  (registers the ids)
+
+DOC = RESULTS / "speed.md"
+HEADLINE = "<!-- bench_vector_envs:headline -->"
 
 
 def env_steps_per_s(
@@ -113,6 +126,8 @@ def native_rounds(args: argparse.Namespace, kwargs: dict[str, Any]) -> None:
         w.wait()
     n = args.num_envs
     print(f"{args.env}: env steps per {args.clock} second, medians of {args.rounds} rounds")
+    rows: list[str] = []
+    headline = ""  # this checkout's
     for name in trees:
         one, vec = rates[name, "one"], rates[name, "vec"]
         ratios = [b / a for a, b in zip(one, vec, strict=True)]
@@ -122,11 +137,39 @@ def native_rounds(args: argparse.Namespace, kwargs: dict[str, Any]) -> None:
             f"{statistics.median(vec):,.0f}; {n} native / one env {statistics.median(ratios):.2f}x "
             f"(quartiles {q[0]:.2f}-{q[-1]:.2f})"
         )
+        rows.append(
+            f"| {name} | {statistics.median(one):,.0f} | {statistics.median(vec):,.0f} | "
+            f"**{statistics.median(ratios):.2f}×** ({q[0]:.2f}–{q[-1]:.2f}) |"
+        )
+        headline = headline or (
+            f"**{n} native envs in one process ÷ one env: {statistics.median(ratios):.2f}×** "
+            f"(median of {args.rounds} per-round ratios on the {args.clock} clock; quartiles "
+            f"{q[0]:.2f}–{q[-1]:.2f}; {machine_short()})."
+        )
+    gains = []
     if args.against:
         this, other = trees
         for kind in ("one", "vec"):
             gain = [a / b for a, b in zip(rates[this, kind], rates[other, kind], strict=True)]
             print(f"  {kind}: this checkout / against, median {statistics.median(gain):.2f}x")
+            gains.append(f"{kind}: {statistics.median(gain):.2f}×")
+    if args.write_docs:
+        clock = "the process's CPU time" if args.clock == "cpu" else "wall time"
+        lines = [
+            f"`{command_line()}`: {machine(args.load_before)}. {args.env}, random actions, "
+            f"{args.rounds} rounds; in each, one env steps {n} × {args.steps:,} times and the "
+            f"native {n}-env batch {args.steps:,} times, timed on {clock}. Other jobs may share "
+            "the cores: the ratio, taken round by round, is the figure to compare.",
+            "",
+            f"| code | one env, steps/s | {n} native, steps/s | "
+            f"{n} native ÷ one env, median (quartiles) |",
+            "|---|---:|---:|---|",
+            *rows,
+        ]
+        if gains:
+            lines += ["", "This checkout ÷ the other, median per round: " + "; ".join(gains) + "."]
+        lines += ["", HEADLINE, headline]  # docs/results/index.md includes the line after HEADLINE
+        write_block(DOC, "bench_vector_envs", lines)
 
 
 def main() -> None:
@@ -144,8 +187,15 @@ def main() -> None:
         help="with --rounds: wall time, or the process's CPU time (a machine others load)",
     )
     parser.add_argument("--against", default=None, help="with --rounds: the code in this dir too")
+    parser.add_argument(
+        "--write-docs",
+        action="store_true",
+        help="write the table into docs/results/speed.md (block bench_vector_envs, or "
+        "bench_vector_envs_table without --rounds)",
+    )
     parser.add_argument("--serve", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    args.load_before = os.getloadavg()[0]
     n, kwargs = args.num_envs, {} if args.floorplan is None else {"floorplan": args.floorplan}
     if args.rounds:
         native_rounds(args, kwargs)
@@ -156,22 +206,36 @@ def main() -> None:
         return
     one = env_steps_per_s(gym.make(args.env, **kwargs), args.steps, 1)
     rows = [("one env", one)]
-    for mode in ("vector_entry_point", "sync"):
+    for mode, label in (("vector_entry_point", "native"), ("sync", "Gymnasium sync")):
         vec = gym.make_vec(args.env, num_envs=n, vectorization_mode=mode, **kwargs)
-        rows.append((f"{n} envs, {mode}", env_steps_per_s(vec, args.steps, n)))
+        rows.append((f"{n} envs, {label}", env_steps_per_s(vec, args.steps, n)))
     vec = gym.make_vec(args.env, num_envs=2, vectorization_mode="async", **kwargs)
-    rows.append(("2 envs, async (2 processes)", env_steps_per_s(vec, args.steps * 2, 2)))
+    rows.append(("2 envs, Gymnasium async (2 processes)", env_steps_per_s(vec, args.steps * 2, 2)))
     p = args.processes
     context = multiprocessing.get_context("spawn")
     barrier = context.Manager().Barrier(p)
     with context.Pool(p) as pool:
         rates = pool.map(_native_rate, [(args.env, n, args.steps, kwargs, barrier)] * p)
-    rows.append((f"{p} processes x {n} envs, native", sum(rates)))
+    rows.append((f"{p} processes × {n} envs, native", sum(rates)))
     print(f"{args.env}: env steps/s, and as a multiple of one env's in this run")
     for name, rate in rows:
         print(f"  {name:34s} {rate:10,.0f}  {rate / one:5.2f}x")
     native = rows[1][1]
     print(f"  {p} processes / one process (native, {n} envs each): {sum(rates) / native:.2f}x")
+    if args.write_docs:
+        plan = f"every episode on `{args.floorplan}`" if args.floorplan else "procedural plans"
+        lines = [
+            f"`{command_line()}`: {machine(args.load_before)}. {args.env}, {plan}, random "
+            f"actions, {args.steps:,} vector steps per row, wall time, one run. Other jobs may "
+            "share the cores, and one run is one sample: read the rows against each other.",
+            "",
+            "| env steps/s | steps/s | × one env |",
+            "|---|---:|---:|",
+            *(f"| {name} | {rate:,.0f} | {rate / one:.2f}× |" for name, rate in rows),
+            f"| {p} processes ÷ one process (native, {n} envs each) | | "
+            f"{sum(rates) / native:.2f}× |",
+        ]
+        write_block(DOC, "bench_vector_envs_table", lines)
 
 
 if __name__ == "__main__":

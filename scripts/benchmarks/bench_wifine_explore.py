@@ -1,8 +1,8 @@
 """Frontier, cross-pass and the learned explorer (regions-ppo) on WiFine's three office floors
 (issue 38): real buildings of ~90 x 58 m in the explore env.
 
-    python scripts/benchmarks/bench_wifine_explore.py [--wifine ../shared/datasets/wifine] [--steps 3000]
-        [--seeds 1] [--out wifine-explore] [--figure docs/figures/wifine_explore.png]
+    python scripts/benchmarks/bench_wifine_explore.py [--wifine ../shared/datasets/wifine]
+        [--steps 3000] [--seeds 1] [--out wifine-explore] [--figure docs/figures/wifine_explore.png]
 
 Each floor's layout (``floor_layouts/Floor_{4,5,6}_10cm.png``: 0.1 m per pixel, the origin at the
 image's bottom-left corner) is loaded through a ROS map YAML written in ``OUT/maps``; then
@@ -11,6 +11,9 @@ budget of ``--steps`` steps, episode ``i`` with ``reset(seed=i)`` (the same rout
 every agent), in ``OUT/floor_<n>/`` (its results.md, curves and trajectories). Prints the table of
 coverage and bits per metre (mean ± 95 % CI over the seeds) and writes it to ``OUT/table.md``;
 the seed-0 trajectory figures of the three floors, stacked, go to ``--figure``.
+
+Results: docs/results/agents.md#real-office-floors; writes docs/figures/wifine_explore.png
+(``--figure``: the seed-0 trajectories of the three floors, stacked).
 """
 
 from __future__ import annotations

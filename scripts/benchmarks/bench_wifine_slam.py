@@ -6,8 +6,10 @@ Each train walk's real fingerprints, odometry made from its true positions at a 
 Radio SLAM kept, judged against the true distance between their scans (wrong: off by more than
 3 of their sigmas or more than 3 m).
 
-    python scripts/benchmarks/bench_wifine_slam.py                      # all 120 train walks, seeds 0 1 2
+    python scripts/benchmarks/bench_wifine_slam.py             # all 120 train walks, seeds 0 1 2
     python scripts/benchmarks/bench_wifine_slam.py --walks 15 --seeds 0 --levels 0.05:0.02
+
+Results: docs/results/slam.md#radio-slam-on-real-wifine-scans.
 """
 
 from __future__ import annotations

@@ -3,6 +3,8 @@
 Usage: python scripts/benchmarks/bench_world.py [--houseexpo DIR] [--seeds 100]
 Prints segments/s of `count_walls`, median ms of `generate_floorplan`, points/s of `mean_rssi`,
 and the agreement of `count_walls` with an independent shapely computation.
+
+Results: docs/results/speed.md#the-simulated-worlds-parts.
 """
 
 from __future__ import annotations

@@ -3,21 +3,30 @@ what is done) and writes the table into docs/benchmark.md between its markers; `
 runs the oracles (privileged, never among the shipped agents) into the oracles' table.
 
     python scripts/benchmarks/benchmark_shipped.py [--workers 2] [--out runs/benchmark]
-    python scripts/benchmarks/benchmark_shipped.py --oracles     # oracle-regions: 5 episodes per env
+    python scripts/benchmarks/benchmark_shipped.py --oracles  # oracle-regions: 5 episodes per env
+
+Results: docs/benchmark.md#the-shipped-agents-on-benchmark-v1--test, between
+``<!-- benchmark:begin -->`` and ``<!-- benchmark:end -->`` (``<!-- oracles:begin -->`` /
+``:end -->`` with ``--oracles``); docs/results/agents.md#learned-vs-frontier includes that table.
+The rows are labelled with the registry's names (``sfw_gym.agents.AGENTS``: ``regions-ppo``,
+``goals-ppo``, ``waypoint-ppo``, ...), never the deprecated ``ppo`` / ``ppo-goals`` /
+``ppo-waypoint``, whose meaning changed over time. A whole run takes hours on 2 cores (the
+agents' episodes, 70 per agent); ``--out`` resumes one.
 """
 
 from __future__ import annotations
 
 import argparse
-import re
 from pathlib import Path
+
+from _docs import ROOT, write_block
 
 from sfw_gym.agents import AGENTS, is_privileged
 from sfw_gym.evaluation.benchmark import format_interval, run_benchmark
 from sfw_gym.evaluation.metric_table import METRICS
 from sfw_gym.evaluation.report import PRIVILEGED_NOTE, agent_label
 
-DOC = Path(__file__).resolve().parents[2] / "docs" / "benchmark.md"
+DOC = ROOT / "docs" / "benchmark.md"
 COLUMNS = ("coverage", "info_gain_per_m", "path_length_m", "free_iou", "wall_precision", "ate_m")
 
 
@@ -55,11 +64,7 @@ def main() -> None:
     lines = table(results)
     if args.oracles:
         lines += ["", PRIVILEGED_NOTE]
-    marker = "oracles" if args.oracles else "benchmark"
-    text = DOC.read_text(encoding="utf-8")
-    block = f"<!-- {marker}:begin -->\n" + "\n".join(lines) + f"\n<!-- {marker}:end -->"
-    pattern = f"<!-- {marker}:begin -->.*<!-- {marker}:end -->"
-    DOC.write_text(re.sub(pattern, lambda _: block, text, flags=re.S))
+    write_block(DOC, "oracles" if args.oracles else "benchmark", lines)
     print("\n".join(lines))
 
 
@@ -68,7 +73,8 @@ def table(results: dict[str, dict]) -> list[str]:
     first = next(iter(results.values()))
     flags = " --oracles" if first.get("privileged") else ""
     lines = [
-        f"`python scripts/benchmarks/benchmark_shipped.py{flags}` (sfw_gym {first['package_version']}, "
+        f"`python scripts/benchmarks/benchmark_shipped.py{flags}` "
+        f"(sfw_gym {first['package_version']}, "
         f"{first['protocol']} / {first['split']}, agent seed 0; mean [95 % bootstrap interval]; "
         "`sfw-gym benchmark compare` gives any pair's paired differences).",
     ]

@@ -1,4 +1,4 @@
-"""Mutation testing of sfw_gym with mutmut 3, per module group, and the table in BENCHMARKS.md.
+"""Mutation testing of sfw_gym with mutmut 3 per module group; the table: docs/results/testing.md.
 
 Not run in CI (it takes minutes to hours). Run it from the repository root, niced on a shared box:
 
@@ -35,7 +35,8 @@ What it does
    name → one-line reason; a name there that is *killed* is reported, since the entry is stale),
    writes the per-module table to stdout, stores the group's numbers in
    ``docs/results/data/mutation_results.json`` (so that a run of other groups keeps them) and rewrites the
-   table between ``<!-- mutation:begin -->`` and ``<!-- mutation:end -->`` in BENCHMARKS.md.
+   table between ``<!-- mutation:begin -->`` and ``<!-- mutation:end -->`` in
+   docs/results/testing.md.
 
 score = killed / (mutants − equivalent); "timeout" and "no tests" mutants count against it.
 
@@ -77,7 +78,7 @@ import tomllib
 ROOT = Path(__file__).resolve().parents[2]
 EQUIVALENT_FILE = ROOT / "scripts" / "tools" / "mutation_equivalent.toml"
 RESULTS_FILE = ROOT / "docs" / "results" / "data" / "mutation_results.json"
-BENCHMARKS = ROOT / "BENCHMARKS.md"
+BENCHMARKS = ROOT / "docs" / "results" / "testing.md"
 BEGIN, END = "<!-- mutation:begin -->", "<!-- mutation:end -->"
 
 #: group -> (source files to mutate, test files whose tests may kill them)
