@@ -11,7 +11,7 @@ so the value loss cannot drown the policy's gradients (the waypoint policy's fai
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import Any
+from typing import Any, NamedTuple
 
 import gymnasium as gym
 import numpy as np
@@ -158,6 +158,23 @@ class HeadGradientNorms(BaseCallback):
         return True
 
 
+class Demonstrations(NamedTuple):
+    """A teacher's decisions (:func:`teacher_decisions`): the observations, the teacher's choice
+    in each ``(N,)`` and the masks of the candidates allowed ``(N, K)``."""
+
+    observations: list[dict[str, np.ndarray]]
+    actions: np.ndarray
+    masks: np.ndarray
+
+    def joined(self, more: Demonstrations) -> Demonstrations:
+        """These decisions followed by ``more`` (DAgger's growing data set)."""
+        return Demonstrations(
+            self.observations + more.observations,
+            np.concatenate([self.actions, more.actions]),
+            np.concatenate([self.masks, more.masks]),
+        )
+
+
 def teacher_decisions(
     env_id: str,
     env_kwargs: dict[str, Any],
@@ -165,7 +182,7 @@ def teacher_decisions(
     learner: Any = None,
     learner_masked: bool = True,
     teacher: str = "explore_lite",
-) -> tuple[list[dict[str, np.ndarray]], np.ndarray, np.ndarray]:
+) -> Demonstrations:
     """Observations, choices and masks of the env's ``teacher`` (``teacher_action(teacher)``; by
     default the frontier agent's choice on the menu,
     :func:`~sfw_gym.navigation.menu.explore_lite_choice`) over one episode per seed. The
@@ -189,26 +206,24 @@ def teacher_decisions(
             obs, _, terminated, truncated, _ = env.step(action)
             done = terminated or truncated
         env.close()
-    return observations, np.array(actions), np.array(masks)
+    return Demonstrations(observations, np.array(actions), np.array(masks))
 
 
 def behaviour_clone(
     policy: Any,
-    observations: list[dict[str, np.ndarray]],
-    actions: np.ndarray,
-    masks: np.ndarray,
+    demos: Demonstrations,
     epochs: int = 20,
     batch_size: int = 256,
     lr: float = 1e-3,
     seed: int = 0,
 ) -> list[float]:
     """Fit the actor of ``policy`` (:class:`GoalsPolicy` or any policy with ``actor_keys``,
-    ``actor_logits`` and ``parameter_groups``) to a teacher's ``actions`` (cross-entropy over
-    the masked candidates); returns the mean loss per epoch."""
+    ``actor_logits`` and ``parameter_groups``) to a teacher's choices ``demos`` (cross-entropy
+    over the masked candidates); returns the mean loss per epoch."""
     gen = torch.Generator().manual_seed(seed)
-    obs = {k: torch.as_tensor(np.stack([o[k] for o in observations])) for k in policy.actor_keys}
-    acts = torch.as_tensor(actions, dtype=torch.long)
-    mask = torch.as_tensor(masks, dtype=torch.bool)
+    obs = _actor_inputs(policy, demos.observations)
+    acts = torch.as_tensor(demos.actions, dtype=torch.long)
+    mask = torch.as_tensor(demos.masks, dtype=torch.bool)
     optimiser = torch.optim.Adam(policy.parameter_groups()["actor"], lr=lr)
     losses = []
     for _ in range(epochs):
@@ -227,21 +242,20 @@ def behaviour_clone(
     return losses
 
 
-def teacher_agreement(
-    policy: Any,
-    observations: list[dict[str, np.ndarray]],
-    actions: np.ndarray,
-    masks: np.ndarray,
-    batch_size: int = 512,
-) -> float:
-    """The share of decisions on which the actor's most likely allowed candidate is the
-    teacher's (behaviour cloning's accuracy)."""
+def teacher_agreement(policy: Any, demos: Demonstrations, batch_size: int = 512) -> float:
+    """The share of ``demos``' decisions on which the actor's most likely allowed candidate is
+    the teacher's (behaviour cloning's accuracy)."""
+    actions, masks = demos.actions, demos.masks
     hits = 0
     with torch.no_grad():
         for start in range(0, len(actions), batch_size):
-            chunk = observations[start : start + batch_size]
-            obs = {k: torch.as_tensor(np.stack([o[k] for o in chunk])) for k in policy.actor_keys}
+            obs = _actor_inputs(policy, demos.observations[start : start + batch_size])
             mask = torch.as_tensor(masks[start : start + batch_size], dtype=torch.bool)
             logits = policy.actor_logits(obs).masked_fill(~mask, -torch.inf)
             hits += int((logits.argmax(1).numpy() == actions[start : start + batch_size]).sum())
     return hits / max(len(actions), 1)
+
+
+def _actor_inputs(policy: Any, observations: list[dict[str, np.ndarray]]) -> dict[str, Any]:
+    """The observations' entries that ``policy``'s actor reads, stacked into tensors."""
+    return {k: torch.as_tensor(np.stack([o[k] for o in observations])) for k in policy.actor_keys}

@@ -539,7 +539,12 @@ def _clone_teacher(
     ``from_model``: instead, copy the actor of an earlier run's clone (the anchor of a
     fine-tuned model in ``from_model``, a folder or ``.zip``), so that fine-tuning variants
     start from the same clone."""
-    from sfw_gym.rl.goal_policy import behaviour_clone, teacher_agreement, teacher_decisions
+    from sfw_gym.rl.goal_policy import (
+        Demonstrations,
+        behaviour_clone,
+        teacher_agreement,
+        teacher_decisions,
+    )
 
     keys = {"episodes", "epochs", "dagger_rounds", "dagger_episodes", "teacher", "from_model"}
     unknown = set(spec) - keys
@@ -551,32 +556,30 @@ def _clone_teacher(
     epochs, first = int(spec.get("epochs", 30)), int(spec.get("episodes", 8))
     per_round = int(spec.get("dagger_episodes", 4))
 
-    def decisions(seeds: range, learner: Any = None) -> tuple[list, np.ndarray, np.ndarray]:
+    def decisions(seeds: range, learner: Any = None) -> Demonstrations:
         obs, acts, masks = teacher_decisions(
             env_id, env_kwargs, seeds, learner, use_masking, spec.get("teacher", "explore_lite")
         )
-        return obs, acts, masks if use_masking else np.ones_like(masks)
+        return Demonstrations(obs, acts, masks if use_masking else np.ones_like(masks))
 
     fits: list[dict[str, Any]] = []
 
     def fit() -> None:
-        losses = behaviour_clone(model.policy, observations, actions, masks, epochs=epochs)
-        agreement = teacher_agreement(model.policy, observations, actions, masks)
+        losses = behaviour_clone(model.policy, demos, epochs=epochs)
+        agreement = teacher_agreement(model.policy, demos)
         fits.append(
             {
-                "decisions": len(actions),
+                "decisions": len(demos.actions),
                 "final_loss": float(losses[-1]) if losses else None,
                 "teacher_agreement": round(float(agreement), 4),
             }
         )
 
-    observations, actions, masks = decisions(range(seed, seed + first))
+    demos = decisions(range(seed, seed + first))
     fit()
     for i in range(int(spec.get("dagger_rounds", 0))):
         start = seed + first + i * per_round
-        more = decisions(range(start, start + per_round), model.policy)
-        observations += more[0]
-        actions, masks = np.concatenate([actions, more[1]]), np.concatenate([masks, more[2]])
+        demos = demos.joined(decisions(range(start, start + per_round), model.policy))
         fit()
     return fits
 

@@ -11,7 +11,12 @@ from tests.envs.test_goals import SMALL, explore_lite
 
 torch = pytest.importorskip("torch")
 sb3_contrib = pytest.importorskip("sb3_contrib")
-from sfw_gym.rl.goal_policy import GoalsPolicy, HeadGradientNorms, behaviour_clone  # noqa: E402
+from sfw_gym.rl.goal_policy import (  # noqa: E402
+    Demonstrations,
+    GoalsPolicy,
+    HeadGradientNorms,
+    behaviour_clone,
+)
 
 
 def model_on(env):
@@ -73,7 +78,7 @@ def test_behaviour_cloning_learns_the_teachers_choices():
     observations, actions, masks = teacher_decisions(range(4))
     held_out, actions_out, masks_out = teacher_decisions([10])
     policy = model_on(gym.make("SfW-ExploreGoals-v0", **SMALL)).policy
-    losses = behaviour_clone(policy, observations, actions, masks, epochs=30)
+    losses = behaviour_clone(policy, Demonstrations(observations, actions, masks), epochs=30)
     assert losses[-1] < 0.5 * losses[0]
     with torch.no_grad():
         logits = policy.heads.forward_actor(policy.extract_features(as_batch(held_out)))

@@ -58,9 +58,9 @@ def test_dagger_rounds_follow_the_cloning_episodes_and_refit_on_everything(monke
 
     monkeypatch.setattr(goal_policy, "teacher_decisions", decisions)
 
-    def clone(policy, observations, actions, masks, epochs):
-        assert len(observations) == len(actions) == len(masks)
-        fits.append(([o["seed"] for o in observations], bool(masks.all())))
+    def clone(policy, demos, epochs):
+        assert len(demos.observations) == len(demos.actions) == len(demos.masks)
+        fits.append(([o["seed"] for o in demos.observations], bool(demos.masks.all())))
 
     monkeypatch.setattr(goal_policy, "behaviour_clone", clone)
     monkeypatch.setattr(goal_policy, "teacher_agreement", lambda *args: 1.0)
