@@ -2,14 +2,8 @@
 
 The package's embedded default world. A plan is laid out as axis-aligned room *tiles* that exactly
 cover the building's interior (tile sides are wall centre lines), on a 5 cm grid in integer
-centimetres, so every shapely operation is exact and no slivers arise:
-
-- **apartment**, "hall" style: a living zone (optionally split into living room and kitchen) at one
-  end, a hall along the long axis with bands of rooms (bedrooms, bathroom, …) on both sides, and
-  optionally a full-depth room closing the hall. "bsp" style: a binary space partition of the
-  interior, the living room being the hub.
-- **office**: a central corridor with offices on both sides, optionally meeting rooms closing its
-  ends; one bathroom and often a kitchen among the band rooms.
+centimetres, so every shapely operation is exact and no slivers arise: apartments ("hall" or "bsp"
+style) and offices (a central corridor), :mod:`sfw_gym.world.layouts` lays them out.
 
 An L-shaped footprint removes one corner room. Every pair of adjacent rooms is separated by a wall
 rectangle (centred on the shared side, one thickness and material per straight wall line),
@@ -26,7 +20,7 @@ from __future__ import annotations
 import math
 import numbers
 from collections import deque
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -37,6 +31,17 @@ from shapely.geometry.polygon import orient
 from sfw_gym.core.config import Config, setting
 from sfw_gym.core.errors import ConfigError, FloorplanError
 from sfw_gym.world.floorplan import Floorplan, Room
+from sfw_gym.world.layouts import (
+    BATH,
+    GRID_CM,
+    Layout,
+    cut_corner,
+    random_layout,
+    snap,
+    symmetry,
+    tile_area,
+    uniform_snap,
+)
 
 #: Kinds of building the generator makes ("random" picks one from the seed).
 KINDS = ("apartment", "office")
@@ -69,7 +74,6 @@ class GeneratorConfig(Config):
             raise ConfigError(f"GeneratorConfig.name must be a string or None, got {self.name!r}")
 
 
-_GRID = 5  # cm: room tiles snap to this grid
 _DOOR_CLEAR = 20  # cm: doorway jamb to the wall line's junction (centre line)
 _MIN_DOOR = 80  # cm
 _PUSH = 3  # cm: edge midpoints pushed into the facing wall (less than half the thinnest wall)
@@ -81,20 +85,6 @@ _INTERIOR = {
     "apartment": (("drywall", 0.75, (10, 12)), ("brick", 0.25, (12, 14))),
     "office": (("drywall", 0.65, (10, 12)), ("glass", 0.2, (10,)), ("brick", 0.15, (12, 14))),
 }
-_BATH, _LIVING, _KITCHEN, _CORRIDOR = "Bathroom", "Living_Room", "Kitchen", "Corridor"
-
-
-@dataclass
-class _Layout:
-    """Room tiles in integer cm (x0, y0, x1, y1) covering [0, width] × [0, height] minus ``cut``."""
-
-    tiles: list[tuple[int, int, int, int]]
-    labels: list[str]
-    hub: int
-    width: int
-    height: int
-    open_pairs: set[tuple[int, int]] = field(default_factory=set)
-    cut: tuple[int, int, int, int] | None = None
 
 
 # ------------------------------------------------------------------------------------------ API
@@ -136,7 +126,7 @@ def generate_floorplan(seed: int, **params: Any) -> Floorplan:
     area = float(p.area_m2 if p.area_m2 is not None else drawn_area)
     extra = p.extra_door_prob
     extra = (0.2 if kind == "apartment" else 0.1) if extra is None else float(extra)
-    door_cm = None if p.door_width_m is None else _snap(100.0 * p.door_width_m)
+    door_cm = None if p.door_width_m is None else snap(100.0 * p.door_width_m)
     name = p.name if p.name is not None else f"gen-{kind}-{int(seed)}"
 
     lo, hi = max(MIN_AREA_M2, 0.85 * area), min(MAX_AREA_M2, 1.15 * area)
@@ -145,18 +135,18 @@ def generate_floorplan(seed: int, **params: Any) -> Floorplan:
     inflate = rng.uniform(1.08, 1.16)  # L-shapes: the removed corner room's share, learnt below
     for _ in range(_MAX_ATTEMPTS):
         if shape == "L":
-            layout = _layout(rng, kind, gross * inflate)
-            layout = _cut_corner(layout, gross) if layout is not None else None
+            layout = random_layout(rng, kind, gross * inflate)
+            layout = cut_corner(layout, gross) if layout is not None else None
             if layout is not None:
-                got = layout.width * layout.height - _area(layout.cut)  # type: ignore[arg-type]
+                got = layout.width * layout.height - tile_area(layout.cut)  # type: ignore[arg-type]
                 inflate = float(np.clip(inflate * gross / got, 1.0, 1.6))
                 if abs(got / gross - 1.0) > 0.08:
                     continue
         else:
-            layout = _layout(rng, kind, gross)
+            layout = random_layout(rng, kind, gross)
         if layout is None:
             continue
-        layout = _symmetry(layout, int(rng.integers(8)))  # any orientation, mirrored or not
+        layout = symmetry(layout, int(rng.integers(8)))  # any orientation, mirrored or not
         plan = _build(rng, layout, kind, ext_material, door_cm, extra, name)
         if plan is not None and lo <= plan.area_m2 <= hi:
             return plan
@@ -172,299 +162,6 @@ def _validate(seed: Any, params: dict[str, Any]) -> GeneratorConfig:
 
 
 # --------------------------------------------------------------------------------------- layouts
-def _snap(v: float) -> int:
-    return round(v / _GRID) * _GRID
-
-
-def _uniform_snap(rng: np.random.Generator, lo: float, hi: float) -> int:
-    """A grid value drawn uniformly in [lo, hi] (grid-rounded bounds)."""
-    a, b = math.ceil(lo / _GRID), math.floor(hi / _GRID)
-    return int(rng.integers(a, max(a, b) + 1)) * _GRID
-
-
-def _partition(rng: np.random.Generator, length: int, lo: int, hi: int) -> list[int]:
-    """Split ``length`` cm into grid-multiple parts within [lo, hi] where possible."""
-    n, lo_n, hi_n = length // _GRID, math.ceil(lo / _GRID), hi // _GRID
-    k_min, k_max = max(1, math.ceil(n / hi_n)), max(1, n // lo_n)
-    k = int(rng.integers(k_min, max(k_min, k_max) + 1))
-    parts, rem = [], n
-    for i in range(k - 1):
-        left = k - i - 1
-        a, b = max(lo_n, rem - left * hi_n), min(hi_n, rem - left * lo_n)
-        if a > b:
-            a = b = rem // (k - i)
-        w = int(rng.integers(a, b + 1))
-        parts.append(w)
-        rem -= w
-    parts.append(rem)
-    return [w * _GRID for w in parts]
-
-
-def _band(
-    rng: np.random.Generator,
-    x0: int,
-    x1: int,
-    special: list[tuple[str, int, int]],
-    lo: int,
-    hi: int,
-) -> list[tuple[int, int, str]]:
-    """Rooms (x0, x1, label) along [x0, x1]: the special (label, min, max) slots that fit, the rest
-    split in [lo, hi] and labelled "" (to be named by the caller)."""
-    length = x1 - x0
-    slots: list[tuple[int, str]] = []
-    for label, a, b in special:
-        room = length - sum(w for w, _ in slots) - lo  # leave at least one ordinary room
-        if room >= a:
-            slots.append((_uniform_snap(rng, a, min(b, room)), label))
-    rest = length - sum(w for w, _ in slots)
-    widths = [(w, "") for w in _partition(rng, rest, lo, hi)]
-    for slot in slots:
-        widths.insert(int(rng.integers(len(widths) + 1)), slot)
-    out, x = [], x0
-    for w, label in widths:
-        out.append((x, x + w, label))
-        x += w
-    return out
-
-
-def _layout(rng: np.random.Generator, kind: str, gross: float) -> _Layout | None:
-    if kind == "office":
-        return _office(rng, gross)
-    return _apartment_hall(rng, gross) if rng.random() < 0.65 else _apartment_bsp(rng, gross)
-
-
-def _depths(rng: np.random.Generator, total: float, lo: int, hi: int) -> tuple[int, int]:
-    total = _snap(float(np.clip(total, 2 * lo, 2 * hi)))
-    a = _uniform_snap(rng, max(lo, total - hi), min(hi, total - lo))
-    return a, total - a
-
-
-def _apartment_hall(rng: np.random.Generator, gross: float) -> _Layout | None:
-    hw = _uniform_snap(rng, 140, 170)
-    aspect = rng.uniform(1.1, 1.8)
-    da, db = _depths(rng, math.sqrt(gross / aspect) - hw, 270, 480)
-    h = da + hw + db
-    w = _snap(gross / h)
-    lw = _uniform_snap(rng, 320, 560)
-    lw = min(lw, w - 250)
-    if lw < 300:
-        return None
-    tiles: list[tuple[int, int, int, int]] = []
-    labels: list[str] = []
-
-    def add(box: tuple[int, int, int, int], label: str) -> int:
-        tiles.append(box)
-        labels.append(label)
-        return len(tiles) - 1
-
-    open_pairs: set[tuple[int, int]] = set()
-    # Living zone at x in [0, lw], full depth; optionally a kitchen on one band's side.
-    kitchen = None
-    if h >= 800 and rng.random() < 0.6:
-        if rng.random() < 0.5:
-            kitchen = add((0, 0, lw, da), _KITCHEN)
-            living = add((0, da, lw, h), _LIVING)
-        else:
-            living = add((0, 0, lw, da + hw), _LIVING)
-            kitchen = add((0, da + hw, lw, h), _KITCHEN)
-        if rng.random() < 0.5:
-            open_pairs.add((min(kitchen, living), max(kitchen, living)))
-    else:
-        living = add((0, 0, lw, h), _LIVING)
-    # Optional full-depth room closing the hall.
-    x_end = w
-    if w - lw >= 300 + 250 + 250 and rng.random() < 0.35:
-        e = _uniform_snap(rng, 300, min(450, w - lw - 250))
-        x_end = w - e
-        add((x_end, 0, w, h), "Bedroom")
-    hall = add((lw, da, x_end, da + hw), _CORRIDOR)
-    if rng.random() < 0.6:
-        open_pairs.add((min(hall, living), max(hall, living)))
-    bath_band = int(rng.integers(2))
-    band_rooms = []
-    for band, (y0, y1) in enumerate(((0, da), (da + hw, h))):
-        special = [(_BATH, 170, 240)] if band == bath_band else []
-        if band != bath_band and kitchen is None:
-            special.append((_KITCHEN, 250, 380))
-        for x0, x1, label in _band(rng, lw, x_end, special, 250, 480):
-            band_rooms.append(add((x0, y0, x1, y1), label))
-    # Name the unnamed band rooms: a bathroom first, then a kitchen next to the living zone if
-    # rooms are left for bedrooms (in a small flat the kitchen is part of the living room).
-    unnamed = [i for i in band_rooms if not labels[i]]
-    if _BATH not in labels and unnamed:
-        bath = min(unnamed, key=lambda i: _area(tiles[i]))
-        labels[bath] = _BATH
-        unnamed.remove(bath)
-    near = [i for i in unnamed if tiles[i][0] == lw]
-    if _KITCHEN not in labels and near and len(unnamed) >= 2:
-        labels[near[0]] = _KITCHEN
-    unnamed = [i for i in band_rooms if not labels[i]]
-    for n, i in enumerate(unnamed):
-        labels[i] = "Office" if n == 2 and len(unnamed) >= 4 else "Bedroom"
-    return _Layout(tiles, labels, hall, w, h, open_pairs)
-
-
-def _apartment_bsp(rng: np.random.Generator, gross: float) -> _Layout | None:
-    aspect = rng.uniform(1.0, 1.6)
-    h = _snap(math.sqrt(gross / aspect))
-    w = _snap(gross / h)
-    leaves: list[tuple[int, int, int, int]] = []
-    stack = [(0, 0, w, h)]
-    lines: tuple[list[int], list[int]] = ([], [])  # x of vertical cuts, y of horizontal cuts
-    while stack:
-        x0, y0, x1, y1 = stack.pop()
-        sx, sy = x1 - x0, y1 - y0
-        big = max(sx, sy)
-        if big < 2 * 250 or (sx * sy <= rng.uniform(9e4, 2.2e5) and big <= 600):
-            leaves.append((x0, y0, x1, y1))
-            continue
-        along_x = sx >= sy
-        start = x0 if along_x else y0
-        lo, hi = start + max(250, 0.3 * big), start + min(big - 250, 0.7 * big)
-        cut = start + _uniform_snap(rng, lo - start, hi - start)
-        # Line up with a parallel wall nearby (offset walls 5–30 cm apart look like mistakes).
-        near = [v for v in lines[not along_x] if 0 < abs(v - cut) < 30 and lo <= v <= hi]
-        cut = near[0] if near else cut
-        lines[not along_x].append(cut)
-        if along_x:
-            stack += [(x0, y0, cut, y1), (cut, y0, x1, y1)]
-        else:
-            stack += [(x0, y0, x1, cut), (x0, cut, x1, y1)]
-    if len(leaves) < 3:
-        return None
-    order = sorted(range(len(leaves)), key=lambda i: _area(leaves[i]))
-    bath = order[0]
-    if _area(leaves[bath]) > 10e4:
-        # No small room: carve a bathroom strip off the narrowest room that has space for it.
-        roomy = [i for i in order[:-1] if max(_sides(leaves[i])) >= 170 + 250]
-        if roomy:
-            i = min(roomy, key=lambda i: min(_sides(leaves[i])))
-            x0, y0, x1, y1 = leaves[i]
-            strip = _uniform_snap(rng, 170, 240)
-            if x1 - x0 >= y1 - y0:
-                leaves[i], extra = (x0 + strip, y0, x1, y1), (x0, y0, x0 + strip, y1)
-            else:
-                leaves[i], extra = (x0, y0 + strip, x1, y1), (x0, y0, x1, y0 + strip)
-            leaves.append(extra)
-            order = sorted(range(len(leaves)), key=lambda i: _area(leaves[i]))
-            bath = len(leaves) - 1
-    order.remove(bath)
-    order.insert(0, bath)
-    labels = ["Bedroom"] * len(leaves)
-    labels[order[-1]] = _LIVING
-    labels[bath] = _BATH
-    if len(leaves) >= 4:  # else the kitchen is part of the living room
-        labels[order[-2]] = _KITCHEN
-    if len(leaves) >= 6 and _area(leaves[order[1]]) <= 9e4:
-        labels[order[1]] = _BATH
-    elif len(leaves) >= 6:
-        labels[order[1]] = "Office"
-    return _Layout(leaves, labels, order[-1], w, h)
-
-
-def _office(rng: np.random.Generator, gross: float) -> _Layout | None:
-    cw = _uniform_snap(rng, 150, 220)
-    aspect = rng.uniform(1.4, 2.6)
-    da, db = _depths(rng, math.sqrt(gross / aspect) - cw, 280, 560)
-    h = da + cw + db
-    w = _snap(gross / h)
-    if w < 300:
-        return None
-    tiles: list[tuple[int, int, int, int]] = []
-    labels: list[str] = []
-    x0, x1 = 0, w
-    if w >= 1100 and rng.random() < 0.45:
-        x0 = _uniform_snap(rng, 400, 650)
-        tiles.append((0, 0, x0, h))
-        labels.append("Meeting_Room")
-    if w - x0 >= 1100 and rng.random() < 0.25:
-        x1 = w - _uniform_snap(rng, 400, 650)
-        tiles.append((x1, 0, w, h))
-        labels.append("Meeting_Room" if x0 == 0 else "Office")
-    hub = len(tiles)
-    tiles.append((x0, da, x1, da + cw))
-    labels.append(_CORRIDOR)
-    bath_band = int(rng.integers(2))
-    band_rooms = []
-    for band, (y0, y1) in enumerate(((0, da), (da + cw, h))):
-        special = [(_BATH, 180, 260)] if band == bath_band else [("Kitchen", 250, 350)]
-        for a, b, label in _band(rng, x0, x1, special, 250, 500):
-            tiles.append((a, y0, b, y1))
-            labels.append(label)
-            band_rooms.append(len(tiles) - 1)
-    if "Meeting_Room" not in labels:
-        wide = [i for i in band_rooms if not labels[i] and tiles[i][2] - tiles[i][0] >= 420]
-        if wide:
-            labels[wide[int(rng.integers(len(wide)))]] = "Meeting_Room"
-    for i in band_rooms:
-        labels[i] = labels[i] or "Office"
-    return _Layout(tiles, labels, hub, w, h)
-
-
-def _symmetry(layout: _Layout, which: int) -> _Layout:
-    """One of the 8 symmetries of the rectangle: bit 0 mirrors x, bit 1 mirrors y, bit 2 swaps
-    the axes."""
-    w, h = layout.width, layout.height
-
-    def move(box: tuple[int, int, int, int]) -> tuple[int, int, int, int]:
-        x0, y0, x1, y1 = box
-        if which & 1:
-            x0, x1 = w - x1, w - x0
-        if which & 2:
-            y0, y1 = h - y1, h - y0
-        return (y0, x0, y1, x1) if which & 4 else (x0, y0, x1, y1)
-
-    return _Layout(
-        [move(t) for t in layout.tiles],
-        layout.labels,
-        layout.hub,
-        h if which & 4 else w,
-        w if which & 4 else h,
-        layout.open_pairs,
-        None if layout.cut is None else move(layout.cut),
-    )
-
-
-def _area(box: tuple[int, int, int, int]) -> int:
-    return (box[2] - box[0]) * (box[3] - box[1])
-
-
-def _sides(box: tuple[int, int, int, int]) -> tuple[int, int]:
-    return box[2] - box[0], box[3] - box[1]
-
-
-def _cut_corner(layout: _Layout, gross: float) -> _Layout | None:
-    """Remove one corner room (L-shaped footprint), the one leaving an interior closest to gross."""
-    w, h = layout.width, layout.height
-    spare = ("Bedroom", "Office", "Meeting_Room")  # one of these may go if another remains
-    if sum(label in spare for label in layout.labels) < 2:
-        return None
-    best, best_err = None, math.inf
-    for i, (x0, y0, x1, y1) in enumerate(layout.tiles):
-        if i == layout.hub or layout.labels[i] not in spare:
-            continue
-        sides = (x0 == 0) + (x1 == w) + (y0 == 0) + (y1 == h)
-        corner = (x0 == 0 or x1 == w) and (y0 == 0 or y1 == h)
-        if sides != 2 or not corner or _area((x0, y0, x1, y1)) < 6e4:
-            continue
-        err = abs(w * h - _area(layout.tiles[i]) - gross)
-        if err < best_err:
-            best, best_err = i, err
-    if best is None:
-        return None
-    index = [i for i in range(len(layout.tiles)) if i != best]
-    new = {old: n for n, old in enumerate(index)}
-    return _Layout(
-        [layout.tiles[i] for i in index],
-        [layout.labels[i] for i in index],
-        new[layout.hub],
-        w,
-        h,
-        {(new[a], new[b]) for a, b in layout.open_pairs if best not in (a, b)},
-        layout.tiles[best],
-    )
-
-
 # -------------------------------------------------------------------------------------- geometry
 def _adjacencies(
     tiles: list[tuple[int, int, int, int]],
@@ -485,7 +182,7 @@ def _adjacencies(
 
 def _spanning_doors(
     rng: np.random.Generator,
-    layout: _Layout,
+    layout: Layout,
     adj: list[tuple[int, int, bool, int, int, int]],
     extra: float,
 ) -> tuple[list[int], list[int]] | None:
@@ -513,7 +210,7 @@ def _spanning_doors(
             u = stack.pop()
             if not seen[u]:
                 seen[u] = True
-                (late if layout.labels[u] == _BATH else queue).append(u)
+                (late if layout.labels[u] == BATH else queue).append(u)
                 stack += partners[u]
 
     visit(layout.hub)
@@ -528,11 +225,7 @@ def _spanning_doors(
         return None
     tree, extra_doors = set(doors), []
     for k, (i, j, *_rest) in enumerate(adj):
-        if (
-            k in tree
-            or (i, j) in layout.open_pairs
-            or _BATH in (layout.labels[i], layout.labels[j])
-        ):
+        if k in tree or (i, j) in layout.open_pairs or BATH in (layout.labels[i], layout.labels[j]):
             continue
         if adj[k][5] - adj[k][4] >= _MIN_DOOR + 2 * _DOOR_CLEAR and rng.random() < extra:
             extra_doors.append(k)
@@ -541,7 +234,7 @@ def _spanning_doors(
 
 def _build(
     rng: np.random.Generator,
-    layout: _Layout,
+    layout: Layout,
     kind: str,
     ext_material: str,
     door_cm: int | None,
@@ -674,14 +367,14 @@ def _build(
 
 def _door_gap(rng: np.random.Generator, s0: int, s1: int, door_cm: int | None) -> tuple[int, int]:
     """A doorway (d0, d1) in the wall segment [s0, s1], clear of the junctions at its ends."""
-    dw = door_cm if door_cm is not None else _uniform_snap(rng, 80, 100)
-    dw = min(dw, (s1 - s0 - 2 * _DOOR_CLEAR) // _GRID * _GRID)
+    dw = door_cm if door_cm is not None else uniform_snap(rng, 80, 100)
+    dw = min(dw, (s1 - s0 - 2 * _DOOR_CLEAR) // GRID_CM * GRID_CM)
     lo, hi = s0 + _DOOR_CLEAR, s1 - _DOOR_CLEAR - dw
     if rng.random() < 0.6:  # near a corner, as doors usually are
         near = (lo, min(hi, lo + 30)) if rng.random() < 0.5 else (max(lo, hi - 30), hi)
-        d0 = _uniform_snap(rng, *near)
+        d0 = uniform_snap(rng, *near)
     else:
-        d0 = _uniform_snap(rng, lo, hi)
+        d0 = uniform_snap(rng, lo, hi)
     d0 = min(max(d0, lo), hi)
     return d0, d0 + dw
 
@@ -729,7 +422,7 @@ def _islands(
     return list(islands.values())
 
 
-def _in_region(layout: _Layout, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+def _in_region(layout: Layout, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     inside = (x > 0) & (x < layout.width) & (y > 0) & (y < layout.height)
     if layout.cut is not None:
         cx0, cy0, cx1, cy1 = layout.cut
@@ -737,7 +430,7 @@ def _in_region(layout: _Layout, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return inside
 
 
-def _on_boundary(layout: _Layout, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+def _on_boundary(layout: Layout, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     on = (x == 0) | (x == layout.width) | (y == 0) | (y == layout.height)
     if layout.cut is not None:
         cx0, cy0, cx1, cy1 = layout.cut
@@ -747,7 +440,7 @@ def _on_boundary(layout: _Layout, x: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 
 def _rooms(
-    layout: _Layout,
+    layout: Layout,
     vert: np.ndarray,
     coord: np.ndarray,
     s0: np.ndarray,
