@@ -32,7 +32,17 @@ def _inverse_high(space: spaces.Space) -> float:
     return 1.0 / max(float(np.max(space.high)), 1.0)
 
 
-def map_encoder(channels: int, width: int = 32) -> nn.Sequential:
+#: Channels of a map encoder's features.
+MAP_FEATURES = 32
+
+
+def _input_sizes(observation_space: spaces.Dict) -> tuple[int, int]:
+    """The number of features per candidate and the size of ``state``."""
+    _, f = observation_space["candidates"].shape or (0, 0)
+    return f, int(np.prod(observation_space["state"].shape or (0,)))
+
+
+def map_encoder(channels: int, width: int = MAP_FEATURES) -> nn.Sequential:
     """Three 3×3 convolutions, the first two with stride 2: a ``P/4 × P/4`` feature map."""
     return nn.Sequential(
         nn.Conv2d(channels, width, 3, stride=2, padding=1),
@@ -67,14 +77,11 @@ class RegionActor(nn.Module):
         self, observation_space: spaces.Dict, hidden: int = 64, map_context: bool = True
     ) -> None:
         super().__init__()
-        _, f = observation_space["candidates"].shape or (0, 0)
-        s = int(np.prod(observation_space["state"].shape or (0,)))
-        width = 32
+        f, s = _input_sizes(observation_space)
         self.map_scale = _inverse_high(observation_space["map"])
-        self.cnn = (
-            map_encoder((observation_space["map"].shape or (0,))[0], width) if map_context else None
-        )
-        inputs = f + s + (3 * width if map_context else 0)  # + sampled, mean and max features
+        self.cnn = map_encoder((observation_space["map"].shape or (0,))[0]) if map_context else None
+        # + the map's features sampled at the candidate, their mean and their max
+        inputs = f + s + (3 * MAP_FEATURES if map_context else 0)
         self.scorer = nn.Sequential(
             nn.Linear(inputs, hidden), nn.Tanh(), nn.Linear(hidden, hidden), nn.Tanh()
         )
@@ -103,9 +110,7 @@ class RegionCritic(nn.Module):
         self, observation_space: spaces.Dict, hidden: int = 64, privileged: bool = True
     ) -> None:
         super().__init__()
-        _, f = observation_space["candidates"].shape or (0, 0)
-        s = int(np.prod(observation_space["state"].shape or (0,)))
-        width = 32
+        f, s = _input_sizes(observation_space)
         map_shape = observation_space["map"].shape or (0, 0, 0)
         channels = map_shape[0]
         self.privileged = privileged and "true_map" in observation_space.spaces
@@ -117,9 +122,9 @@ class RegionCritic(nn.Module):
                 raise ValueError(f"true_map {true_shape} and map {map_shape} differ in size")
             channels += true_shape[0]
             self.true_scale = _inverse_high(observation_space["true_map"])
-        self.cnn = map_encoder(channels, width)
+        self.cnn = map_encoder(channels)
         self.mlp = nn.Sequential(
-            nn.Linear(2 * width + 2 * f + 1 + s, hidden),
+            nn.Linear(2 * MAP_FEATURES + 2 * f + 1 + s, hidden),
             nn.Tanh(),
             nn.Linear(hidden, hidden),
             nn.Tanh(),
