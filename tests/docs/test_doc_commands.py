@@ -175,3 +175,12 @@ def test_the_readme_and_the_user_paths_are_run():
     assert "README.md" in names and "docs/benchmark.md" in names
     assert {f"docs/guide/{n}.md" for n in ("install", "first-env", "train-and-compare",
             "train-default-agent", "own-building", "own-survey")} <= names  # fmt: skip
+
+
+def test_the_readme_s_two_commands_set_up_run_the_demo_and_test_on_every_core():
+    first, second = commands(blocks(ROOT / "README.md")[0][1])
+    assert first.startswith("python3 -m venv") and first.endswith("sfw-gym demo")
+    assert "pip install torch==2.13.0" in first  # the CPU build here, before anything pulls CUDA
+    assert " -n auto" in second and "pytest" in second
+    ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8")
+    assert second in ci  # CI runs the README's own test command
