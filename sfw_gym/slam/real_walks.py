@@ -107,6 +107,8 @@ class WalkSlamResult:
     length_m: float
     ate_odometry_m: float
     ate_slam_m: float
+    # RadioSlamResult's closure fields (as float64), each with its truth beside it: the same
+    # names so that a walk's result reads as the SLAM result it scores
     closures: np.ndarray
     closure_distance_m: np.ndarray
     closure_sigma_m: np.ndarray
