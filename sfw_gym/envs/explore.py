@@ -51,6 +51,7 @@ class SfWExploreEnv(gym.Env):
 
     ## Observation Space
     ``Dict`` accepted by stable-baselines3's ``MultiInputPolicy``:
+
     - ``map``: ``uint8 (3, M, M)``, M = ``map_px`` (64): the belief map fitted to the image (0 wall,
       255 free, 127 unknown), the trajectory (128) with the robot (255), the routers (255);
     - ``local``: ``uint8 (1, C, C)``, C = ``crop_px`` (48): the belief around the robot at full

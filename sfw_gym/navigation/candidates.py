@@ -288,7 +288,8 @@ class GoalFinder:
         return cost, out
 
     def heading_change(self, view: RobotView, cells: np.ndarray) -> np.ndarray:
-        """|bearing from the robot to each cell − heading|, radians in [0, π]."""
+        """The absolute angle between the bearing from the robot to each cell and its heading,
+        radians in [0, π]."""
         x, y, th = view.odometry_pose
         bearing = np.arctan2(self._row_y[cells[:, 0]] - y, self._col_x[cells[:, 1]] - x) - th
         return np.abs(wrap_angle(bearing))

@@ -82,7 +82,9 @@ class PPOAgent(Agent):
     """Acts with a MaskablePPO model over candidate goals (``goals-ppo``: the learned explorer
     before the region one, which is now ``regions-ppo``).
 
-    Parameters (keyword arguments, :class:`MaskedPPOSettings`):
+    Its parameters are :class:`MaskedPPOSettings`' fields, given as keyword arguments.
+
+    Args:
         path: A ``sfw-gym train ppo_mask`` output folder (``<env-id>.zip`` or an older run's
             ``model.zip``, ``config.yml``) or a ``.zip`` in it or in its ``checkpoints``; by
             default the shipped model.
@@ -198,7 +200,9 @@ class RegionsPPOAgent(RegionAgent):
     candidate menu from the whole map (its actor reads no ground truth), and the classical
     steering drives towards it, exactly as in the env.
 
-    Parameters (keyword arguments, :class:`RegionsPPOSettings`):
+    Its parameters are :class:`RegionsPPOSettings`' fields, given as keyword arguments.
+
+    Args:
         path: A training output folder or a ``.zip`` in it or in its ``checkpoints``; by
             default the shipped region model.
         deterministic: Take the most likely region (the default); else sample it with the

@@ -57,7 +57,9 @@ class WaypointPPOSettings(LearnedAgentSettings):
 class WaypointPPOAgent(Agent):
     """Acts with a PPO model trained by ``sfw-gym train ppo`` (by default the shipped one).
 
-    Parameters (keyword arguments, :class:`WaypointPPOSettings`):
+    Its parameters are :class:`WaypointPPOSettings`' fields, given as keyword arguments.
+
+    Args:
         path: A training output folder holding the model (``<env-id>.zip``, or ``model.zip``
             of an older run) and ``config.yml``, or that ``.zip``; by default the shipped
             policy.

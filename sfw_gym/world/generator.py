@@ -94,16 +94,18 @@ def generate_floorplan(seed: int, **params: Any) -> Floorplan:
     Args:
         seed: non-negative integer; the only source of randomness (``np.random.default_rng``).
         **params: optional overrides:
-            kind: "apartment", "office" or "random" (default: drawn from the seed).
-            area_m2: target free area, 40–200 m² (default: drawn; apartments ~42–160,
-                offices ~60–195). The result lies within ±15 % of it and always in 40–200 m².
-            shape: "rectangle", "L" or "random" (default: drawn, about one in three is L-shaped).
-            exterior_material: "brick" or "concrete" (default: drawn).
-            door_width_m: doorway width, 0.8–1.2 m, rounded to 5 cm (default: drawn per door,
-                0.8–1.0 m); a doorway in a short wall is narrowed to fit, never below 0.8 m.
-            extra_door_prob: probability, 0–1, that two adjacent rooms already connected
-                otherwise get a door too (loops); default 0.2 (apartments), 0.1 (offices).
-            name: the plan's name (default ``"gen-<kind>-<seed>"``).
+
+            - ``kind``: "apartment", "office" or "random" (default: drawn from the seed).
+            - ``area_m2``: target free area, 40–200 m² (default: drawn; apartments ~42–160,
+              offices ~60–195). The result lies within ±15 % of it and always in 40–200 m².
+            - ``shape``: "rectangle", "L" or "random" (default: drawn, about one in three is
+              L-shaped).
+            - ``exterior_material``: "brick" or "concrete" (default: drawn).
+            - ``door_width_m``: doorway width, 0.8–1.2 m, rounded to 5 cm (default: drawn per door,
+              0.8–1.0 m); a doorway in a short wall is narrowed to fit, never below 0.8 m.
+            - ``extra_door_prob``: probability, 0–1, that two adjacent rooms already connected
+              otherwise get a door too (loops); default 0.2 (apartments), 0.1 (offices).
+            - ``name``: the plan's name (default ``"gen-<kind>-<seed>"``).
 
     Returns:
         A valid :class:`Floorplan`: one free-space polygon, labelled rooms, every free cell
