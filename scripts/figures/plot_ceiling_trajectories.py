@@ -1,6 +1,7 @@
 """Figures of an oracle's and frontier's trajectories on chosen episodes of finished
 evaluations (issue 40): each RUN:EPISODE gives one figure (the true plan with both paths, and
-each agent's final belief), written as OUT_<plan>.png.
+each agent's final belief), written as OUT_<plan>.png: with the default ``--out``, it writes
+docs/figures/ceiling_<plan>.png (docs/results/ceiling.md).
 
     python scripts/figures/plot_ceiling_trajectories.py runs/ceiling_test:3 runs/ceiling_hx:0 \\
         --agents frontier,oracle-coverage --out docs/figures/ceiling
