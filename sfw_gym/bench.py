@@ -102,7 +102,7 @@ def memory_run(env_id: str, steps: int, seed: int = 0) -> tuple[float, float, in
 
 
 def run_bench(env_id: str, steps: int, resets: int, memory_steps: int = 0) -> list[str]:
-    """Measure and return printable lines (also the BENCHMARKS.md rows)."""
+    """Measure and return printable lines (also the rows of docs/results/speed.md)."""
     load_before = os.getloadavg()[0]
     ours = time_env(env_id, steps, resets)
     ref = time_env("CartPole-v1", steps, resets)

@@ -30,8 +30,7 @@ where OUT is that command's output folder. It writes, by KIND:
 The other figures are written into docs/figures by the script that makes them:
 ``scripts/figures/plot_ceiling_trajectories.py`` (``ceiling_<plan>.png``),
 ``scripts/benchmarks/bench_wifine_explore.py`` (``wifine_explore.png``) and
-``scripts/benchmarks/bench_fingerprints.py`` (``wifine_tracking.png``). One cannot be made again:
-``ppo_attempt1_training_curve.png``, the curve of a policy the repository no longer has.
+``scripts/benchmarks/bench_fingerprints.py`` (``wifine_tracking.png``).
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """Compare the baseline agents on generated plans and on the HouseExpo plans (issue 5's benchmark).
 
-Usage: ``python scripts/studies/compare_agents.py [--episodes 20] [--houseexpo DIR] [--out runs/compare]
-[--agents frontier,cross-pass,random] [--env SfW-ExploreFull-v0] [--workers 2]``
+Usage: ``python scripts/studies/compare_agents.py [--episodes 20] [--houseexpo DIR] [--out
+runs/compare] [--agents frontier,cross-pass,random] [--env SfW-ExploreFull-v0] [--workers 2]``
 
 Runs ``sfw_gym.evaluation.evaluate`` twice — ``--episodes`` procedural plans (seeds 0, 1, …) and
 one episode per HouseExpo file (seeds 100, 101, …) — into ``OUT/generated`` and ``OUT/houseexpo``

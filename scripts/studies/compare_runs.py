@@ -2,7 +2,8 @@
 
 Usage::
 
-    python scripts/studies/compare_runs.py BEFORE/episodes.jsonl AFTER/episodes.jsonl [--agent frontier]
+    python scripts/studies/compare_runs.py BEFORE/episodes.jsonl AFTER/episodes.jsonl \
+        [--agent frontier]
 
 Episodes are paired by seed; for each metric it prints both means and the mean of the paired
 differences (after − before) with its 95 % interval: the package's one paired comparison

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Ablations of the shipped candidate-goal explorer (BENCHMARKS.md, issue 13): the shipped recipe
+# Ablations of the shipped candidate-goal explorer (docs/results/training.md#ablations): the shipped recipe
 # (behaviour cloning + DAgger + 10,000 MaskablePPO decisions) with one thing changed, then paired
 # with frontier on the 50 held-out seeds.
 #   nomask: use_masking false (cloning, rollouts, updates and the agent ignore the masks)

@@ -2,7 +2,8 @@
 SLAM at two drift levels; LiDAR and WiFi-only map quality on the same runs; speed.
 
     python scripts/studies/lidar_study.py [--plans 20] [--workers 2] [--out runs/lidar_study]
-    python scripts/studies/lidar_study.py --lidar '{"max_range_m": 4, "range_noise_std_m": 0.03}' ...
+    python scripts/studies/lidar_study.py --lidar '{"max_range_m": 4, "range_noise_std_m": 0.03}'
+    ...
 
 Each run: the frontier agent for 3,000 steps on a held-out generated plan (seeds 3,000,000+,
 of 120–200 m², the generator's largest, so that its loops are long) with drifting odometry, 16

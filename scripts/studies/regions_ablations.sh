@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Ablations of the region explorer (BENCHMARKS.md, issue 30): the shipped recipe with one thing
+# Ablations of the region explorer (docs/results/training.md#ablations): the shipped recipe with one thing
 # changed, trained for STEPS decisions; compare with the full run's checkpoint at the same count
 # on the validation seeds (scripts/studies/regions_study.py --seed 1000000). The fine-tuning ablations
 # start from the full run's clone (behaviour_cloning.from_model), so only the fine-tuning differs.
@@ -9,7 +9,7 @@
 #          alone; cloned afresh: its actor differs)
 # Usage: [BASE=recipe.yml] scripts/studies/regions_ablations.sh [OUT=runs/regions_ablations] [STEPS=9000]
 #        [FULL=runs/regions] [NAMES...]   (BASE: the recipe to ablate, default the shipped
-#        ppo_mask.yml; the figures in BENCHMARKS.md ablate the greedy-teacher variant written
+#        ppo_mask.yml; the figures in docs/results/training.md ablate the greedy-teacher variant written
 #        there, from its run's clone)
 set -euo pipefail
 out=${1:-runs/regions_ablations}

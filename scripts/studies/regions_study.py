@@ -10,8 +10,8 @@ time per step relative to frontier's and per episode. Oracles (privileged) are m
 episode that ended earlier keeps its final coverage): run with ``--max-steps`` the largest.
 
     python scripts/studies/regions_study.py --episodes 50 --seed 2000000 --out runs/study_test
-    python scripts/studies/regions_study.py --episodes 11 --floorplans ../shared/floorplans/houseexpo \
-        --out runs/study_hx
+    python scripts/studies/regions_study.py --episodes 11 \
+        --floorplans ../shared/floorplans/houseexpo --out runs/study_hx
     python scripts/studies/regions_study.py --agents frontier,region-teacher --episodes 20 \
         --seed 3000000 --out runs/teacher20      # the teacher before any cloning
     python scripts/studies/regions_study.py --agents frontier,oracle-coverage --episodes 20 \

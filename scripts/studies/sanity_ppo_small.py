@@ -1,6 +1,7 @@
 """The first rung of the learning sanity ladder: plain PPO on raw wheel commands beats random.
 
-    python scripts/studies/sanity_ppo_small.py [--timesteps 40000] [--out runs/sanity_small] [--episodes 20]
+    python scripts/studies/sanity_ppo_small.py [--timesteps 40000] [--out runs/sanity_small]
+    [--episodes 20]
 
 Trains ``sfw-gym train ppo`` on ``SfW-ExploreSmall-v0`` (raw continuous actions, SB3's
 ``MultiInputPolicy``, the hyperparameters and ``env_kwargs`` of ``ppo.yml``; resumable), prints

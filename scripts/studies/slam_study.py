@@ -4,7 +4,7 @@ closures, speed. Frontier agent, held-out generated plans (seeds 2,000,000+), me
     python scripts/studies/slam_study.py [--plans 20] [--workers 2] [--out runs/slam_study]
     python scripts/studies/slam_study.py --speed 3      # env ms/step by pose source, one process
 
-Writes ``OUT/tables.md`` (the tables for BENCHMARKS.md) and ``OUT/records.json``. Every table
+Writes ``OUT/tables.md`` (the tables for docs/results/slam.md) and ``OUT/records.json``. Every table
 pairs its rows on the same plans and start poses (the pose source changes where the robot maps,
 never where it drives: the same actions give the same true path only under the same agent, so
 each pose source runs its own frontier episode on the same plan and seed).

@@ -1,6 +1,7 @@
 """Re-make realistic bugs by hand, one at a time, and check that the suite notices each.
 
-Usage: ``python scripts/tools/hand_made_bugs.py [NAME ...]`` (default: every case). Each case replaces one
+Usage: ``python scripts/tools/hand_made_bugs.py [NAME ...]`` (default: every case). Each case
+replaces one
 exact snippet in a source file, runs the named tests with ``-x``, prints CAUGHT (a test failed) or
 MISSED, and restores the file. The first five are the bugs of issue 21; the rest are the
 behaviours that issue's change added. Takes about 3 minutes on 2 cores.

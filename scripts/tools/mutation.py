@@ -6,7 +6,7 @@ Not run in CI (it takes minutes to hours). Run it from the repository root, nice
     nice -n 10 .venv/bin/python scripts/tools/mutation.py --modules agents env cli
     nice -n 10 .venv/bin/python scripts/tools/mutation.py --modules navigation \
         --files sfw_gym/navigation/planning.py sfw_gym/navigation/regions.py   # some modules only
-    .venv/bin/python scripts/tools/mutation.py --report-only     # rewrite the table from mutants/ only
+    .venv/bin/python scripts/tools/mutation.py --report-only   # the table from mutants/ only
 
 How long it took (x86_64, 2 cores shared with other work, load ≈ 2, 2 workers, niced):
 mapper + radio + navigation, 2,012 mutants: 7.7 min wall (4.5 mutants/s; the unit tests of these
@@ -34,8 +34,8 @@ What it does
 3. Subtracts the mutants reviewed as equivalent (``scripts/tools/mutation_equivalent.toml``: mutant
    name → one-line reason; a name there that is *killed* is reported, since the entry is stale),
    writes the per-module table to stdout, stores the group's numbers in
-   ``docs/results/data/mutation_results.json`` (so that a run of other groups keeps them) and rewrites the
-   table between ``<!-- mutation:begin -->`` and ``<!-- mutation:end -->`` in
+   ``docs/results/data/mutation_results.json`` (so that a run of other groups keeps them) and
+   rewrites the table between ``<!-- mutation:begin -->`` and ``<!-- mutation:end -->`` in
    docs/results/testing.md.
 
 score = killed / (mutants − equivalent); "timeout" and "no tests" mutants count against it.
@@ -78,7 +78,7 @@ import tomllib
 ROOT = Path(__file__).resolve().parents[2]
 EQUIVALENT_FILE = ROOT / "scripts" / "tools" / "mutation_equivalent.toml"
 RESULTS_FILE = ROOT / "docs" / "results" / "data" / "mutation_results.json"
-BENCHMARKS = ROOT / "docs" / "results" / "testing.md"
+RESULTS_PAGE = ROOT / "docs" / "results" / "testing.md"
 BEGIN, END = "<!-- mutation:begin -->", "<!-- mutation:end -->"
 
 #: group -> (source files to mutate, test files whose tests may kill them)
@@ -342,10 +342,11 @@ def section(results: dict) -> str:
         " score = killed / (mutants − equivalent); timeouts, crashes and mutants without tests"
         " count as not killed. Equivalent mutants, each with its reason:"
         " `scripts/tools/mutation_equivalent.toml`; the others not killed:"
-        " `scripts/tools/mutation.py --report-only --list-survivors`. mutmut does not mutate decorated"
-        " functions, so the numba `@njit` kernels (the sparse mapper's ray update, the k-threshold"
-        " kernel, grid traversal, the RSSI and wall-crossing kernels) are not in these numbers:"
-        " they are checked against the dense oracle (`tests/mapping/test_dense_mapper.py`) and"
+        " `scripts/tools/mutation.py --report-only --list-survivors`. mutmut does not mutate"
+        " decorated functions, so the numba `@njit` kernels (the sparse mapper's ray update, the"
+        " k-threshold kernel, grid traversal, the RSSI and wall-crossing kernels) are not in these"
+        " numbers: they are checked against the dense oracle"
+        " (`tests/mapping/test_dense_mapper.py`) and"
         " hand-computed cases instead. Each mutant runs only the tests of its group's test files"
         " that call the mutated function (`GROUPS` in the script)."
     )
@@ -367,12 +368,12 @@ def section(results: dict) -> str:
 
 
 def write_benchmarks(text: str) -> None:
-    doc = BENCHMARKS.read_text()
+    doc = RESULTS_PAGE.read_text()
     if BEGIN in doc and END in doc:
         doc = re.sub(re.escape(BEGIN) + r".*?" + re.escape(END), lambda _: text, doc, flags=re.S)
     else:
         doc = doc.rstrip("\n") + "\n\n## Mutation testing\n\n" + text + "\n"
-    BENCHMARKS.write_text(doc)
+    RESULTS_PAGE.write_text(doc)
 
 
 def machine() -> str:
@@ -441,7 +442,8 @@ def main(argv: list[str] | None = None) -> int:
         if names is None or names:
             wall = run_mutmut(files, tests, args.max_children, names)
 
-    command = f"`nice -n 10 .venv/bin/python scripts/tools/mutation.py --modules {' '.join(args.modules)}"
+    modules = " ".join(args.modules)
+    command = f"`nice -n 10 .venv/bin/python scripts/tools/mutation.py --modules {modules}"
     command += f" --files {' '.join(args.files)}" if args.files else ""
     command += f" --sample {args.sample}`" if args.sample else "`"
     fresh = wall is not None and not args.survivors  # a new run, not a rerun of survivors

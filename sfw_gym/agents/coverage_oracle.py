@@ -6,7 +6,7 @@ could gain there, divided by the true shortest path's cost plus an offset, and d
 shortest path to the best one with pure pursuit on the true pose: no searching, no detours
 through believed walls, no goals behind unseen walls. Its paths may run a robot's radius from a
 wall (``margin_m`` 0), where the footprint reaches the cells along it; it brushes walls there, a
-third as often as frontier bumps (BENCHMARKS.md, issue 40). On a drifting-odometry env it is
+third as often as frontier bumps (docs/results/ceiling.md). On a drifting-odometry env it is
 no ceiling: the belief it reads is drawn in the drifting frame, and it plans in the true one.
 
 The gain at a cell is the entropy of the belief's unknown cells the robot would resolve there:

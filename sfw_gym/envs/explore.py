@@ -78,7 +78,7 @@ class SfWExploreEnv(gym.Env):
     whatever the plan's size, the benchmark of how much a robot maps in a fixed time.
     ``SfW-ExploreFull-v0``: ``steps_per_m2`` = 60 steps per m² of the plan's free area (capped by
     ``max_steps`` = 30,000), room for a frontier explorer to map 90 % of any plan (see
-    BENCHMARKS.md). The episode's budget is ``info["max_steps"]``.
+    docs/results/agents.md). The episode's budget is ``info["max_steps"]``.
     ``gym.make(..., max_episode_steps=N)`` still works but truncates from outside, without it.
 
     ## Arguments

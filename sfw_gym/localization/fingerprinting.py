@@ -19,8 +19,8 @@ queried one scan at a time:
   12–13 (heard APs weighted by strength, the GP's variance alone) places WiFine's scans at 4.4 m
   mean error, this at 2.7 m.
 
-The measurements that chose these settings are in BENCHMARKS.md ("Fingerprint localisation on
-real data").
+The measurements that chose these settings are in docs/results/history.md ("Fingerprint
+localisation on real data").
 """
 
 from __future__ import annotations

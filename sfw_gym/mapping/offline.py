@@ -59,8 +59,8 @@ BANDS = ("2.4", "5")
 METHODS = ("inverse-k", "sfw-reference")
 #: The offline default: every heard router's ray (``router_policy="all"``) and two passes. On
 #: recorded two-router walks it beats ``"strongest"`` and one pass on free-space IoU and
-#: interior-wall recall (scripts/studies/mapper_logs_study.py, BENCHMARKS.md, issue 31); with one router
-#: the policies coincide and two passes still win.
+#: interior-wall recall (scripts/studies/mapper_logs_study.py, docs/results/mapping.md); with one
+#: router the policies coincide and two passes still win.
 OFFLINE_CONFIG = MapperConfig(router_policy="all")
 OFFLINE_PASSES = 2
 PROGRESS_MIN_ROWS = 5000

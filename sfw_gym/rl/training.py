@@ -328,8 +328,8 @@ def train_ppo(
     the cores (a policy 5× slower measured on a busy 2-core machine), and keeps a run's result
     the same on any machine. With the native env there are no workers: more threads speed PPO
     up (``n_envs`` 16 and 2 threads: 2.5× the throughput of 4 SubprocVecEnv workers and one
-    thread on 2 cores, BENCHMARKS.md), at the price of results that may differ in the last bits
-    between thread counts.
+    thread on 2 cores, docs/results/speed.md), at the price of results that may differ in the last
+    bits between thread counts.
 
     ``vec_env``: ``"native"`` steps the ``n_envs`` envs together in this process
     (`sfw_gym.envs.vector`, through `sfw_gym.rl.vec_env.SB3VecEnv`; an ``env_wrapper`` in the

@@ -67,7 +67,8 @@ class WaypointPPOAgent(Agent):
             that an episode is a function of the env seed alone; else sample it from the policy
             as in training, with the agent's generator seeded in :meth:`reset` (never torch's
             global one), so that it is a function of the env and agent seeds. The shipped
-            waypoint policy explores far better sampled (BENCHMARKS.md: coverage 0.446 vs 0.148):
+            waypoint policy explores far better sampled (docs/results/history.md: coverage 0.446 vs
+            0.148):
             its most likely waypoint can be one it cannot reach, which it then names again and
             again (nothing in the observation changes); sampling moves on.
         device: Torch device of the policy (``"cpu"`` is plenty for one env).

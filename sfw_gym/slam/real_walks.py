@@ -41,8 +41,8 @@ WRONG_ERROR_M = 3.0
 WRONG_TURN_RAD = math.pi / 4
 
 #: Radio SLAM's settings for scans a few seconds (~1.7 m) apart, chosen on WiFine train walks
-#: (BENCHMARKS.md, "Radio SLAM on real WiFine scans"); the odometry's sigmas come from the noise
-#: level (:func:`real_walk_config`).
+#: (docs/results/slam.md, "Radio SLAM on real WiFine scans"); the odometry's sigmas come from the
+#: noise level (:func:`real_walk_config`).
 REAL_WALK_SETTINGS: dict[str, Any] = {
     "keyframe_every": 1,  # a scan every ~1.7 m: every one a node (~160 a walk)
     "min_rssi_dbm": -75.0,  # the weak readings (-76 … -83 dBm) flicker and go stale
@@ -56,7 +56,7 @@ REAL_WALK_SETTINGS: dict[str, Any] = {
     "outlier_sigma": 2.0,
     # corridor closures: a closure's two scans walked the same or opposite way (within 40°)
     # lie each on the other's line of travel, ± 1.5 m, the kernel at 2 sigmas (heading closures,
-    # heading_snap_deg, were tried and are off: BENCHMARKS.md says why)
+    # heading_snap_deg, were tried and are off: docs/results/history.md says why)
     "corridor_sigma_m": 1.5,
     "corridor_max_turn_rad": 0.7,
     "corridor_robust_scale": 2.0,

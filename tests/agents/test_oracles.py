@@ -81,7 +81,8 @@ def test_no_default_runs_an_oracle():
     assert not any(is_privileged(a) for a in DEMO_AGENTS)
     evaluate = build_parser().parse_args(["evaluate"])
     assert not any(is_privileged(a) for a in evaluate.agents.split(","))
-    spec = importlib.util.spec_from_file_location("shipped", ROOT / "scripts/benchmarks/benchmark_shipped.py")
+    script = ROOT / "scripts/benchmarks/benchmark_shipped.py"
+    spec = importlib.util.spec_from_file_location("shipped", script)
     assert spec and spec.loader
     shipped = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(shipped)
@@ -139,7 +140,8 @@ def test_an_evaluation_and_a_benchmark_record_and_mark_an_oracle(tmp_path):
 
 
 def test_coverage_at_a_budget_reads_the_last_sample_at_or_before_it():
-    spec = importlib.util.spec_from_file_location("study", ROOT / "scripts/studies/regions_study.py")
+    script = ROOT / "scripts/studies/regions_study.py"
+    spec = importlib.util.spec_from_file_location("study", script)
     assert spec and spec.loader
     study = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(study)

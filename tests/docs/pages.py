@@ -17,7 +17,7 @@ PAGES = [p for p in PAGES if "_build" not in p.parts]
 #: The pages whose commands ``test_doc_commands.py`` runs, and those it leaves to another test.
 RUN_ELSEWHERE = {
     "docs/rl-zoo.md": "tests/rl/test_rl_zoo.py runs rl-zoo's train and enjoy on these files",
-    "docs/ray.md": "the Ray venv runs tests/evaluation/test_ray_backend.py and tests/rl/test_rllib.py",
+    "docs/ray.md": "the Ray venv runs tests/evaluation/test_ray_backend.py, tests/rl/test_rllib.py",
 }
 #: Results pages show the benchmarks behind each figure (minutes to hours each): their scripts
 #: and options are checked (``test_docs_links.py``), not run.
@@ -40,7 +40,8 @@ def saved_as(page: Path) -> dict[int, str]:
     before the block), by block index."""
     text, out = page.read_text(encoding="utf-8"), {}
     for i, m in enumerate(_FENCE.finditer(text)):
-        named = re.search(r"[Ss]ave it as `([\w.]+)`[^`]*$", text[max(0, m.start() - 300) : m.start()])
+        before = text[max(0, m.start() - 300) : m.start()]
+        named = re.search(r"[Ss]ave it as `([\w.]+)`[^`]*$", before)
         if named:
             out[i] = named.group(1)
     return out

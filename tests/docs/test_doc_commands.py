@@ -34,20 +34,40 @@ SMOKE: dict[str, tuple[list[tuple[str, str]], list[tuple[str, str | None]]]] = {
     "demo": ([(r"--episodes \d+", "--episodes 1")], [("--episodes", "1"), ("--no-progress", None)]),
     "evaluate": (
         [(r"--episodes \d+", "--episodes 1")],
-        [("--episodes", "1"), ("--env-kwargs", '{"max_steps": 60}'), ("--workers", "1"),
-         ("--no-progress", None)],
+        [
+            ("--episodes", "1"),
+            ("--env-kwargs", '{"max_steps": 60}'),
+            ("--workers", "1"),
+            ("--no-progress", None),
+        ],
     ),
-    "benchmark run": ([(r"--episodes \d+", "--episodes 1")], [("--episodes", "1"), ("--no-progress", None)]),
+    "benchmark run": (
+        [(r"--episodes \d+", "--episodes 1")],
+        [("--episodes", "1"), ("--no-progress", None)],
+    ),
     "train": (
         [(r"--timesteps \d+", "--timesteps 32")],
-        [("--timesteps", "32"), ("--n-envs", "1"), ("--eval-episodes", "1"), ("--no-progress", None)],
+        [
+            ("--timesteps", "32"),
+            ("--n-envs", "1"),
+            ("--eval-episodes", "1"),
+            ("--no-progress", None),
+        ],
     ),
     "localize": (
         [(r"--plans \d+", "--plans 1")],
-        [("--plans", "1"), ("--runs", "1"), ("--survey-steps", "150"), ("--test-steps", "30"),
-         ("--particles", "100"), ("--no-direct", None), ("--workers", "1"), ("--no-progress", None)],
+        [
+            ("--plans", "1"),
+            ("--runs", "1"),
+            ("--survey-steps", "150"),
+            ("--test-steps", "30"),
+            ("--particles", "100"),
+            ("--no-direct", None),
+            ("--workers", "1"),
+            ("--no-progress", None),
+        ],
     ),
-}  # fmt: skip
+}
 
 
 def smoke_hyperparams(folder: Path) -> Path:
@@ -162,7 +182,8 @@ def test_smoke_makes_commands_smaller_and_keeps_the_rest(tmp_path):
     fitted = yaml.safe_load(Path(train[train.index("--hyperparams") + 1]).read_text())
     assert fitted["SfW-ExploreRegions-v0"]["env_kwargs"] == {"privileged": True, "max_steps": 60}
     assert fitted["sfw_gym"]["SfW-ExploreRegions-v0"]["behaviour_cloning"]["episodes"] == 1
-    assert smoke(["sfw-gym", "world", "--seed", "3"], tmp_path) == ["sfw-gym", "world", "--seed", "3"]
+    world = ["sfw-gym", "world", "--seed", "3"]
+    assert smoke(world, tmp_path) == world
 
 
 def test_a_broken_command_fails_the_page(tmp_path):

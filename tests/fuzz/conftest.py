@@ -3,7 +3,8 @@
 ``outcome(category, fn)`` runs one case under a 10 s alarm and tallies it: ``valid`` (it
 returned), ``clean error`` (an :class:`~sfw_gym.SfwGymError` with a one-line message, naming the
 input where the case says which), anything else fails the test (a traceback, an unclear or
-multi-line message, a hang). The tally is printed after the run (the BENCHMARKS table).
+multi-line message, a hang). The tally is printed after the run (the table in
+docs/results/testing.md).
 
 Profiles: ``ci`` (the default, bounded so CI stays quick) and ``long``::
 
