@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from sfw_gym.cli import main
+from sfw_gym.cli import EXAMPLES, build_parser, main
 from sfw_gym.core.errors import ConfigError
 
 SMALL = "SfW-ExploreSmall-v0"
@@ -385,25 +385,16 @@ def test_a_failure_is_one_line_and_status_1_and_debug_shows_the_traceback(monkey
         main(["--debug", "map", "nope.csv", "--routers", "1,1"])
 
 
-@pytest.mark.parametrize("command", sorted(__import__("sfw_gym.cli").cli.EXAMPLES))
-def test_every_subcommand_shows_its_defaults_and_an_example_that_parses(command):
+@pytest.mark.parametrize("command", sorted(EXAMPLES))
+def test_every_subcommand_shows_an_example_that_parses(command):
+    """(That every default shows, in one format: tests/cli/test_help_unchanged.py.)"""
     import argparse
     import shlex
-
-    from sfw_gym.cli import EXAMPLES, build_parser
 
     parser = build_parser()
     sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
     assert set(sub.choices) == {*EXAMPLES, "bench"}  # one example per subcommand (bench: speed)
     help_text = " ".join(sub.choices[command].format_help().split())
-    for action in sub.choices[command]._actions:
-        default = action.default
-        if not action.option_strings or default is None or default is False:
-            continue
-        if default is argparse.SUPPRESS or default == "":
-            continue
-        shown = f"(default: {default})" in help_text or "default" in (action.help or "").lower()
-        assert shown, f"{command} {action.option_strings[0]}: its default {default!r} not shown"
     assert f"example: {EXAMPLES[command]}" in help_text
     args = parser.parse_args(shlex.split(EXAMPLES[command])[1:])
     assert args.command == command

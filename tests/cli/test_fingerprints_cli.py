@@ -9,7 +9,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from sfw_gym.cli import main, parse_floorplan_option
+from sfw_gym.cli import main
+from sfw_gym.cli.fingerprints import parse_floorplan_option
 from sfw_gym.datasets import Fingerprints, read_csv
 from sfw_gym.evaluation.fingerprints import majority_key
 from sfw_gym.world.floorplan import floorplan_from_polygon

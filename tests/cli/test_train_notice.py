@@ -1,0 +1,41 @@
+"""``sfw-gym train`` says, as it starts and in its help, which policy it trains, what one
+timestep counts, roughly how long it takes, and which command trains the default learned agent."""
+
+from __future__ import annotations
+
+from sfw_gym.cli.train import DEFAULT_AGENT_COMMAND, _print_notice, describe, notice
+from sfw_gym.core.data import default_hyperparams
+from sfw_gym.rl.training import zoo_hyperparams
+
+
+def test_training_the_default_env_says_it_is_the_waypoint_policy_and_takes_an_hour(capsys):
+    _print_notice("SfW-Explore-v0", default_hyperparams("ppo"), 200_000)
+    line = capsys.readouterr().out
+    assert line.count("\n") == 1
+    assert "waypoint-ppo" in line and "one timestep is one waypoint (about 35 env steps" in line
+    assert "200,000 timesteps take roughly 69 min" in line
+    assert f"trained by: {DEFAULT_AGENT_COMMAND}" in line
+
+
+def test_training_the_region_policy_says_it_is_the_default_agent():
+    params = zoo_hyperparams("SfW-ExploreRegions-v0", default_hyperparams("ppo_mask"))
+    line = notice("SfW-ExploreRegions-v0", params, 30_000)
+    assert "regions-ppo, the default learned agent" in line
+    assert "one region decision (up to 20 env steps)" in line and "roughly 35 min" in line
+    assert DEFAULT_AGENT_COMMAND not in line  # it is this command
+
+
+def test_another_env_counts_env_steps_and_rllib_gives_no_time():
+    line = notice("SfW-ExploreSmall-v0", {}, 32)
+    assert "a policy over the env's own actions" in line and "one timestep is one env step" in line
+    assert "times were measured for other envs only" in line
+    wrapped = {"env_wrapper": [{"sfw_gym.envs.waypoint.WaypointWrapper": {}}]}
+    line = notice("SfW-Explore-v0", wrapped, 1000, rllib=True)
+    assert "waypoint-ppo" in line and "measured for stable-baselines3 only" in line
+
+
+def test_the_help_says_it_for_each_env():
+    text = describe()
+    for words in ("regions-ppo, the default learned agent", "goals-ppo", "waypoint-ppo"):
+        assert words in text
+    assert DEFAULT_AGENT_COMMAND in text and "one env step" in text
