@@ -46,5 +46,6 @@ def run(args: argparse.Namespace) -> int:
         model=args.model,
     )
     print(index.parent.joinpath("results.md").read_text(encoding="utf-8"), end="")
-    print(f"report: {index} ({time.perf_counter() - start:.0f} s)")
+    html = index.with_suffix(".html")
+    print(f"report: {index} ({time.perf_counter() - start:.0f} s); open {html} in a browser")
     return 0

@@ -30,7 +30,7 @@ TORCH_THREADS = 1
 
 class Policy(NamedTuple):
     """What ``sfw-gym train`` learns on one kind of env, and how fast the shipped run went
-    (BENCHMARKS.md: 2-core CPU, one torch thread, the shipped hyperparameters)."""
+    (docs/results/training.md: 2-core CPU, one torch thread, the shipped hyperparameters)."""
 
     what: str  # the policy, and the agent that acts with it
     timestep: str  # what one of --timesteps is
@@ -88,7 +88,7 @@ def describe() -> str:
     lines = [
         "Train a PPO policy. What it learns, and what one timestep (--timesteps) counts, depend "
         "on --env;",
-        "times with the shipped hyperparameters on 2 CPU cores (BENCHMARKS.md):",
+        "times with the shipped hyperparameters on 2 CPU cores (docs/results/training.md):",
     ]
     for env_id, key, algo in (
         ("SfW-ExploreRegions-v0", "SfW-ExploreRegions-v0", "ppo_mask"),

@@ -13,6 +13,7 @@ def test_demo_writes_the_report(tmp_path, capsys):
     assert main(["demo", "--out", str(out), "--episodes", "1", "--no-progress"]) == 0
     printed = capsys.readouterr().out
     assert f"report: {out / 'index.md'}" in printed
+    assert f"open {out / 'index.html'} in a browser" in printed and (out / "index.html").exists()
     assert "| agent | episodes | coverage |" in printed  # the results table, printed too
     index = (out / "index.md").read_text(encoding="utf-8")
     for agent in ("frontier", "cross-pass", "regions-ppo"):
