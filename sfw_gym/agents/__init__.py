@@ -35,6 +35,10 @@ AGENTS: dict[str, str] = {
     # privileged: they read the ground truth (sfw_gym.agents.oracles); run only when named
     "oracle-coverage": "sfw_gym.agents.coverage_oracle:CoverageOracle",
     "oracle-regions": "sfw_gym.agents.region_oracle:RegionOracle",
+    # the coverage oracle less one piece of its knowledge each: where the ceiling lives
+    "oracle-belief-paths": "sfw_gym.agents.coverage_oracle:BeliefPathsOracle",
+    "oracle-frontier-targets": "sfw_gym.agents.coverage_oracle:FrontierTargetsOracle",
+    "oracle-belief-gain": "sfw_gym.agents.coverage_oracle:BeliefGainOracle",
 }
 #: Names of an earlier release, kept for one more: each warns (FutureWarning) and builds the
 #: agent it names now.

@@ -9,6 +9,13 @@ wall (``margin_m`` 0), where the footprint reaches the cells along it; it brushe
 third as often as frontier bumps (docs/results/ceiling.md). On a drifting-odometry env it is
 no ceiling: the belief it reads is drawn in the drifting frame, and it plans in the true one.
 
+Three variants each give up one piece of that knowledge, to tell where the ceiling lives
+(``plan_on``, ``targets_from``, ``gain_from``; registered as ``oracle-belief-paths``,
+``oracle-frontier-targets`` and ``oracle-belief-gain``): paths planned on the belief (unknown
+cells passable, believed walls not: bumps and detours as a robot has them), targets among the
+belief's frontier cells only, or the gain counted on the belief alone (the ray towards the
+nearest router, ending at the first believed wall).
+
 The gain at a cell is the entropy of the belief's unknown cells the robot would resolve there:
 its footprint (the mapper's rule 1), and the stretch of the ray towards the router that is truly
 strongest there (the one the mapper updates), from the cell back to the first true wall: the
@@ -27,7 +34,7 @@ from numba import njit
 from sfw_gym.agents.base import AgentSettings, Decision, RobotView
 from sfw_gym.agents.oracles import OracleAgent
 from sfw_gym.core.config import setting
-from sfw_gym.core.constants import U8_FREE_MIN
+from sfw_gym.core.constants import U8_FREE_MIN, U8_WALL_MAX
 from sfw_gym.navigation.candidates import unknown_bits_at
 from sfw_gym.navigation.menu import FEATURES
 from sfw_gym.navigation.planning import (
@@ -42,6 +49,8 @@ from sfw_gym.navigation.planning import (
     wall_distance_m,
 )
 
+#: Where a piece of the oracle's knowledge comes from.
+KNOWLEDGE = ("truth", "belief")
 #: The oracle's decisions carry no menu features.
 NO_FEATURES = np.full(len(FEATURES), np.nan)
 NO_FEATURES.flags.writeable = False
@@ -61,6 +70,14 @@ class CoverageOracleSettings(AgentSettings):
         blocked_ray_weight: The weight of a ray's free stretch when a true wall stands between
             the cell and the router (the mapper marks it free only where another reading on
             that ray has the same k); 1 where the router is in sight.
+        plan_on: Where paths are planned: ``"truth"`` (the true plan) or ``"belief"`` (the
+            belief map, unknown passable, replanned as it grows; the target is still chosen by
+            its true path's cost).
+        targets_from: The candidate targets: ``"truth"`` (every true free cell the robot fits
+            on) or ``"frontiers"`` (those the belief marks free beside an unknown cell).
+        gain_from: What the gain reads: ``"truth"`` (the truly strongest router's ray, ending
+            at the first true wall) or ``"belief"`` (the nearest router's ray, ending at the
+            first believed wall).
     """
 
     replan_every_steps: int = setting(10, integer=True, ge=1)
@@ -69,6 +86,9 @@ class CoverageOracleSettings(AgentSettings):
     margin_m: float = setting(0.0, ge=0.0)
     lookahead_m: float = setting(0.4, ge=0.05)
     blocked_ray_weight: float = setting(0.3, ge=0.0, le=1.0)
+    plan_on: str = setting("truth", choices=KNOWLEDGE)
+    targets_from: str = setting("truth", choices=("truth", "frontiers"))
+    gain_from: str = setting("truth", choices=KNOWLEDGE)
 
 
 class CoverageOracle(OracleAgent):
@@ -96,8 +116,8 @@ class CoverageOracle(OracleAgent):
         res = float(grid.resolution_m)
         free = np.asarray(truth.truth_u8) >= U8_FREE_MIN
         lethal = view.radius_m + self.settings.margin_m
-        band = WallBand(view.radius_m, lethal_radius_m=lethal)
-        self._cost = 1.0 + wall_cost_term(wall_distance_m(~free, res), res, band)
+        self._band = WallBand(view.radius_m, lethal_radius_m=lethal)
+        self._cost = 1.0 + wall_cost_term(wall_distance_m(~free, res), res, self._band)
         rows, cols = np.nonzero(free)
         centres = grid.cell_to_world(np.stack([rows, cols], axis=1))
         self._zone = np.full(free.shape, -1, np.int64)  # the truly strongest router; -1: wall
@@ -123,7 +143,7 @@ class CoverageOracle(OracleAgent):
         return _gains(
             view.log_odds,
             view.belief_u8,
-            self._zone,
+            self._zone if self.settings.gain_from == "truth" else self._belief_zone(view),
             self._routers,
             np.asarray(cells, np.int64).reshape(-1, 2),
             self._footprint,
@@ -132,6 +152,41 @@ class CoverageOracle(OracleAgent):
             self._res,
             self.settings.blocked_ray_weight,
         )
+
+    def _belief_zone(self, view: RobotView) -> np.ndarray:
+        """Each cell's nearest router (a robot's guess of the strongest), -1 where the belief
+        holds a wall: the gain's router and where its ray ends, read from the belief alone."""
+        rows, cols = np.indices(view.belief_u8.shape)
+        x = self._origin[0] + (cols + 0.5) * self._res
+        y = self._origin[1] + (rows + 0.5) * self._res
+        d2 = (x[..., None] - self._routers[:, 0]) ** 2 + (y[..., None] - self._routers[:, 1]) ** 2
+        zone = np.argmin(d2, axis=-1).astype(np.int64)
+        zone[view.belief_u8 <= U8_WALL_MAX] = -1
+        return zone
+
+    def _candidate_cells(self, view: RobotView) -> np.ndarray:
+        """The cells a target may be: all of them, or the belief's frontier cells among them."""
+        cells = self._candidates
+        if self.settings.targets_from == "truth":
+            return cells
+        belief = view.belief_u8
+        unknown = (belief > U8_WALL_MAX) & (belief < U8_FREE_MIN)
+        beside = np.zeros_like(unknown)
+        beside[1:] |= unknown[:-1]
+        beside[:-1] |= unknown[1:]
+        beside[:, 1:] |= unknown[:, :-1]
+        beside[:, :-1] |= unknown[:, 1:]
+        frontier = (belief >= U8_FREE_MIN) & beside
+        return cells[frontier[cells[:, 0], cells[:, 1]]]
+
+    def _driven_paths(self, view: RobotView, start: tuple[int, int], true_paths: Any) -> Any:
+        """The paths the robot drives: on the true plan, or on the belief (believed walls and
+        their band impassable, unknown cells passable)."""
+        if self.settings.plan_on == "truth":
+            return true_paths
+        walls = view.belief_u8 <= U8_WALL_MAX
+        cost = 1.0 + wall_cost_term(wall_distance_m(walls, self._res), self._res, self._band)
+        return cost_field(free_start(cost, start), start, self._res)
 
     def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
         pose = self.ground_truth().pose
@@ -147,14 +202,16 @@ class CoverageOracle(OracleAgent):
 
     def plan(self, view: RobotView, pose: tuple[float, float, float]) -> None:
         """Choose the target of most bits per metre on the true plan from the true ``pose`` and
-        set its true path (:attr:`target_rc`; None when nothing is left to gain)."""
+        set its path, true or on the belief (:attr:`target_rc`; None when nothing is left to
+        gain)."""
         self.n_plans += 1
         self._since_plan = 0
         start = self._grid.clipped_cell(pose)
         paths = cost_field(free_start(self._cost, start), start, self._res)
-        cells = self._candidates
+        driven = self._driven_paths(view, start, paths)
+        cells = self._candidate_cells(view)
         metres = paths.cumulative[cells[:, 0], cells[:, 1]]
-        reachable = np.isfinite(metres)
+        reachable = np.isfinite(metres) & np.isfinite(driven.cumulative[cells[:, 0], cells[:, 1]])
         fresh = reachable & ~self._visited[cells[:, 0], cells[:, 1]]
         bits = self.gains(view, cells[fresh])
         if not (bits > 0).any():  # what is left lies where it has been: go round again
@@ -171,7 +228,7 @@ class CoverageOracle(OracleAgent):
         i = int(np.argmax(bits / (metres + self.settings.distance_offset_m)))
         self.target_rc = (int(cells[i, 0]), int(cells[i, 1]))
         self.decisions.append(Decision(self.steps, self.target_rc, len(cells), NO_FEATURES))
-        self.follower.set_path(cells_to_world(self._grid, paths.path(self.target_rc)))
+        self.follower.set_path(cells_to_world(self._grid, driven.path(self.target_rc)))
 
 
 @njit(cache=True)
@@ -235,3 +292,49 @@ def _gains(
             weight,
         )
     return out
+
+
+# ---------------------------------------------------------------- where the ceiling lives
+@dataclass(frozen=True)
+class BeliefPathsSettings(CoverageOracleSettings):
+    """:class:`CoverageOracleSettings`, paths planned on the belief."""
+
+    plan_on: str = setting("belief", choices=KNOWLEDGE)
+
+
+@dataclass(frozen=True)
+class FrontierTargetsSettings(CoverageOracleSettings):
+    """:class:`CoverageOracleSettings`, targets among the belief's frontier cells."""
+
+    targets_from: str = setting("frontiers", choices=("truth", "frontiers"))
+
+
+@dataclass(frozen=True)
+class BeliefGainSettings(CoverageOracleSettings):
+    """:class:`CoverageOracleSettings`, the gain counted on the belief alone."""
+
+    gain_from: str = setting("belief", choices=KNOWLEDGE)
+
+
+class BeliefPathsOracle(CoverageOracle):
+    """The coverage oracle with its paths planned on the belief (privileged: its targets and
+    their gains still read the truth)."""
+
+    name = "oracle-belief-paths"
+    settings_class = BeliefPathsSettings
+
+
+class FrontierTargetsOracle(CoverageOracle):
+    """The coverage oracle with its targets among the belief's frontier cells (privileged: their
+    gains and paths still read the truth)."""
+
+    name = "oracle-frontier-targets"
+    settings_class = FrontierTargetsSettings
+
+
+class BeliefGainOracle(CoverageOracle):
+    """The coverage oracle with the gain at a target counted on the belief alone (privileged:
+    its candidates and paths still read the truth)."""
+
+    name = "oracle-belief-gain"
+    settings_class = BeliefGainSettings

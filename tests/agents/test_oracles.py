@@ -28,7 +28,7 @@ from sfw_gym.evaluation import evaluate
 from sfw_gym.evaluation.benchmark import results_markdown as benchmark_markdown
 from sfw_gym.evaluation.metric_table import TABLE_METRICS
 from sfw_gym.evaluation.report import PRIVILEGED_NOTE, results_markdown
-from sfw_gym.navigation.planning import wall_distance_m
+from sfw_gym.navigation.planning import cost_field, wall_distance_m
 from sfw_gym.world.floorplan import Floorplan
 from tests.agents.test_agents import _reachable
 
@@ -282,3 +282,70 @@ def test_it_chooses_by_bits_per_metre_with_the_offset(monkeypatch):
         oracle.plan(env.unwrapped.robot_view(), start)
         chosen[offset] = oracle.target_rc
     assert chosen == {0.01: near, 100.0: far}
+
+
+# ------------------------------------------------- the variants: where the ceiling lives
+def test_each_variant_gives_up_one_piece_of_knowledge():
+    """Each variant differs from the coverage oracle in its one setting, and is an oracle."""
+    for name, (field, value) in {
+        "oracle-belief-paths": ("plan_on", "belief"),
+        "oracle-frontier-targets": ("targets_from", "frontiers"),
+        "oracle-belief-gain": ("gain_from", "belief"),
+    }.items():
+        settings = vars(make_agent(name).settings)
+        base = vars(make_agent("oracle-coverage").settings)
+        assert {k for k in base if base[k] != settings[k]} == {field} and settings[field] == value
+        assert is_privileged(name)
+
+
+def test_the_belief_gain_runs_to_the_router_past_a_wall_the_belief_does_not_hold():
+    """The true gain stops at the true wall between the cell and the router; counted on a
+    belief that holds no wall there, the ray runs on to the router, at full weight."""
+    gains = {}
+    for name in ("oracle-coverage", "oracle-belief-gain"):
+        env = gym.make("SfW-Explore-v0", n_routers=1)
+        env.reset(seed=0, options={"floorplan": two_rooms(), "routers": [(0.55, 3.05)]})
+        oracle = make_agent(name, blocked_ray_weight=0.25)
+        oracle.reset(env, seed=0)
+        at = cell(env, (6.05, 3.05))[None]
+        gains[name] = [
+            oracle.gains(hand_view(env, [xy]), at)[0] for xy in [(5.05, 3.05), (2.05, 3.05)]
+        ]
+    assert gains["oracle-coverage"] == pytest.approx([0.25, 0.0])
+    assert gains["oracle-belief-gain"] == pytest.approx([1.0, 1.0])
+
+
+def test_frontier_targets_are_believed_free_cells_beside_the_unknown():
+    env = gym.make("SfW-Explore-v0", n_routers=1)
+    env.reset(seed=0, options={"floorplan": two_rooms(), "routers": [(0.55, 3.05)]})
+    oracle = make_agent("oracle-frontier-targets")
+    oracle.reset(env, seed=0)
+    view = hand_view(env, [(2.05, 2.05)])
+    (r, c) = cell(env, (2.05, 2.05))
+    targets = {tuple(t) for t in oracle._candidate_cells(view)}
+    assert targets == {(r - 1, c), (r + 1, c), (r, c - 1), (r, c + 1)}
+    truth = make_agent("oracle-coverage")
+    truth.reset(env, seed=0)
+    assert len(truth._candidate_cells(view)) > 100 * len(targets)  # every cell the robot fits on
+
+
+def test_belief_paths_go_round_a_wall_the_belief_holds():
+    """A believed wall across the left room with a gap at its top: the path planned on the
+    belief goes through the gap, the true path (no wall there) straight across."""
+    env = gym.make("SfW-Explore-v0", n_routers=1)
+    env.reset(seed=0, options={"floorplan": two_rooms(), "routers": [(0.55, 3.05)]})
+    view = env.unwrapped.robot_view()
+    grid = view.grid
+    belief = np.full(view.belief_u8.shape, U8_FREE, np.uint8)
+    wall = grid.world_to_cell(np.array([[2.05, y] for y in np.arange(0.05, 3.0, 0.1)]))
+    belief[wall[:, 0], wall[:, 1]] = 0
+    view = type(view)(**{**vars(view), "belief_u8": belief})
+    start, goal = tuple(cell(env, (1.05, 1.05))), tuple(cell(env, (3.05, 1.05)))
+    rows = {}
+    for name in ("oracle-coverage", "oracle-belief-paths"):
+        oracle = make_agent(name)
+        oracle.reset(env, seed=0)
+        true_paths = cost_field(oracle._cost, start, 0.1)
+        path = oracle._driven_paths(view, start, true_paths).path(goal)
+        rows[name] = max(grid.cell_to_world(np.asarray(path))[:, 1])
+    assert rows["oracle-coverage"] < 1.5 and rows["oracle-belief-paths"] > 3.0
