@@ -34,8 +34,10 @@ from numba import njit
 from sfw_gym.agents.base import AgentSettings, Decision, RobotView
 from sfw_gym.agents.oracles import OracleAgent
 from sfw_gym.core.config import setting
-from sfw_gym.core.constants import U8_FREE_MIN, U8_WALL_MAX
+from sfw_gym.core.constants import U8_FREE_MIN
+from sfw_gym.mapping.grid import belief_classes
 from sfw_gym.navigation.candidates import unknown_bits_at
+from sfw_gym.navigation.frontiers import frontier_mask
 from sfw_gym.navigation.menu import FEATURES
 from sfw_gym.navigation.planning import (
     PurePursuit,
@@ -74,7 +76,8 @@ class CoverageOracleSettings(AgentSettings):
             belief map, unknown passable, replanned as it grows; the target is still chosen by
             its true path's cost).
         targets_from: The candidate targets: ``"truth"`` (every true free cell the robot fits
-            on) or ``"frontiers"`` (those the belief marks free beside an unknown cell).
+            on) or ``"frontiers"`` (the belief's frontier cells among them: unknown cells beside
+            a believed-free one, :func:`~sfw_gym.navigation.frontiers.frontier_mask`).
         gain_from: What the gain reads: ``"truth"`` (the truly strongest router's ray, ending
             at the first true wall) or ``"belief"`` (the nearest router's ray, ending at the
             first believed wall).
@@ -161,7 +164,7 @@ class CoverageOracle(OracleAgent):
         y = self._origin[1] + (rows + 0.5) * self._res
         d2 = (x[..., None] - self._routers[:, 0]) ** 2 + (y[..., None] - self._routers[:, 1]) ** 2
         zone = np.argmin(d2, axis=-1).astype(np.int64)
-        zone[view.belief_u8 <= U8_WALL_MAX] = -1
+        zone[belief_classes(view.belief_u8)[1]] = -1
         return zone
 
     def _candidate_cells(self, view: RobotView) -> np.ndarray:
@@ -169,14 +172,7 @@ class CoverageOracle(OracleAgent):
         cells = self._candidates
         if self.settings.targets_from == "truth":
             return cells
-        belief = view.belief_u8
-        unknown = (belief > U8_WALL_MAX) & (belief < U8_FREE_MIN)
-        beside = np.zeros_like(unknown)
-        beside[1:] |= unknown[:-1]
-        beside[:-1] |= unknown[1:]
-        beside[:, 1:] |= unknown[:, :-1]
-        beside[:, :-1] |= unknown[:, 1:]
-        frontier = (belief >= U8_FREE_MIN) & beside
+        frontier = frontier_mask(view.belief_u8)
         return cells[frontier[cells[:, 0], cells[:, 1]]]
 
     def _driven_paths(self, view: RobotView, start: tuple[int, int], true_paths: Any) -> Any:
@@ -184,7 +180,7 @@ class CoverageOracle(OracleAgent):
         their band impassable, unknown cells passable)."""
         if self.settings.plan_on == "truth":
             return true_paths
-        walls = view.belief_u8 <= U8_WALL_MAX
+        walls = belief_classes(view.belief_u8)[1]
         cost = 1.0 + wall_cost_term(wall_distance_m(walls, self._res), self._res, self._band)
         return cost_field(free_start(cost, start), start, self._res)
 

@@ -315,7 +315,7 @@ def test_the_belief_gain_runs_to_the_router_past_a_wall_the_belief_does_not_hold
     assert gains["oracle-belief-gain"] == pytest.approx([1.0, 1.0])
 
 
-def test_frontier_targets_are_believed_free_cells_beside_the_unknown():
+def test_frontier_targets_are_the_belief_s_frontier_cells():
     env = gym.make("SfW-Explore-v0", n_routers=1)
     env.reset(seed=0, options={"floorplan": two_rooms(), "routers": [(0.55, 3.05)]})
     oracle = make_agent("oracle-frontier-targets")
@@ -323,7 +323,7 @@ def test_frontier_targets_are_believed_free_cells_beside_the_unknown():
     view = hand_view(env, [(2.05, 2.05)])
     (r, c) = cell(env, (2.05, 2.05))
     targets = {tuple(t) for t in oracle._candidate_cells(view)}
-    assert targets == {(r - 1, c), (r + 1, c), (r, c - 1), (r, c + 1)}
+    assert targets == {(r, c)}  # the one unknown cell, beside believed-free ones
     truth = make_agent("oracle-coverage")
     truth.reset(env, seed=0)
     assert len(truth._candidate_cells(view)) > 100 * len(targets)  # every cell the robot fits on
