@@ -130,7 +130,7 @@ def run_command(line: str, workspace: Path) -> None:
         if "../shared" in part and not SHARED.is_dir():
             pytest.skip(f"{part!r} needs ../shared")
         argv = shlex.split(part)
-        if argv[0] in ("sfw-gym", "python", "python3", "tensorboard"):
+        if argv[0] in ("sfw-gym", "python", "python3"):
             argv[0] = str(BIN / argv[0]) if (BIN / argv[0]).exists() else sys.executable
         argv = smoke(argv, workspace) if argv[0].endswith("sfw-gym") else argv
         done = subprocess.run(
