@@ -1,0 +1,145 @@
+"""The learned map predictor (issue 46): it learns a family of plans whose continuation is
+certain, its training resumes from its checkpoint, a bad folder is named, and the shipped
+weights load from the package."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from sklearn.metrics import roc_auc_score
+
+torch = pytest.importorskip("torch")
+
+from sfw_gym.core.errors import ConfigError  # noqa: E402
+from sfw_gym.navigation.prediction import FREE, OUTSIDE, UNKNOWN, WALL  # noqa: E402
+from sfw_gym.rl.map_predictor import (  # noqa: E402
+    DEFAULT_PREDICTOR_DIR,
+    LearnedMapPredictor,
+    MapPredictorNet,
+    PredictorConfig,
+    PredictorTraining,
+    SnapshotSampler,
+    predictor_loss,
+    save_predictor,
+    train_predictor,
+)
+
+H, W = 24, 48
+
+
+def corridor(row: int, known_cols: int) -> tuple[np.ndarray, np.ndarray]:
+    """A corridor along the map, rows ``row``..``row + 3`` free between two wall rows, outside
+    elsewhere; the belief knows its first ``known_cols`` columns (walls and floor)."""
+    truth = np.full((H, W), OUTSIDE, np.uint8)
+    truth[row - 1] = truth[row + 4] = WALL
+    truth[row : row + 4] = FREE
+    codes = np.full((H, W), UNKNOWN, np.uint8)
+    codes[row - 1 : row + 5, :known_cols] = truth[row - 1 : row + 5, :known_cols]
+    return codes, truth
+
+
+def corridor_episodes(rng: np.random.Generator, n: int) -> list[SimpleNamespace]:
+    out = []
+    for _ in range(n):
+        row = int(rng.integers(3, H - 8))
+        snaps = [corridor(row, int(k))[0] for k in rng.integers(6, 20, size=4)]
+        truth = corridor(row, 0)[1]
+        out.append(
+            SimpleNamespace(
+                codes=np.stack(snaps), truth=truth, proximity=np.zeros((H, W), np.float32)
+            )
+        )
+    return out
+
+
+@pytest.mark.slow
+def test_the_predictor_learns_where_a_corridor_goes():
+    """Corridors at random heights, seen up to a random column: the predictor must read the
+    belief to say where the free space and the walls go on (no prior alone can)."""
+    torch.manual_seed(0)
+    rng = np.random.default_rng(0)
+    sampler = SnapshotSampler(corridor_episodes(rng, 40), 48, rng)  # the whole map
+    net = MapPredictorNet(PredictorConfig(width=8, heads=2))
+    opt = torch.optim.Adam(net.parameters(), lr=2e-3)
+    for _ in range(300):
+        x, y = sampler.batch(8)
+        xt, yt = torch.from_numpy(x), torch.from_numpy(y)
+        loss = predictor_loss(net(xt), yt, xt, 0.1)
+        opt.zero_grad()
+        loss.backward()
+        opt.step()
+    predictor = LearnedMapPredictor.__new__(LearnedMapPredictor)
+    predictor.net, predictor.threads = net.eval(), 1
+    codes, truth = corridor(11, 10)  # a corridor at a row it may not have seen
+    p = predictor.predict_codes(codes, np.zeros((H, W), np.float32))
+    unseen = codes == UNKNOWN
+    floor, walls = unseen & (truth == FREE), unseen & (truth == WALL)
+    outside = unseen & (truth == OUTSIDE)
+    # free space goes on where the corridor goes, walls beside it, nothing elsewhere
+    assert p.p_free[floor].mean() > 0.6, p.p_free[floor].mean()
+    assert p.p_wall[walls].mean() > 0.3, p.p_wall[walls].mean()
+    assert p.p_free[outside].mean() < 0.1 and p.p_wall[outside].mean() < 0.1
+    assert roc_auc_score(truth[unseen] == FREE, p.p_free[unseen]) > 0.95
+    assert roc_auc_score(truth[unseen] == WALL, p.p_wall[unseen]) > 0.9
+    assert 0.0 <= p.spread.min() and p.spread.max() <= 0.5
+
+
+def test_training_checkpoints_and_resumes(tmp_path: Path):
+    from sfw_gym.evaluation.prediction import load_snapshots  # noqa: F401 (the files' reader)
+
+    rng = np.random.default_rng(1)
+    files = []
+    for i, ep in enumerate(corridor_episodes(rng, 3)):
+        f = tmp_path / f"ep{i}.npz"
+        np.savez_compressed(
+            f,
+            codes=ep.codes,
+            steps=np.arange(len(ep.codes)),
+            truth=ep.truth,
+            routers_xy=np.array([[1.0, 1.0]]),
+            origin_xy=np.zeros(2),
+            resolution_m=np.float64(0.1),
+            agent=np.str_("frontier"),
+            seed=np.int64(i),
+            floorplan=np.str_(""),
+        )
+        files.append(f)
+    training = PredictorTraining(steps=4, batch=2, crop=24, threads=1)
+    net_config = PredictorConfig(width=4, heads=2)
+    out = tmp_path / "model"
+    train_predictor(files, out, training, net_config, log_every=2, checkpoint_every=2)
+    first = torch.load(out / "model.pt", weights_only=True)
+    # resumed: a longer run continues from step 4 (the log goes on, nothing is redone)
+    longer = PredictorTraining(steps=6, batch=2, crop=24, threads=1)
+    train_predictor(files, out, longer, net_config, log_every=2, checkpoint_every=2)
+    steps = [int(line.split(",")[0]) for line in (out / "log.csv").read_text().splitlines()[1:]]
+    assert steps == [2, 4, 6]
+    assert not all(
+        torch.equal(first[k], v) for k, v in torch.load(out / "model.pt", weights_only=True).items()
+    )
+    p = LearnedMapPredictor(out)
+    assert p.net.config == net_config
+
+
+def test_a_folder_without_a_predictor_is_named(tmp_path: Path):
+    with pytest.raises(ConfigError, match="not a map predictor"):
+        LearnedMapPredictor(tmp_path)
+    save_predictor(MapPredictorNet(PredictorConfig(4, 1)), tmp_path, PredictorTraining(), 0, 0)
+    (tmp_path / "model.pt").write_bytes(b"garbage")
+    with pytest.raises(ConfigError, match=str(tmp_path)):
+        LearnedMapPredictor(tmp_path)
+
+
+def test_the_shipped_predictor_loads_and_predicts_any_map_size():
+    assert (DEFAULT_PREDICTOR_DIR / "model.pt").stat().st_size < 10 * 2**20
+    p = LearnedMapPredictor()
+    for shape in ((37, 53), (64, 64)):
+        codes = np.full(shape, UNKNOWN, np.uint8)
+        codes[10:20, 10:20] = FREE
+        m = p.predict_codes(codes, np.zeros(shape, np.float32))
+        assert m.p_free.shape == shape
+        assert np.all(m.p_free[10:20, 10:20] == 1.0)
+        assert np.all((m.p_free >= 0) & (m.p_free + m.p_wall <= 1.0 + 1e-5))
