@@ -80,6 +80,7 @@ def test_every_data_file_the_package_reads_is_in_the_wheel():
     ]["sfw_gym"]
     package = REPO / "sfw_gym"
     read = [data.DEFAULT_HYPERPARAMS, data.SCENARIOS]
+    read += [data.DEFAULT_PREDICTOR_DIR / "model.pt", data.DEFAULT_PREDICTOR_DIR / "config.json"]
     for folder, env_id in SHIPPED_MODELS.items():  # each with rl-zoo's files, for rl_zoo3.enjoy
         read += [folder / f"{env_id}.zip", folder / "config.yml"]
         read += [folder / env_id / "config.yml", folder / env_id / "args.yml"]

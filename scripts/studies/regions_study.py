@@ -6,8 +6,9 @@ plans and seeds, then prints each agent's bits per metre and coverage as ratios 
 frontier's (ratio of the means, 95 % interval by a paired bootstrap over episodes: the package's
 paired comparison, ``compare_paired(..., ratio=True)``), the decisions per episode, the wall
 time per step relative to frontier's and per episode. Oracles (privileged) are marked †.
-``--budgets`` adds coverage at those step counts (read off each episode's coverage curve; an
-episode that ended earlier keeps its final coverage): run with ``--max-steps`` the largest.
+``--budgets`` adds coverage and bits per metre at those step counts (read off each episode's
+curve; an episode that ended earlier keeps its final values): run with ``--max-steps`` the
+largest.
 
     python scripts/studies/regions_study.py --episodes 50 --seed 2000000 --out runs/study_test
     python scripts/studies/regions_study.py --episodes 11 \
@@ -134,22 +135,26 @@ def main() -> None:
     if budgets:
         lines += [
             "",
-            f"Coverage at each step budget: mean, and ratio to {label[ref_name]} (95 % paired "
-            "bootstrap)",
+            f"At each step budget: coverage and bits per metre, mean and ratio to "
+            f"{label[ref_name]} (95 % paired bootstrap)",
             "",
-            "| agent | " + " | ".join(f"{b:,} steps" for b in budgets) + " |",
-            "|---|" + "---|" * len(budgets),
+            "| agent | "
+            + " | ".join(f"coverage at {b:,} | bits/m at {b:,}" for b in budgets)
+            + " |",
+            "|---|" + "---|---|" * len(budgets),
         ]
         at = {
-            (a, b): np.array([coverage_at(records[a][i]["curve"], b) for i in episodes])
+            (a, b, k): np.array([curve_at(records[a][i]["curve"], b)[k] for i in episodes])
             for a in agents
             for b in budgets
+            for k in (0, 1)
         }
         for agent in agents:
             cells = [
-                f"{at[agent, b].mean():.3f} "
-                f"({compare_paired(at[ref_name, b], at[agent, b], ratio=True).text('{:.3f}')})"
+                f"{at[agent, b, k].mean():.3f} "
+                f"({compare_paired(at[ref_name, b, k], at[agent, b, k], ratio=True).text('{:.3f}')})"
                 for b in budgets
+                for k in (0, 1)
             ]
             lines.append(f"| {label[agent]} | " + " | ".join(cells) + " |")
     if any(is_privileged(a) for a in agents):
@@ -159,11 +164,15 @@ def main() -> None:
     print(text)
 
 
-def coverage_at(curve: list[list[float]], step: int) -> float:
-    """Coverage at ``step`` from an episode's curve (``[step, coverage, …]`` rows): the last
-    sample at or before it (an episode that ended earlier keeps its final coverage)."""
-    covered = [c for s, c, *_ in curve if s <= step]
-    return float(covered[-1])
+def curve_at(curve: list[list[float]], step: int) -> tuple[float, float]:
+    """Coverage and bits per metre at ``step`` from an episode's curve (``[step, coverage, IoU,
+    path m, entropy bits]`` rows): the last sample at or before it (an episode that ended earlier
+    keeps its final values); bits per metre is NaN on a curve without entropy (before issue 46)."""
+    rows = [row for row in curve if row[0] <= step]
+    last = rows[-1]
+    if len(last) < 5 or last[3] <= 0:
+        return float(last[1]), float("nan")
+    return float(last[1]), float((curve[0][4] - last[4]) / last[3])
 
 
 if __name__ == "__main__":

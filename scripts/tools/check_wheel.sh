@@ -37,6 +37,7 @@ PY
 "$py" -c "from sfw_gym.rl import WaypointPPOAgent; a = WaypointPPOAgent(); print('WaypointPPOAgent() loads', a.settings.path)"
 "$py" -c "from sfw_gym.rl import PPOAgent; a = PPOAgent(); print('PPOAgent() loads', a.settings.path)"
 "$py" -c "from sfw_gym.rl import RegionsPPOAgent; a = RegionsPPOAgent(); print('RegionsPPOAgent() loads', a.settings.path)"
+"$py" -c "from sfw_gym.agents import make_agent; a = make_agent('predict-explore'); p = a.make_predictor(); print('predict-explore loads its predictor', p.path)"
 "$work/venv/bin/sfw-gym" demo --episodes 1 --workers 1 --out "$work/report" --no-progress | tail -3
 "$work/venv/bin/sfw-gym" train ppo --env SfW-ExploreSmall-v0 --timesteps 256 --out "$work/run" \
     --no-progress | tail -2

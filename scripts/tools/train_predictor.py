@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from sfw_gym.evaluation.prediction import load_snapshots
 from sfw_gym.rl.map_predictor import PredictorConfig, PredictorTraining, train_predictor
 
 
@@ -38,7 +39,11 @@ def main() -> None:
         threads=args.threads,
     )
     out = train_predictor(
-        files, args.out, training, PredictorConfig(args.width, args.heads), checkpoint_every=500
+        [load_snapshots(f) for f in files],
+        args.out,
+        training,
+        PredictorConfig(args.width, args.heads),
+        checkpoint_every=500,
     )
     print(f"{out}: trained on {len(files)} episodes")
 

@@ -32,6 +32,8 @@ AGENTS: dict[str, str] = {
     "regions-ppo": "sfw_gym.rl.agent:RegionsPPOAgent",
     "goals-ppo": "sfw_gym.rl.agent:PPOAgent",
     "waypoint-ppo": "sfw_gym.rl.waypoint_agent:WaypointPPOAgent",
+    # greedy bits per metre on the learned map predictor's map
+    "predict-explore": "sfw_gym.rl.predict_explore:PredictExploreAgent",
     # privileged: they read the ground truth (sfw_gym.agents.oracles); run only when named
     "oracle-coverage": "sfw_gym.agents.coverage_oracle:CoverageOracle",
     "oracle-regions": "sfw_gym.agents.region_oracle:RegionOracle",

@@ -13,6 +13,8 @@ guesses about the unseen made by a map predictor
   ``p_free`` along the ray from the candidate; the mapper marks free the stretch up to the first
   wall), all times the probability that the candidate itself is free and discounted by the
   predictor's ``spread`` there.
+- **Cost**: the path's metres, plus ``turn_cost_m_per_rad`` per radian of turning towards the
+  candidate (as frontier charges) and ``distance_offset_m``.
 - **Paths**: an unknown cell costs ``1 + unknown_wall_cost · p_wall`` instead of a flat
   ``unknown_cost``: the planner goes through doorways it expects and around walls it expects.
 
@@ -36,7 +38,7 @@ from sfw_gym.agents.greedy import GreedyInfoGainAgent, GreedySettings
 from sfw_gym.core.config import setting
 from sfw_gym.navigation.candidates import unknown_bits_at
 from sfw_gym.navigation.menu import FEATURES
-from sfw_gym.navigation.planning import CostField
+from sfw_gym.navigation.planning import CostField, WallBand, wall_cost_term, wall_distance_m
 from sfw_gym.navigation.prediction import (
     UNKNOWN,
     FreePriorPredictor,
@@ -64,6 +66,10 @@ class PredictExploreSettings(GreedySettings):
             least this probability.
         spread_penalty: A candidate's gain is multiplied by ``1 − spread_penalty · spread``.
         unknown_wall_cost: Planner cost of an unknown cell is ``1 + this · p_wall``.
+        predicted_band_weight: The wall band around predicted walls costs this fraction of
+            the band around believed walls (0: none).
+        switch_margin: Keep the current goal while its score is within this fraction of the
+            best candidate's (0: always the best).
     """
 
     predictor: str = setting("nearest", choices=tuple(BASELINE_PREDICTORS))
@@ -72,6 +78,8 @@ class PredictExploreSettings(GreedySettings):
     min_p_free: float = setting(0.5, ge=0.0, le=1.0)
     spread_penalty: float = setting(1.0, ge=0.0)
     unknown_wall_cost: float = setting(8.0, ge=0.0)
+    predicted_band_weight: float = setting(0.5, ge=0.0)
+    switch_margin: float = setting(0.0, ge=0.0)
     replan_every_steps: int = setting(10, integer=True, ge=1)
 
 
@@ -113,18 +121,33 @@ class PredictiveExplorer(GreedyInfoGainAgent):
             self._raw = self._predictor.predict_codes(codes, self._inputs.proximity)
             self._predicted_at = self.steps
             self.n_predictions += 1
+            self._band = self._predicted_wall_band(view, codes, self._raw.p_wall)
         raw = self._raw
         self.predicted = PredictedMap.with_belief(codes, raw.p_free, raw.p_wall, raw.spread)
         return self.predicted
+
+    def _predicted_wall_band(self, view: RobotView, codes: np.ndarray, p_wall: np.ndarray):
+        """The planner's wall band (:func:`~sfw_gym.navigation.planning.wall_cost_term`) around
+        the unknown cells predicted to be walls, times ``predicted_band_weight`` (finite: a
+        prediction may be wrong; the predicted wall itself costs ``unknown_wall_cost · p_wall``)."""
+        walls = ((codes & 3) == UNKNOWN) & (p_wall >= 0.5)
+        if not walls.any() or self.settings.predicted_band_weight == 0:
+            return np.zeros(codes.shape)
+        res = view.grid.resolution_m
+        term = wall_cost_term(wall_distance_m(walls, res), res, WallBand(view.radius_m))
+        term[~np.isfinite(term)] = 0.0
+        return self.settings.predicted_band_weight * term
 
     def _costs(self, view: RobotView, relaxed: bool = False) -> np.ndarray:
         cost = super()._costs(view, relaxed)
         if relaxed:
             return cost
         p_wall = self.prediction(view).p_wall
-        unknown = ((self._inputs.codes(view) & 3) == UNKNOWN) & np.isfinite(cost)
+        finite = np.isfinite(cost)
+        unknown = ((self._inputs.codes(view) & 3) == UNKNOWN) & finite
         extra = 1.0 - self.settings.unknown_cost + self.settings.unknown_wall_cost * p_wall
         cost[unknown] += extra[unknown]
+        cost[finite] += self._band[finite]
         return cost
 
     def expected_gain(self, view: RobotView, cells: np.ndarray) -> np.ndarray:
@@ -159,7 +182,9 @@ class PredictiveExplorer(GreedyInfoGainAgent):
         if not self.finder.frontier(view).any():
             self._stop("no_frontiers")
             return None
-        menu = self.finder.find(view, paths, sources=("info_gain",), features=("path_cost_m",))
+        menu = self.finder.find(
+            view, paths, sources=("info_gain",), features=("path_cost_m", "heading_change_rad")
+        )
         self.finder.mark_unreachable(
             menu.walled_off_rc, self.steps + self.settings.unreachable_ttl_steps
         )
@@ -172,9 +197,13 @@ class PredictiveExplorer(GreedyInfoGainAgent):
         metres = np.concatenate(
             [menu.feature("path_cost_m"), paths.cumulative[beyond[:, 0], beyond[:, 1]]]
         )
-        score = self.expected_gain(view, targets) / (metres + self.settings.distance_offset_m)
+        turn = np.concatenate(
+            [menu.feature("heading_change_rad"), self.finder.heading_change(view, beyond)]
+        )
+        cost = metres + self.settings.turn_cost_m_per_rad * turn + self.settings.distance_offset_m
+        score = self.expected_gain(view, targets) / cost
         self.candidates = list(zip(map(tuple, targets.tolist()), score.tolist(), strict=True))
-        i = int(np.argmax(score))
+        i = self._keep_or_switch(targets, score)
         if i < len(menu):
             self._log_decision(menu, i)
         else:
@@ -183,6 +212,18 @@ class PredictiveExplorer(GreedyInfoGainAgent):
         self._resume()
         target = (int(targets[i, 0]), int(targets[i, 1]))
         return Goal((int(goals[i, 0]), int(goals[i, 1])), target, "frontier")
+
+    def _keep_or_switch(self, targets: np.ndarray, score: np.ndarray) -> int:
+        """The best candidate, unless the current goal's target is still one whose score is
+        within ``switch_margin`` of the best (then that one: no dithering between goals)."""
+        best = int(np.argmax(score))
+        goal = self.goal
+        if goal is None or self.settings.switch_margin <= 0:
+            return best
+        same = np.flatnonzero((targets[:, 0] == goal.target[0]) & (targets[:, 1] == goal.target[1]))
+        if len(same) and score[same[0]] * (1 + self.settings.switch_margin) >= score[best]:
+            return int(same[0])
+        return best
 
 
 def predicted_gain(

@@ -29,6 +29,8 @@ DEFAULT_WAYPOINT_MODEL_DIR = data_path("agents", "ppo", "SfW-Explore-v0_1")
 DEFAULT_MODEL_DIR = data_path("agents", "ppo_mask", "SfW-ExploreGoals-v0_1")
 #: The shipped region explorer (``sfw-gym train ppo_mask --env SfW-ExploreRegions-v0``).
 DEFAULT_REGIONS_MODEL_DIR = data_path("agents", "ppo_mask", "SfW-ExploreRegions-v0_1")
+#: The map predictor that ``predict-explore`` reads (``scripts/tools/train_predictor.py``).
+DEFAULT_PREDICTOR_DIR = data_path("agents", "predictor")
 #: PPO hyperparameters per env id (rl-zoo format).
 DEFAULT_HYPERPARAMS = data_path("agents", "hyperparams", "ppo.yml")
 

@@ -37,7 +37,8 @@ class EpisodeSpec:
         floorplan: Plan file passed as ``reset(options={"floorplan": ...})``, or None.
         env_kwargs: Extra ``gym.make`` kwargs.
         agent_params: Agent constructor parameters.
-        curve_every: Record coverage / IoU / path length every this many steps.
+        curve_every: Record ``[step, coverage, map IoU, path length m, entropy bits]`` every
+            this many steps (and at the last).
         gif_path: Write a GIF of the episode here (None: no GIF).
         npz_path: Write the final belief, truth, trajectory and the agent's decision log
             (:func:`~sfw_gym.agents.base.decision_arrays`) here (None: not).
@@ -95,8 +96,8 @@ class EpisodeRecord:
         self.spec = spec
         self.start = start
         self.entropy_at_start = info["entropy_bits"]
-        self.curve: list[tuple[int, float, float, float]] = [
-            (0, info["coverage"], info["map_iou"], 0.0)
+        self.curve: list[tuple[int, float, float, float, float]] = [
+            (0, info["coverage"], info["map_iou"], 0.0, info["entropy_bits"])
         ]
         self.steps = 0
 
@@ -105,7 +106,13 @@ class EpisodeRecord:
         self.steps += 1
         if self.steps % self.spec.curve_every == 0 or done:
             self.curve.append(
-                (self.steps, info["coverage"], info["map_iou"], info["path_length_m"])
+                (
+                    self.steps,
+                    info["coverage"],
+                    info["map_iou"],
+                    info["path_length_m"],
+                    info["entropy_bits"],
+                )
             )
 
     def finish(

@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 import pickle
 import time
+from collections import Counter
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
@@ -24,7 +25,7 @@ from torch import nn
 from torch.nn import functional as F
 
 from sfw_gym.core.atomic import atomic_path, write_text_atomic
-from sfw_gym.core.data import data_path
+from sfw_gym.core.data import DEFAULT_PREDICTOR_DIR
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.navigation.prediction import (
     INPUT_CHANNELS,
@@ -34,8 +35,6 @@ from sfw_gym.navigation.prediction import (
     input_channels,
 )
 
-#: The shipped predictor's folder (``model.pt`` and ``config.json``).
-DEFAULT_PREDICTOR_DIR = data_path("agents", "predictor")
 #: The network sees maps padded to a multiple of this (three halvings).
 PAD_TO = 8
 #: The label of cells outside the map (padding): no loss.
@@ -138,7 +137,8 @@ def load_predictor_net(folder: str | Path) -> MapPredictorNet:
     folder = Path(folder)
     try:
         config = PredictorConfig(**json.loads((folder / "config.json").read_text())["network"])
-        net = MapPredictorNet(config)
+        with torch.random.fork_rng(devices=[]):  # the initial weights, replaced: no global draw
+            net = MapPredictorNet(config)
         net.load_state_dict(torch.load(folder / "model.pt", map_location="cpu", weights_only=True))
     except (OSError, KeyError, TypeError, ValueError, RuntimeError, pickle.UnpicklingError) as exc:
         reason = str(exc).splitlines()[0]
@@ -238,18 +238,17 @@ def predictor_loss(
 
 
 def train_predictor(
-    snapshot_files: list[Path],
+    episodes: list[Any],
     out: str | Path,
     training: PredictorTraining = PredictorTraining(),
     network: PredictorConfig = PredictorConfig(),
     log_every: int = 200,
     checkpoint_every: int = 1000,
 ) -> Path:
-    """Train a predictor on ``snapshot_files`` into ``out`` (``model.pt``, ``config.json``,
+    """Train a predictor on ``episodes`` (each with ``codes``, ``truth`` and ``proximity``: a
+    :class:`~sfw_gym.evaluation.prediction.Snapshots`) into ``out`` (``model.pt``, ``config.json``,
     ``log.csv``). Checkpoints atomically every ``checkpoint_every`` steps
     (``checkpoint.pt``) and resumes from it when run again with the same ``out``."""
-    from sfw_gym.evaluation.prediction import load_snapshots
-
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     torch.set_num_threads(training.threads)
@@ -257,7 +256,7 @@ def train_predictor(
     net = MapPredictorNet(network)
     opt = torch.optim.Adam(net.parameters(), lr=training.lr)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, training.steps, training.lr / 10)
-    start = 0
+    start, spent = 0, 0.0
     ckpt = out / "checkpoint.pt"
     rng = np.random.default_rng(training.seed)
     if ckpt.exists():
@@ -268,7 +267,8 @@ def train_predictor(
         rng.bit_generator.state = state["rng"]
         torch.set_rng_state(state["torch_rng"])
         start = int(state["step"])
-    sampler = SnapshotSampler([load_snapshots(f) for f in snapshot_files], training.crop, rng)
+        spent = float(state.get("seconds", 0.0))
+    sampler = SnapshotSampler(list(episodes), training.crop, rng)
     log = out / "log.csv"
     if start == 0:
         log.write_text("step,loss,seconds\n")
@@ -287,7 +287,8 @@ def train_predictor(
         done = step + 1
         if done % log_every == 0:
             with log.open("a") as fh:
-                fh.write(f"{done},{running / log_every:.5f},{time.perf_counter() - began:.1f}\n")
+                seconds = spent + time.perf_counter() - began
+                fh.write(f"{done},{running / log_every:.5f},{seconds:.1f}\n")
             running = 0.0
         if done % checkpoint_every == 0 or done == training.steps:
             with atomic_path(ckpt) as tmp:
@@ -299,29 +300,50 @@ def train_predictor(
                         "rng": rng.bit_generator.state,
                         "torch_rng": torch.get_rng_state(),
                         "step": done,
+                        "seconds": spent + time.perf_counter() - began,
                     },
                     tmp,
                 )
-    save_predictor(
-        net, out, training, len(snapshot_files), sum(len(e.codes) for e in sampler.episodes)
-    )
+    save_predictor(net, out, training, sampler.episodes, spent + time.perf_counter() - began)
     return out
 
 
+def unknown_prior(episodes: list[Any], every: int = 10) -> dict[str, float]:
+    """The share of the cells still unknown that are truly free and truly a wall, over every
+    ``every``-th snapshot of ``episodes``: the free-prior baseline's probabilities."""
+    counts = np.zeros(3)
+    for ep in episodes:
+        unknown = (ep.codes[::every] & 3) == UNKNOWN
+        counts += np.bincount(np.broadcast_to(ep.truth, unknown.shape)[unknown], minlength=3)[:3]
+    total = max(counts.sum(), 1.0)
+    return {"p_free": counts[0] / total, "p_wall": counts[1] / total}
+
+
 def save_predictor(
-    net: MapPredictorNet, out: Path, training: PredictorTraining, episodes: int, snapshots: int
+    net: MapPredictorNet,
+    out: Path,
+    training: PredictorTraining,
+    episodes: list[Any],
+    seconds: float = float("nan"),
 ) -> None:
-    """``model.pt`` (the weights) and ``config.json`` (the network's shape and how it was
-    trained), each written atomically."""
+    """``model.pt`` (the weights) and ``config.json`` (the network's shape, how it was trained,
+    how long, on what, and the unknown cells' class shares), each written atomically."""
     with atomic_path(out / "model.pt") as tmp:
         torch.save(net.state_dict(), tmp)
     record = {
         "network": asdict(net.config),
         "training": asdict(training),
-        "episodes": episodes,
-        "snapshots": snapshots,
+        "training_seconds": round(seconds, 1),
+        "episodes": len(episodes),
+        "snapshots": sum(len(e.codes) for e in episodes),
+        "agents": dict(Counter(getattr(e, "agent", "?") for e in episodes)),
+        "unknown_prior": unknown_prior(episodes) if episodes else {},
         "parameters": sum(p.numel() for p in net.parameters()),
         "inputs": list(INPUT_CHANNELS),
-        "unknown_class": UNKNOWN,
     }
     write_text_atomic(out / "config.json", json.dumps(record, indent=2) + "\n")
+
+
+def predictor_record(folder: str | Path | None = None) -> dict[str, Any]:
+    """The ``config.json`` of a predictor's folder (default: the shipped one)."""
+    return json.loads((Path(folder or DEFAULT_PREDICTOR_DIR) / "config.json").read_text())

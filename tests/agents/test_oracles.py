@@ -139,16 +139,23 @@ def test_an_evaluation_and_a_benchmark_record_and_mark_an_oracle(tmp_path):
         assert (PRIVILEGED_NOTE in (tmp_path / name / "results.md").read_text()) is privileged
 
 
-def test_coverage_at_a_budget_reads_the_last_sample_at_or_before_it():
+def test_coverage_and_bits_per_metre_at_a_budget_read_the_last_sample_at_or_before_it():
     script = ROOT / "scripts/studies/regions_study.py"
     spec = importlib.util.spec_from_file_location("study", script)
     assert spec and spec.loader
     study = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(study)
-    curve = [[0, 0.0, 0.0, 0.0], [10, 0.2, 0.0, 1.0], [20, 0.5, 0.0, 2.0], [25, 0.6, 0.0, 2.5]]
-    assert study.coverage_at(curve, 10) == 0.2
-    assert study.coverage_at(curve, 19) == 0.2
-    assert study.coverage_at(curve, 1000) == 0.6  # ended earlier: its final coverage
+    curve = [
+        [0, 0.0, 0.0, 0.0, 100.0],
+        [10, 0.2, 0.0, 1.0, 90.0],
+        [20, 0.5, 0.0, 2.0, 70.0],
+        [25, 0.6, 0.0, 2.5, 60.0],
+    ]
+    assert study.curve_at(curve, 10) == (0.2, 10.0)
+    assert study.curve_at(curve, 19) == (0.2, 10.0)
+    assert study.curve_at(curve, 1000) == (0.6, 16.0)  # ended earlier: its final values
+    old = [row[:4] for row in curve]  # a record from before issue 46: no entropy
+    assert study.curve_at(old, 20)[0] == 0.5 and np.isnan(study.curve_at(old, 20)[1])
 
 
 # ------------------------------------------------------------------------- the coverage oracle

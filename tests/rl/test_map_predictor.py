@@ -88,10 +88,10 @@ def test_the_predictor_learns_where_a_corridor_goes():
 
 
 def test_training_checkpoints_and_resumes(tmp_path: Path):
-    from sfw_gym.evaluation.prediction import load_snapshots  # noqa: F401 (the files' reader)
+    from sfw_gym.evaluation.prediction import load_snapshots
 
     rng = np.random.default_rng(1)
-    files = []
+    episodes = []
     for i, ep in enumerate(corridor_episodes(rng, 3)):
         f = tmp_path / f"ep{i}.npz"
         np.savez_compressed(
@@ -106,15 +106,15 @@ def test_training_checkpoints_and_resumes(tmp_path: Path):
             seed=np.int64(i),
             floorplan=np.str_(""),
         )
-        files.append(f)
+        episodes.append(load_snapshots(f))
     training = PredictorTraining(steps=4, batch=2, crop=24, threads=1)
     net_config = PredictorConfig(width=4, heads=2)
     out = tmp_path / "model"
-    train_predictor(files, out, training, net_config, log_every=2, checkpoint_every=2)
+    train_predictor(episodes, out, training, net_config, log_every=2, checkpoint_every=2)
     first = torch.load(out / "model.pt", weights_only=True)
     # resumed: a longer run continues from step 4 (the log goes on, nothing is redone)
     longer = PredictorTraining(steps=6, batch=2, crop=24, threads=1)
-    train_predictor(files, out, longer, net_config, log_every=2, checkpoint_every=2)
+    train_predictor(episodes, out, longer, net_config, log_every=2, checkpoint_every=2)
     steps = [int(line.split(",")[0]) for line in (out / "log.csv").read_text().splitlines()[1:]]
     assert steps == [2, 4, 6]
     assert not all(
@@ -127,7 +127,7 @@ def test_training_checkpoints_and_resumes(tmp_path: Path):
 def test_a_folder_without_a_predictor_is_named(tmp_path: Path):
     with pytest.raises(ConfigError, match="not a map predictor"):
         LearnedMapPredictor(tmp_path)
-    save_predictor(MapPredictorNet(PredictorConfig(4, 1)), tmp_path, PredictorTraining(), 0, 0)
+    save_predictor(MapPredictorNet(PredictorConfig(4, 1)), tmp_path, PredictorTraining(), [])
     (tmp_path / "model.pt").write_bytes(b"garbage")
     with pytest.raises(ConfigError, match=str(tmp_path)):
         LearnedMapPredictor(tmp_path)

@@ -1,0 +1,89 @@
+"""The predictive explorer (issue 46): greedy bits per metre with the gain and the paths read off
+a predicted map. Here with the predictors that learn nothing (no torch); the learned
+``predict-explore`` runs through every registered agent's tests (its object graph holds no
+ground truth, same seed same decisions)."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import sfw_gym  # noqa: F401 (registration)
+from sfw_gym.agents.frontier import FrontierAgent, Goal
+from sfw_gym.agents.predict_explore import PredictiveExplorer
+from sfw_gym.core.errors import ConfigError
+from sfw_gym.navigation.planning import cost_field
+from sfw_gym.navigation.prediction import UNKNOWN, PredictedMap
+
+SMALL = "SfW-ExploreSmall-v0"
+
+
+def run(agent, steps: int, seed: int = 2):
+    env = gym.make(SMALL)
+    obs, _ = env.reset(seed=seed)
+    agent.reset(env, seed=seed)
+    for _ in range(steps):
+        obs, *_ = env.step(agent.act(obs))
+    return env
+
+
+def test_it_re_predicts_as_often_as_asked_and_keeps_the_belief_on_top():
+    agent = PredictiveExplorer(predict_every_steps=25)
+    env = run(agent, 100)
+    assert 4 <= agent.n_predictions <= 6  # at replans, at most every 25 steps
+    view = env.unwrapped.robot_view()
+    predicted = agent.prediction(view)
+    codes = agent._inputs.codes(view)
+    free, wall = (codes & 3) == 0, (codes & 3) == 1
+    assert np.all(predicted.p_free[free] == 1.0) and np.all(predicted.p_wall[wall] == 1.0)
+    assert agent.decisions, "it chose goals"
+
+
+def test_unknown_cells_cost_by_their_predicted_wall_probability():
+    agent = PredictiveExplorer(predictor="prior", unknown_wall_cost=8.0, predicted_band_weight=0.0)
+    env = run(agent, 30)
+    view = env.unwrapped.robot_view()
+    cost = agent._costs(view)
+    base = FrontierAgent._costs(agent, view)
+    unknown = ((agent._inputs.codes(view) & 3) == UNKNOWN) & np.isfinite(base)
+    p_wall = agent.prediction(view).p_wall
+    expected = base - agent.settings.unknown_cost + 1.0 + 8.0 * p_wall
+    np.testing.assert_allclose(cost[unknown], expected[unknown])
+    known = ~unknown & np.isfinite(base)
+    np.testing.assert_array_equal(cost[known], base[known])
+
+
+def test_a_goal_within_the_switch_margin_is_kept():
+    agent = PredictiveExplorer(switch_margin=0.25)
+    run(agent, 5)
+    targets = np.array([[1, 1], [2, 2], [3, 3]])
+    agent.goal = Goal((2, 2), (2, 2), "frontier")
+    assert agent._keep_or_switch(targets, np.array([1.0, 1.1, 1.3])) == 1  # 1.1 · 1.25 ≥ 1.3
+    assert agent._keep_or_switch(targets, np.array([1.0, 1.1, 1.5])) == 2
+    agent.goal = None
+    assert agent._keep_or_switch(targets, np.array([1.0, 1.1, 1.3])) == 2
+
+
+def test_candidates_beyond_the_frontier_are_where_free_space_is_predicted():
+    class AllFree:
+        def predict_codes(self, codes, proximity):
+            ones = np.ones(codes.shape, np.float32)
+            return PredictedMap.with_belief(codes, ones, 0 * ones, 0 * ones)
+
+    agent = PredictiveExplorer(beyond_stride_cells=3)
+    agent._predictor = AllFree()
+    env = run(agent, 20)
+    view = env.unwrapped.robot_view()
+    field = cost_field(agent._costs(view), view.cell, view.grid.resolution_m)
+    beyond = agent._beyond_cells(view, field)
+    assert len(beyond) > 0
+    codes = agent._inputs.codes(view)
+    assert np.all((codes[beyond[:, 0], beyond[:, 1]] & 3) == UNKNOWN)
+    assert np.all(beyond % 3 == 1)  # the lattice
+    assert not agent.finder.frontier(view)[beyond[:, 0], beyond[:, 1]].any()
+
+
+def test_an_unknown_predictor_is_refused():
+    with pytest.raises(ConfigError, match="predictor"):
+        PredictiveExplorer(predictor="oracle")
