@@ -103,7 +103,7 @@ def main() -> None:
         f"({record['training']['steps']:,} steps of {record['training']['batch']} crops)"
         + (f" in {trained_s / 60:.0f} min" if np.isfinite(trained_s) else ""),
     ]
-    print("\n".join(rows + [""] + facts))
+    print("\n".join([*rows, "", *facts]))
     if args.write_docs:
         lines = [f"`{command_line()}` ({machine_short()}):", "", *rows, "", *facts]
         write_block(DOC, "bench_predictor", lines)

@@ -1,7 +1,7 @@
 """The map predictor at work (issue 46): at a few moments of one ``predict-explore`` episode, the
 belief, the predicted map and the true plan side by side, with the robot's path so far.
 
-    python scripts/figures/plot_prediction.py --seed 2000003 --out docs/figures/prediction_moments.png
+    python scripts/figures/plot_prediction.py --seed 2000003
 
 The predicted map is drawn as colour: green where it expects free space, red where it expects a
 wall, dark where it expects neither (outside); the believed cells in grey (free light, walls
@@ -64,7 +64,7 @@ def main() -> None:
             (
                 predicted_rgb(predicted.p_free, predicted.p_wall),
                 None,
-                "predicted (green free, red wall)",
+                "predicted: green free, red wall",
             ),
             (truth.truth_u8, "gray", "true plan"),
         ]

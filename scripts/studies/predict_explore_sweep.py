@@ -45,7 +45,10 @@ def main() -> None:
     for n, params in enumerate(json.loads(args.settings)):
         recs = run("predict-explore", params, out / str(n), args)
         eps = sorted(set(ref) & set(recs))
-        col = lambda rs, k: np.array([float(rs[i][k]) for i in eps])  # noqa: E731
+
+        def col(rs: dict[int, dict], k: str, eps: list[int] = eps) -> np.ndarray:
+            return np.array([float(rs[i][k]) for i in eps])
+
         rb = compare_paired(col(ref, "info_gain_per_m"), col(recs, "info_gain_per_m"), ratio=True)
         rc = compare_paired(col(ref, "coverage"), col(recs, "coverage"), ratio=True)
         ms = sum(recs[i]["wall_s"] for i in eps) / sum(recs[i]["steps"] for i in eps)

@@ -150,9 +150,13 @@ def main() -> None:
             for k in (0, 1)
         }
         for agent in agents:
+            ratio = {
+                (b, k): compare_paired(at[ref_name, b, k], at[agent, b, k], ratio=True)
+                for b in budgets
+                for k in (0, 1)
+            }
             cells = [
-                f"{at[agent, b, k].mean():.3f} "
-                f"({compare_paired(at[ref_name, b, k], at[agent, b, k], ratio=True).text('{:.3f}')})"
+                f"{at[agent, b, k].mean():.3f} ({ratio[b, k].text('{:.3f}')})"
                 for b in budgets
                 for k in (0, 1)
             ]

@@ -57,7 +57,7 @@ def test_snapshots_are_taken_at_the_steps_asked_and_resume(tmp_path):
 def test_a_file_that_is_not_a_snapshot_is_named(tmp_path):
     bad = tmp_path / "x.npz"
     np.savez(bad, codes=np.zeros((1, 2, 2)))
-    with pytest.raises(ConfigError, match="x.npz"):
+    with pytest.raises(ConfigError, match=r"x\.npz"):
         load_snapshots(bad)
 
 
