@@ -14,6 +14,7 @@ are collected on first use (frontier on the native vector env) and kept in ``--w
 from __future__ import annotations
 
 import argparse
+import os
 import time
 from pathlib import Path
 
@@ -100,9 +101,14 @@ def main() -> None:
         f"- one prediction, one core: median {1000 * np.median(times):.1f} ms, 90th percentile "
         f"{1000 * np.percentile(times, 90):.1f} ms over {len(times)} test and HouseExpo maps",
         f"- trained on {record['snapshots']:,} snapshots of {record['episodes']} episodes "
-        f"({record['training']['steps']:,} steps of {record['training']['batch']} crops)"
+        f"({record.get('steps_done', record['training']['steps']):,} steps of "
+        f"{record['training']['batch']} crops of {record['training']['crop']} cells, "
+        f"{record['training']['threads']} thread(s))"
         + (f" in {trained_s / 60:.0f} min" if np.isfinite(trained_s) else ""),
     ]
+    facts.append(
+        f"- 1-minute load average {os.getloadavg()[0]:.1f} at the end (others share the cores)"
+    )
     print("\n".join([*rows, "", *facts]))
     if args.write_docs:
         lines = [f"`{command_line()}` ({machine_short()}):", "", *rows, "", *facts]

@@ -2,7 +2,9 @@
 every 500 steps and resumes when run again with the same ``--out``.
 
     python scripts/tools/train_predictor.py --snapshots runs/predictor/snapshots \
-        --out runs/predictor/model --steps 8000
+        --out runs/predictor/model --steps 10000 --threads 1
+    python scripts/tools/train_predictor.py --out runs/predictor/model --steps 10000 --threads 1 \
+        --export      # stopped early: its latest checkpoint as the model
     cp runs/predictor/model/{model.pt,config.json} sfw_gym/data/agents/predictor/   # ship it
 """
 
@@ -12,7 +14,12 @@ import argparse
 from pathlib import Path
 
 from sfw_gym.evaluation.prediction import load_snapshots
-from sfw_gym.rl.map_predictor import PredictorConfig, PredictorTraining, train_predictor
+from sfw_gym.rl.map_predictor import (
+    PredictorConfig,
+    PredictorTraining,
+    export_checkpoint,
+    train_predictor,
+)
 
 
 def main() -> None:
@@ -28,6 +35,11 @@ def main() -> None:
     p.add_argument("--seed", type=int, default=defaults.seed)
     p.add_argument("--width", type=int, default=PredictorConfig().width)
     p.add_argument("--heads", type=int, default=PredictorConfig().heads)
+    p.add_argument(
+        "--export",
+        action="store_true",
+        help="write the latest checkpoint of --out as the model (a run stopped early), no training",
+    )
     args = p.parse_args()
     files = sorted(Path(args.snapshots).glob("*.npz"))
     training = PredictorTraining(
@@ -38,13 +50,13 @@ def main() -> None:
         seed=args.seed,
         threads=args.threads,
     )
-    out = train_predictor(
-        [load_snapshots(f) for f in files],
-        args.out,
-        training,
-        PredictorConfig(args.width, args.heads),
-        checkpoint_every=500,
-    )
+    network = PredictorConfig(args.width, args.heads)
+    episodes = [load_snapshots(f) for f in files]
+    if args.export:
+        export_checkpoint(episodes, args.out, training, network)
+        print(f"{args.out}: exported its checkpoint")
+        return
+    out = train_predictor(episodes, args.out, training, network, checkpoint_every=500)
     print(f"{out}: trained on {len(files)} episodes")
 
 

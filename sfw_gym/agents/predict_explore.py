@@ -78,7 +78,7 @@ class PredictExploreSettings(GreedySettings):
     min_p_free: float = setting(0.5, ge=0.0, le=1.0)
     spread_penalty: float = setting(1.0, ge=0.0)
     unknown_wall_cost: float = setting(8.0, ge=0.0)
-    predicted_band_weight: float = setting(0.5, ge=0.0)
+    predicted_band_weight: float = setting(1.0, ge=0.0)
     switch_margin: float = setting(0.0, ge=0.0)
     replan_every_steps: int = setting(10, integer=True, ge=1)
 

@@ -301,10 +301,35 @@ def train_predictor(
                         "torch_rng": torch.get_rng_state(),
                         "step": done,
                         "seconds": spent + time.perf_counter() - began,
+                        "training": asdict(training),
+                        "network": asdict(network),
                     },
                     tmp,
                 )
     save_predictor(net, out, training, sampler.episodes, spent + time.perf_counter() - began)
+    return out
+
+
+def export_checkpoint(
+    episodes: list[Any],
+    out: str | Path,
+    training: PredictorTraining = PredictorTraining(),
+    network: PredictorConfig = PredictorConfig(),
+) -> Path:
+    """Write ``out``'s latest checkpoint as a predictor (``model.pt``, ``config.json``): a run
+    stopped before its last step still gives a model. ``episodes`` are those it trained on;
+    ``training`` and ``network`` are the run's, where its checkpoint does not record them."""
+    out = Path(out)
+    try:
+        state = torch.load(out / "checkpoint.pt", map_location="cpu", weights_only=False)
+        training = PredictorTraining(**state.get("training", asdict(training)))
+        network = PredictorConfig(**state.get("network", asdict(network)))
+    except (OSError, KeyError, TypeError, RuntimeError, pickle.UnpicklingError) as exc:
+        raise ConfigError(f"{out}: no training checkpoint to export ({exc})") from None
+    with torch.random.fork_rng(devices=[]):
+        net = MapPredictorNet(network)
+    net.load_state_dict(state["net"])
+    save_predictor(net, out, training, episodes, float(state["seconds"]), int(state["step"]))
     return out
 
 
@@ -325,15 +350,17 @@ def save_predictor(
     training: PredictorTraining,
     episodes: list[Any],
     seconds: float = float("nan"),
+    steps_done: int | None = None,
 ) -> None:
     """``model.pt`` (the weights) and ``config.json`` (the network's shape, how it was trained,
-    how long, on what, and the unknown cells' class shares), each written atomically."""
+    how long and how many of its steps were done, on what, and the unknown cells' class shares), each written atomically."""
     with atomic_path(out / "model.pt") as tmp:
         torch.save(net.state_dict(), tmp)
     record = {
         "network": asdict(net.config),
         "training": asdict(training),
         "training_seconds": round(seconds, 1),
+        "steps_done": training.steps if steps_done is None else steps_done,
         "episodes": len(episodes),
         "snapshots": sum(len(e.codes) for e in episodes),
         "agents": dict(Counter(getattr(e, "agent", "?") for e in episodes)),
