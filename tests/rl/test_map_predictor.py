@@ -22,7 +22,9 @@ from sfw_gym.rl.map_predictor import (  # noqa: E402
     PredictorConfig,
     PredictorTraining,
     SnapshotSampler,
+    export_checkpoint,
     predictor_loss,
+    predictor_record,
     save_predictor,
     train_predictor,
 )
@@ -122,6 +124,27 @@ def test_training_checkpoints_and_resumes(tmp_path: Path):
     )
     p = LearnedMapPredictor(out)
     assert p.net.config == net_config
+    record = predictor_record(out)
+    assert record["steps_done"] == 6 and record["episodes"] == 3
+    assert 0 < record["unknown_prior"]["p_free"] < 1
+
+
+def test_a_run_stopped_early_exports_its_checkpoint(tmp_path: Path):
+    episodes = corridor_episodes(np.random.default_rng(2), 2)
+    out = tmp_path / "model"
+    planned = PredictorTraining(steps=4, batch=2, crop=24, threads=1)
+    train_predictor(episodes, out, planned, PredictorConfig(4, 2), checkpoint_every=2)
+    (out / "model.pt").unlink()
+    checkpoint = torch.load(out / "checkpoint.pt", weights_only=False)
+    export_checkpoint(episodes, out)
+    record = predictor_record(out)
+    assert record["steps_done"] == checkpoint["step"] == 4
+    assert record["network"] == {"width": 4, "heads": 2} and record["training"]["steps"] == 4
+    net = LearnedMapPredictor(out).net
+    for name, value in net.state_dict().items():
+        assert torch.equal(value, checkpoint["net"][name])
+    with pytest.raises(ConfigError, match="no training checkpoint"):
+        export_checkpoint(episodes, tmp_path / "nothing")
 
 
 def test_a_folder_without_a_predictor_is_named(tmp_path: Path):
