@@ -36,7 +36,7 @@ from sfw_gym.agents.oracles import OracleAgent
 from sfw_gym.core.config import setting
 from sfw_gym.core.constants import U8_FREE_MIN
 from sfw_gym.mapping.grid import belief_classes
-from sfw_gym.navigation.candidates import unknown_bits_at
+from sfw_gym.navigation.candidates import footprint_bits, ray_cells, unknown_bits_at
 from sfw_gym.navigation.frontiers import frontier_mask
 from sfw_gym.navigation.menu import FEATURES
 from sfw_gym.navigation.planning import (
@@ -235,32 +235,17 @@ def _gain_at(
     its strongest router, from beyond the footprint's ``radius`` to the first truly non-free
     cell (times ``weight`` unless the ray reaches the router); each cell once (``seen`` holds
     ``mark`` where counted)."""
-    h, w = belief.shape
-    total = 0.0
-    for k in range(len(footprint)):
-        r, c = r0 + footprint[k, 0], c0 + footprint[k, 1]
-        if 0 <= r < h and 0 <= c < w and seen[r, c] != mark:
-            seen[r, c] = mark
-            total += unknown_bits_at(log_odds, belief, r, c)
-    x0 = origin[0] + (c0 + 0.5) * res
-    y0 = origin[1] + (r0 + 0.5) * res
-    router = routers[zone[r0, c0]]
-    dx, dy = router[0] - x0, router[1] - y0
-    length = np.hypot(dx, dy)
-    n = int(np.ceil(length / (0.5 * res)))
+    total = footprint_bits(log_odds, belief, r0, c0, footprint, seen, mark)
+    cells, reached = ray_cells(r0, c0, routers[zone[r0, c0]], radius, origin, res, belief.shape)
     ray = 0.0
-    for j in range(1, n + 1):
-        t = j / n
-        if t * length <= radius:
-            continue  # the footprint, counted above
-        r = int(np.floor((y0 + dy * t - origin[1]) / res))
-        c = int(np.floor((x0 + dx * t - origin[0]) / res))
-        if not (0 <= r < h and 0 <= c < w) or zone[r, c] < 0:
-            return total + weight * ray  # a true wall (or outside): the free stretch ends
+    for k in range(len(cells)):
+        r, c = cells[k, 0], cells[k, 1]
+        if zone[r, c] < 0:
+            return total + weight * ray  # a true wall: the free stretch ends
         if seen[r, c] != mark:
             seen[r, c] = mark
             ray += unknown_bits_at(log_odds, belief, r, c)
-    return total + ray
+    return total + (ray if reached else weight * ray)  # left the grid: as a wall
 
 
 @njit(cache=True)

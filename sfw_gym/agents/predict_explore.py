@@ -36,7 +36,7 @@ from sfw_gym.agents.base import Decision, RobotView
 from sfw_gym.agents.frontier import Goal
 from sfw_gym.agents.greedy import GreedyInfoGainAgent, GreedySettings
 from sfw_gym.core.config import setting
-from sfw_gym.navigation.candidates import unknown_bits_at
+from sfw_gym.navigation.candidates import footprint_bits, ray_cells, unknown_bits_at
 from sfw_gym.navigation.menu import FEATURES
 from sfw_gym.navigation.planning import CostField, WallBand, wall_cost_term, wall_distance_m
 from sfw_gym.navigation.prediction import (
@@ -257,32 +257,16 @@ def predicted_gain(
 def _predicted_gains(
     log_odds, belief, p_free, spread, routers, cells, footprint, radius, origin, res, penalty
 ):  # pragma: no cover (compiled)
-    h, w = belief.shape
     seen = np.zeros(belief.shape, np.int64)
     out = np.zeros(len(cells))
     for i in range(len(cells)):
         mark = i + 1
         r0, c0 = cells[i, 0], cells[i, 1]
-        total = 0.0
-        for k in range(len(footprint)):
-            r, c = r0 + footprint[k, 0], c0 + footprint[k, 1]
-            if 0 <= r < h and 0 <= c < w and seen[r, c] != mark:
-                seen[r, c] = mark
-                total += unknown_bits_at(log_odds, belief, r, c)
-        x0 = origin[0] + (c0 + 0.5) * res
-        y0 = origin[1] + (r0 + 0.5) * res
-        dx, dy = routers[i, 0] - x0, routers[i, 1] - y0
-        length = np.hypot(dx, dy)
-        n = int(np.ceil(length / (0.5 * res)))
+        total = footprint_bits(log_odds, belief, r0, c0, footprint, seen, mark)
+        ray, _ = ray_cells(r0, c0, routers[i], radius, origin, res, belief.shape)
         reach = 1.0
-        for j in range(1, n + 1):
-            t = j / n
-            if t * length <= radius:
-                continue  # the footprint, counted above
-            r = int(np.floor((y0 + dy * t - origin[1]) / res))
-            c = int(np.floor((x0 + dx * t - origin[0]) / res))
-            if not (0 <= r < h and 0 <= c < w):
-                break
+        for k in range(len(ray)):
+            r, c = ray[k, 0], ray[k, 1]
             if seen[r, c] == mark:
                 continue
             seen[r, c] = mark

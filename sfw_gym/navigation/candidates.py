@@ -96,8 +96,10 @@ __all__ = [
     "candidate_goals",
     "explore_lite_choice",
     "explore_lite_utilities",
+    "footprint_bits",
     "greedy_choice",
     "proven_on_bounded_paths",
+    "ray_cells",
     "unknown_bits_at",
 ]
 
@@ -633,6 +635,47 @@ def unknown_bits_at(log_odds, belief, r, c):  # pragma: no cover (compiled)
     if b <= U8_WALL_MAX or b >= U8_FREE_MIN:
         return 0.0
     return cell_entropy_bits(np.float64(log_odds[r, c]))
+
+
+@njit(cache=True)
+def footprint_bits(log_odds, belief, r0, c0, footprint, seen, mark):  # pragma: no cover
+    """The unknown bits of the cells ``(r0, c0) + footprint`` inside the grid, each once: a
+    cell is counted where ``seen`` does not hold ``mark`` yet (and is marked)."""
+    h, w = belief.shape
+    total = 0.0
+    for k in range(len(footprint)):
+        r, c = r0 + footprint[k, 0], c0 + footprint[k, 1]
+        if 0 <= r < h and 0 <= c < w and seen[r, c] != mark:
+            seen[r, c] = mark
+            total += unknown_bits_at(log_odds, belief, r, c)
+    return total
+
+
+@njit(cache=True)
+def ray_cells(r0, c0, target, radius, origin, res, shape):  # pragma: no cover (compiled)
+    """``(K, 2)`` cells of the ray from cell (r0, c0)'s centre towards the point ``target``,
+    sampled every half cell, from beyond ``radius`` (m; the robot's footprint) to the target or
+    the grid's edge (a cell repeats where several samples fall in it), and whether it reached
+    the target inside the grid."""
+    h, w = shape
+    x0 = origin[0] + (c0 + 0.5) * res
+    y0 = origin[1] + (r0 + 0.5) * res
+    dx, dy = target[0] - x0, target[1] - y0
+    length = np.hypot(dx, dy)
+    n = int(np.ceil(length / (0.5 * res)))
+    out = np.empty((n, 2), np.int64)
+    k = 0
+    for j in range(1, n + 1):
+        t = j / n
+        if t * length <= radius:
+            continue
+        r = int(np.floor((y0 + dy * t - origin[1]) / res))
+        c = int(np.floor((x0 + dx * t - origin[0]) / res))
+        if not (0 <= r < h and 0 <= c < w):
+            return out[:k], False
+        out[k, 0], out[k, 1] = r, c
+        k += 1
+    return out[:k], True
 
 
 @njit(cache=True)

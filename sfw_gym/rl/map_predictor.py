@@ -353,7 +353,8 @@ def save_predictor(
     steps_done: int | None = None,
 ) -> None:
     """``model.pt`` (the weights) and ``config.json`` (the network's shape, how it was trained,
-    how long and how many of its steps were done, on what, and the unknown cells' class shares), each written atomically."""
+    how long and how many of its steps were done, on what, and the unknown cells' class
+    shares), each written atomically."""
     with atomic_path(out / "model.pt") as tmp:
         torch.save(net.state_dict(), tmp)
     record = {
