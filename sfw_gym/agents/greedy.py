@@ -10,7 +10,7 @@ from sfw_gym.agents.base import RobotView
 from sfw_gym.agents.frontier import FrontierAgent, FrontierSettings, Goal
 from sfw_gym.core.config import setting
 from sfw_gym.navigation.candidates import CandidateSettings
-from sfw_gym.navigation.menu import bits_per_metre
+from sfw_gym.navigation.menu import CandidateGoals, bits_per_metre
 from sfw_gym.navigation.planning import CostField
 
 
@@ -67,17 +67,25 @@ class GreedyInfoGainAgent(FrontierAgent):
         """Bits the mapper would gain with the robot at each of ``cells`` (N, 2)."""
         return self.finder.expected_gain(view, cells)
 
-    def _choose_goal(self, view: RobotView, paths: CostField) -> Goal | None:
+    def _info_gain_menu(
+        self, view: RobotView, paths: CostField, features: tuple[str, ...]
+    ) -> CandidateGoals | None:
+        """The menu of frontier cells (subsampled) with ``features``, its walled-off cells
+        marked unreachable; None (and the stop reason) when no frontier is left."""
         self.candidates = []
         if not self.finder.frontier(view).any():
             self._stop("no_frontiers")
             return None
-        menu = self.finder.find(
-            view, paths, sources=("info_gain",), features=("path_cost_m", "expected_gain_bits")
-        )
+        menu = self.finder.find(view, paths, sources=("info_gain",), features=features)
         self.finder.mark_unreachable(
             menu.walled_off_rc, self.steps + self.settings.unreachable_ttl_steps
         )
+        return menu
+
+    def _choose_goal(self, view: RobotView, paths: CostField) -> Goal | None:
+        menu = self._info_gain_menu(view, paths, ("path_cost_m", "expected_gain_bits"))
+        if menu is None:
+            return None
         if len(menu) == 0:
             self._stop("all_blacklisted")
             return None

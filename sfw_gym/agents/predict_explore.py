@@ -178,16 +178,9 @@ class PredictiveExplorer(GreedyInfoGainAgent):
         return np.argwhere(mask)
 
     def _choose_goal(self, view: RobotView, paths: CostField) -> Goal | None:
-        self.candidates = []
-        if not self.finder.frontier(view).any():
-            self._stop("no_frontiers")
+        menu = self._info_gain_menu(view, paths, ("path_cost_m", "heading_change_rad"))
+        if menu is None:
             return None
-        menu = self.finder.find(
-            view, paths, sources=("info_gain",), features=("path_cost_m", "heading_change_rad")
-        )
-        self.finder.mark_unreachable(
-            menu.walled_off_rc, self.steps + self.settings.unreachable_ttl_steps
-        )
         beyond = self._beyond_cells(view, paths)
         targets = np.concatenate([menu.target_rc.reshape(-1, 2), beyond]).astype(np.int64)
         if not len(targets):

@@ -21,7 +21,7 @@ from sklearn.metrics import roc_auc_score
 from sfw_gym.core.atomic import atomic_path
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.envs.explore import unwrap_sfw
-from sfw_gym.evaluation.vector import check_native_vector_env
+from sfw_gym.evaluation.vector import check_native_vector_env, reset_sub_env
 from sfw_gym.mapping.grid import GridSpec
 from sfw_gym.navigation.prediction import (
     FREE,
@@ -95,14 +95,7 @@ def _run(vec: Any, n: int, queue: list[SnapshotEpisode], out: Path, make_agent, 
         if not queue:
             return
         ep = queue.pop(0)
-        mask = np.zeros(n, np.bool_)
-        mask[i] = True
-        seeds: list[int | None] = [None] * n
-        seeds[i] = ep.seed
-        options: dict[str, Any] = {"reset_mask": mask}
-        if ep.floorplan:
-            options["floorplan"] = ep.floorplan
-        obs, _ = vec.reset(seed=seeds, options=options)
+        obs, _ = reset_sub_env(vec, i, ep.seed, ep.floorplan)
         agent = make_agent(ep.agent)
         agent.reset(vec.envs[i], seed=ep.seed)
         view = unwrap_sfw(vec.envs[i]).robot_view()

@@ -111,14 +111,7 @@ def run_vector(
                 return
             index, spec = queue.popleft()
             begin = time.perf_counter()
-            mask = np.zeros(n, np.bool_)
-            mask[i] = True
-            seeds: list[int | None] = [None] * n
-            seeds[i] = spec.seed
-            options: dict[str, Any] = {"reset_mask": mask}
-            if spec.floorplan:
-                options["floorplan"] = spec.floorplan
-            obs, infos = vec.reset(seed=seeds, options=options)
+            obs, infos = reset_sub_env(vec, i, spec.seed, spec.floorplan)
             episode = EpisodeRecord(spec, SubEnvInfo(infos, i), begin)
             agent = make_agent(spec.agent, **spec.agent_params)
             agent.reset(vec.envs[i], seed=spec.agent_reset_seed)
@@ -147,6 +140,22 @@ def run_vector(
                     start(i)
     finally:
         vec.close()
+
+
+def reset_sub_env(
+    vec: Any, i: int, seed: int, floorplan: str | None = None
+) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+    """Reset sub-env ``i`` of a native vector env alone (``reset_mask``, clearing its pending
+    autoreset) with ``seed`` and, if given, a plan file; the others go on as they were."""
+    n = vec.num_envs
+    mask = np.zeros(n, np.bool_)
+    mask[i] = True
+    seeds: list[int | None] = [None] * n
+    seeds[i] = seed
+    options: dict[str, Any] = {"reset_mask": mask}
+    if floorplan:
+        options["floorplan"] = floorplan
+    return vec.reset(seed=seeds, options=options)
 
 
 def _standing_action(space: gym.Space) -> Any:
