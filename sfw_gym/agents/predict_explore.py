@@ -109,10 +109,14 @@ class PredictiveExplorer(GreedyInfoGainAgent):
         self._raw: PredictedMap | None = None
         self._predicted_at = -(10**9)
         self.predicted: PredictedMap | None = None
+        self._predicted_view: RobotView | None = None
         self.n_predictions = 0
 
     def prediction(self, view: RobotView) -> PredictedMap:
-        """The predicted map now (re-predicted when ``predict_every_steps`` have passed)."""
+        """The predicted map now (re-predicted when ``predict_every_steps`` have passed; once
+        per view: a step's planning asks several times)."""
+        if view is self._predicted_view and self.predicted is not None:
+            return self.predicted
         codes = self._inputs.codes(view)
         if (
             self._raw is None
@@ -124,7 +128,13 @@ class PredictiveExplorer(GreedyInfoGainAgent):
             self._band = self._predicted_wall_band(view, codes, self._raw.p_wall)
         raw = self._raw
         self.predicted = PredictedMap.with_belief(codes, raw.p_free, raw.p_wall, raw.spread)
+        self._predicted_view, self._codes = view, codes
         return self.predicted
+
+    def _unknown(self, view: RobotView) -> np.ndarray:
+        """The cells the belief does not know (as the prediction of ``view`` read them)."""
+        self.prediction(view)
+        return (self._codes & 3) == UNKNOWN
 
     def _predicted_wall_band(self, view: RobotView, codes: np.ndarray, p_wall: np.ndarray):
         """The planner's wall band (:func:`~sfw_gym.navigation.planning.wall_cost_term`) around
@@ -144,7 +154,7 @@ class PredictiveExplorer(GreedyInfoGainAgent):
             return cost
         p_wall = self.prediction(view).p_wall
         finite = np.isfinite(cost)
-        unknown = ((self._inputs.codes(view) & 3) == UNKNOWN) & finite
+        unknown = self._unknown(view) & finite
         extra = 1.0 - self.settings.unknown_cost + self.settings.unknown_wall_cost * p_wall
         cost[unknown] += extra[unknown]
         cost[finite] += self._band[finite]
@@ -172,7 +182,7 @@ class PredictiveExplorer(GreedyInfoGainAgent):
         pred = self.prediction(view)
         mask = np.zeros(view.grid.shape, bool)
         mask[s // 2 :: s, s // 2 :: s] = True
-        mask &= (self._inputs.codes(view) & 3) == UNKNOWN
+        mask &= self._unknown(view)
         mask &= pred.p_free >= self.settings.min_p_free
         mask &= paths.reachable() & ~self.blacklisted & ~self.finder.frontier(view)
         return np.argwhere(mask)
