@@ -70,16 +70,21 @@ class PredictExploreSettings(GreedySettings):
             the band around believed walls (0: none).
         switch_margin: Keep the current goal while its score is within this fraction of the
             best candidate's (0: always the best).
+
+    Greedy's ``zones_every_steps`` (100 here, greedy's 25) and ``replan_every_steps`` (10,
+    frontier's 5) are set for the cost per step; the validation sweeps
+    (docs/results/prediction.md) found no loss in either.
     """
 
     predictor: str = setting("nearest", choices=tuple(BASELINE_PREDICTORS))
-    predict_every_steps: int = setting(20, integer=True, ge=1)
+    predict_every_steps: int = setting(30, integer=True, ge=1)
     beyond_stride_cells: int = setting(4, integer=True, ge=1)
     min_p_free: float = setting(0.5, ge=0.0, le=1.0)
     spread_penalty: float = setting(1.0, ge=0.0)
     unknown_wall_cost: float = setting(8.0, ge=0.0)
     predicted_band_weight: float = setting(1.0, ge=0.0)
     switch_margin: float = setting(0.0, ge=0.0)
+    zones_every_steps: int = setting(100, integer=True, ge=1)
     replan_every_steps: int = setting(10, integer=True, ge=1)
 
 
