@@ -115,6 +115,8 @@ class PredictiveExplorer(GreedyInfoGainAgent):
         self._predicted_at = -(10**9)
         self.predicted: PredictedMap | None = None
         self._predicted_view: RobotView | None = None
+        self._codes = np.zeros(view.grid.shape, np.uint8)
+        self._band = np.zeros(view.grid.shape)  # the planner's cost around predicted walls
         self.n_predictions = 0
 
     def prediction(self, view: RobotView) -> PredictedMap:
@@ -141,7 +143,9 @@ class PredictiveExplorer(GreedyInfoGainAgent):
         self.prediction(view)
         return (self._codes & 3) == UNKNOWN
 
-    def _predicted_wall_band(self, view: RobotView, codes: np.ndarray, p_wall: np.ndarray):
+    def _predicted_wall_band(
+        self, view: RobotView, codes: np.ndarray, p_wall: np.ndarray
+    ) -> np.ndarray:
         """The planner's wall band (:func:`~sfw_gym.navigation.planning.wall_cost_term`) around
         the unknown cells predicted to be walls, times ``predicted_band_weight`` (finite: a
         prediction may be wrong; the predicted wall itself costs ``unknown_wall_cost · p_wall``)."""
