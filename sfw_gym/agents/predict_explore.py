@@ -77,8 +77,8 @@ class PredictExploreSettings(GreedySettings):
     """
 
     predictor: str = setting("nearest", choices=tuple(BASELINE_PREDICTORS))
-    predict_every_steps: int = setting(30, integer=True, ge=1)
-    beyond_stride_cells: int = setting(4, integer=True, ge=1)
+    predict_every_steps: int = setting(40, integer=True, ge=1)
+    beyond_stride_cells: int = setting(6, integer=True, ge=1)
     min_p_free: float = setting(0.5, ge=0.0, le=1.0)
     spread_penalty: float = setting(1.0, ge=0.0)
     unknown_wall_cost: float = setting(8.0, ge=0.0)
