@@ -159,9 +159,7 @@ class CoverageOracle(OracleAgent):
     def _belief_zone(self, view: RobotView) -> np.ndarray:
         """Each cell's nearest router (a robot's guess of the strongest), -1 where the belief
         holds a wall: the gain's router and where its ray ends, read from the belief alone."""
-        rows, cols = np.indices(view.belief_u8.shape)
-        x = self._origin[0] + (cols + 0.5) * self._res
-        y = self._origin[1] + (rows + 0.5) * self._res
+        x, y = view.grid.cell_centres()
         d2 = (x[..., None] - self._routers[:, 0]) ** 2 + (y[..., None] - self._routers[:, 1]) ** 2
         zone = np.argmin(d2, axis=-1).astype(np.int64)
         zone[belief_classes(view.belief_u8)[1]] = -1

@@ -20,7 +20,7 @@ guesses about the unseen made by a map predictor
 
 The predictor is re-run every ``predict_every_steps`` (at a replan); in between, the newest
 belief overrides the last prediction on the cells it knows. The learned agent is
-``predict-explore`` (:class:`sfw_gym.rl.map_predictor.PredictExploreAgent`); this class alone
+``predict-explore`` (:class:`sfw_gym.rl.predict_explore.PredictExploreAgent`); this class alone
 runs with a predictor that learns nothing (``predictor="nearest"``: the nearest known cell's
 class), the ablation that says what the learning is worth.
 """
@@ -28,6 +28,7 @@ class), the ablation that says what the learning is worth.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numba import njit
@@ -103,13 +104,16 @@ class PredictiveExplorer(GreedyInfoGainAgent):
     settings: PredictExploreSettings
 
     def make_predictor(self) -> MapPredictor:
-        """The map predictor this agent reads."""
+        """The map predictor this agent reads (built once, on first use: :attr:`predictor`)."""
         return BASELINE_PREDICTORS[self.settings.predictor]()
+
+    @cached_property
+    def predictor(self) -> MapPredictor:
+        """The agent's map predictor (:meth:`make_predictor`, kept across episodes)."""
+        return self.make_predictor()
 
     def _on_reset(self, view: RobotView) -> None:
         super()._on_reset(view)
-        if not hasattr(self, "_predictor"):
-            self._predictor = self.make_predictor()
         self._inputs = PredictorInputs(view)
         self._raw: PredictedMap | None = None
         self._predicted_at = -(10**9)
@@ -129,7 +133,7 @@ class PredictiveExplorer(GreedyInfoGainAgent):
             self._raw is None
             or self.steps - self._predicted_at >= self.settings.predict_every_steps
         ):
-            self._raw = self._predictor.predict_codes(codes, self._inputs.proximity)
+            self._raw = self.predictor.predict_codes(codes, self._inputs.proximity)
             self._predicted_at = self.steps
             self.n_predictions += 1
             self._band = self._predicted_wall_band(view, codes, self._raw.p_wall)

@@ -16,8 +16,7 @@ from typing import Protocol
 import numpy as np
 from scipy import ndimage
 
-from sfw_gym.core.constants import U8_FREE_MIN, U8_WALL_MAX
-from sfw_gym.mapping.grid import GridSpec
+from sfw_gym.mapping.grid import GridSpec, belief_classes
 from sfw_gym.navigation.view import RobotView
 
 #: A cell's class in the belief codes (:meth:`PredictorInputs.codes`) and in the truth.
@@ -34,10 +33,10 @@ ROUTER_PROXIMITY_SCALE_M = 5.0
 
 def belief_class(belief_u8: np.ndarray) -> np.ndarray:
     """The belief read by thirds, as classes ``FREE``, ``WALL``, ``UNKNOWN`` (uint8)."""
-    b = np.asarray(belief_u8)
-    out = np.full(b.shape, UNKNOWN, np.uint8)
-    out[b >= U8_FREE_MIN] = FREE
-    out[b <= U8_WALL_MAX] = WALL
+    free, wall, _ = belief_classes(belief_u8)
+    out = np.full(free.shape, UNKNOWN, np.uint8)
+    out[free] = FREE
+    out[wall] = WALL
     return out
 
 
@@ -54,9 +53,7 @@ def truth_class(truth_u8: np.ndarray) -> np.ndarray:
 def router_proximity(grid: GridSpec, routers_xy: np.ndarray) -> np.ndarray:
     """Per cell, ``exp(-d / ROUTER_PROXIMITY_SCALE_M)`` with ``d`` the distance to the nearest
     router (float32): where the mapper's rays converge."""
-    rows, cols = np.indices(grid.shape)
-    x = grid.origin_xy[0] + (cols + 0.5) * grid.resolution_m
-    y = grid.origin_xy[1] + (rows + 0.5) * grid.resolution_m
+    x, y = grid.cell_centres()
     routers = np.asarray(routers_xy, np.float64).reshape(-1, 2)
     d = np.hypot(x[..., None] - routers[:, 0], y[..., None] - routers[:, 1]).min(axis=-1)
     return np.exp(-d / ROUTER_PROXIMITY_SCALE_M).astype(np.float32)

@@ -223,14 +223,13 @@ def predictor_loss(
     labels: torch.Tensor,
     inputs: torch.Tensor,
     known_weight: float,
-    generator: torch.Generator | None = None,
 ) -> torch.Tensor:
     """Cross-entropy of every head, each cell weighted by a Poisson(1) bootstrap draw per head
     (the ensemble's diversity), by ``known_weight`` where the belief knows it, 0 beyond the map."""
     b, heads, _, h, w = logits.shape
     unknown = inputs[:, INPUT_CHANNELS.index("unknown")]
     weight = torch.where(unknown > 0, 1.0, known_weight) * (labels != IGNORE)
-    boot = torch.poisson(torch.ones(b, heads, h, w), generator=generator)
+    boot = torch.poisson(torch.ones(b, heads, h, w))
     target = labels.clamp(max=OUTSIDE)[:, None].expand(b, heads, h, w)
     ce = F.cross_entropy(logits.permute(0, 2, 1, 3, 4), target, reduction="none")
     w_all = boot * weight[:, None]

@@ -72,7 +72,7 @@ def test_candidates_beyond_the_frontier_are_where_free_space_is_predicted():
             return PredictedMap.with_belief(codes, ones, 0 * ones, 0 * ones)
 
     agent = PredictiveExplorer(beyond_stride_cells=3)
-    agent._predictor = AllFree()
+    agent.predictor = AllFree()
     env = run(agent, 20)
     view = env.unwrapped.robot_view()
     field = cost_field(agent._costs(view), view.cell, view.grid.resolution_m)
