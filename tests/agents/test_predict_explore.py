@@ -87,3 +87,37 @@ def test_candidates_beyond_the_frontier_are_where_free_space_is_predicted():
 def test_an_unknown_predictor_is_refused():
     with pytest.raises(ConfigError, match="predictor"):
         PredictiveExplorer(predictor="oracle")
+
+
+def test_a_band_around_predicted_walls_raises_the_cost_beside_them():
+    class WallAcross:
+        """Free everywhere, but a wall predicted along row 20 (unknown cells only)."""
+
+        def predict_codes(self, codes, proximity):
+            p_wall = np.zeros(codes.shape, np.float32)
+            p_wall[20] = 0.9
+            return PredictedMap.with_belief(codes, 1 - p_wall, p_wall, 0 * p_wall)
+
+    costs = {}
+    for weight in (0.0, 1.0):
+        agent = PredictiveExplorer(predicted_band_weight=weight, unknown_wall_cost=0.0)
+        agent.predictor = WallAcross()
+        env = run(agent, 10)
+        view = env.unwrapped.robot_view()
+        costs[weight] = agent._costs(view)
+        unknown = agent._unknown(view)
+    beside = unknown[21] & np.isfinite(costs[0.0][21])  # one cell off the predicted wall
+    assert beside.any()
+    assert np.all(costs[1.0][21][beside] > costs[0.0][21][beside])
+    far = unknown[35] & np.isfinite(costs[0.0][35])  # beyond the band: unchanged
+    np.testing.assert_array_equal(costs[1.0][35][far], costs[0.0][35][far])
+
+
+def test_a_step_predicts_once_however_often_its_planning_asks():
+    agent = PredictiveExplorer(predict_every_steps=1)
+    env = run(agent, 3)
+    view = env.unwrapped.robot_view()
+    first = agent.prediction(view)
+    n = agent.n_predictions
+    assert agent.prediction(view) is first and agent.n_predictions == n
+    assert agent.prediction(env.unwrapped.robot_view()) is not first  # a new view: anew

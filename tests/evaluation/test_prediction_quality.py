@@ -81,3 +81,26 @@ def test_quality_on_cases_computed_by_hand():
     assert q == pytest.approx(
         {"free_iou": 1.0, "wall_f1": 1.0, "free_auroc": 1.0, "wall_auroc": 1.0}
     )
+
+
+def test_an_episode_s_curve_records_the_entropy_beside_coverage_and_path():
+    from sfw_gym.evaluation.rollout import EpisodeRecord, EpisodeSpec
+
+    def info(coverage, path, entropy):
+        return {
+            "coverage": coverage,
+            "map_iou": 0.9,
+            "path_length_m": path,
+            "entropy_bits": entropy,
+        }
+
+    spec = EpisodeSpec(agent="frontier", episode=0, seed=0, curve_every=2)
+    record = EpisodeRecord(spec, info(0.0, 0.0, 100.0), 0.0)
+    record.step(info(0.1, 0.2, 95.0), False)
+    record.step(info(0.2, 0.4, 90.0), False)
+    record.step(info(0.3, 0.5, 88.0), True)
+    assert record.curve == [
+        (0, 0.0, 0.9, 0.0, 100.0),
+        (2, 0.2, 0.9, 0.4, 90.0),
+        (3, 0.3, 0.9, 0.5, 88.0),
+    ]

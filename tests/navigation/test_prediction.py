@@ -121,3 +121,13 @@ def test_expected_gain_on_a_predicted_map_equals_the_hand_computed_case():
         view, predicted, np.array([[9.5, 0.5]]), np.array([[0, 0]]), np.zeros((1, 2)), 0.0
     )
     assert gain[0] == pytest.approx(0.9, rel=1e-5)
+
+
+def test_a_ray_stops_at_the_grid_s_edge_and_says_whether_it_reached_its_target():
+    from sfw_gym.navigation.candidates import ray_cells
+
+    origin = np.zeros(2)
+    cells, reached = ray_cells(0, 0, np.array([4.5, 0.5]), 0.4, origin, 1.0, (1, 10))
+    assert reached and cells[:, 1].tolist() == [1, 1, 2, 2, 3, 3, 4, 4]  # half-cell samples
+    cells, reached = ray_cells(0, 0, np.array([14.5, 0.5]), 0.4, origin, 1.0, (1, 10))
+    assert not reached and cells[:, 1].max() == 9

@@ -89,7 +89,7 @@ def test_the_predictor_learns_where_a_corridor_goes():
     assert 0.0 <= p.spread.min() and p.spread.max() <= 0.5
 
 
-def test_training_checkpoints_and_resumes(tmp_path: Path):
+def test_training_checkpoints_and_resumes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch):
     from sfw_gym.evaluation.prediction import load_snapshots
 
     rng = np.random.default_rng(1)
@@ -116,7 +116,13 @@ def test_training_checkpoints_and_resumes(tmp_path: Path):
     first = torch.load(out / "model.pt", weights_only=True)
     # resumed: a longer run continues from step 4 (the log goes on, nothing is redone)
     longer = PredictorTraining(steps=6, batch=2, crop=24, threads=1)
+    batches = []
+    draw = SnapshotSampler.batch
+    monkeypatch.setattr(
+        SnapshotSampler, "batch", lambda self, n: batches.append(n) or draw(self, n)
+    )
     train_predictor(episodes, out, longer, net_config, log_every=2, checkpoint_every=2)
+    assert len(batches) == 2  # steps 5 and 6 only
     steps = [int(line.split(",")[0]) for line in (out / "log.csv").read_text().splitlines()[1:]]
     assert steps == [2, 4, 6]
     assert not all(
@@ -136,9 +142,11 @@ def test_a_run_stopped_early_exports_its_checkpoint(tmp_path: Path):
     train_predictor(episodes, out, planned, PredictorConfig(4, 2), checkpoint_every=2)
     (out / "model.pt").unlink()
     checkpoint = torch.load(out / "checkpoint.pt", weights_only=False)
+    checkpoint["step"] = 2  # as if stopped halfway through the 4 steps planned
+    torch.save(checkpoint, out / "checkpoint.pt")
     export_checkpoint(episodes, out)
     record = predictor_record(out)
-    assert record["steps_done"] == checkpoint["step"] == 4
+    assert record["steps_done"] == 2
     assert record["network"] == {"width": 4, "heads": 2} and record["training"]["steps"] == 4
     net = LearnedMapPredictor(out).net
     for name, value in net.state_dict().items():
