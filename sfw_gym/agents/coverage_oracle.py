@@ -36,7 +36,12 @@ from sfw_gym.agents.oracles import OracleAgent
 from sfw_gym.core.config import setting
 from sfw_gym.core.constants import U8_FREE_MIN
 from sfw_gym.mapping.grid import belief_classes
-from sfw_gym.navigation.candidates import footprint_bits, ray_cells, unknown_bits_at
+from sfw_gym.navigation.candidates import (
+    footprint_bits,
+    ray_buffer,
+    ray_cells,
+    unknown_bits_at,
+)
 from sfw_gym.navigation.frontiers import frontier_mask
 from sfw_gym.navigation.menu import FEATURES
 from sfw_gym.navigation.planning import (
@@ -227,14 +232,15 @@ class CoverageOracle(OracleAgent):
 
 @njit(cache=True)
 def _gain_at(
-    log_odds, belief, zone, routers, r0, c0, footprint, radius, origin, res, seen, mark, weight
+    log_odds, belief, zone, routers, r0, c0, footprint, radius, origin, res, seen, mark, weight, buf
 ):  # pragma: no cover (compiled)
     """The unknown bits at the robot's footprint on cell (r0, c0) plus those on the ray towards
     its strongest router, from beyond the footprint's ``radius`` to the first truly non-free
     cell (times ``weight`` unless the ray reaches the router); each cell once (``seen`` holds
     ``mark`` where counted)."""
     total = footprint_bits(log_odds, belief, r0, c0, footprint, seen, mark)
-    cells, reached = ray_cells(r0, c0, routers[zone[r0, c0]], radius, origin, res, belief.shape)
+    router = routers[zone[r0, c0]]
+    cells, reached = ray_cells(r0, c0, router, radius, origin, res, belief.shape, buf)
     ray = 0.0
     for k in range(len(cells)):
         r, c = cells[k, 0], cells[k, 1]
@@ -252,6 +258,7 @@ def _gains(
 ):  # pragma: no cover (compiled)
     """:func:`_gain_at` of each cell."""
     seen = np.zeros(belief.shape, np.int64)
+    buf = ray_buffer(belief.shape)
     out = np.zeros(len(cells))
     for i in range(len(cells)):
         r, c = cells[i, 0], cells[i, 1]
@@ -269,6 +276,7 @@ def _gains(
             seen,
             i + 1,
             weight,
+            buf,
         )
     return out
 

@@ -37,7 +37,12 @@ from sfw_gym.agents.base import Decision, RobotView
 from sfw_gym.agents.frontier import Goal
 from sfw_gym.agents.greedy import GreedyInfoGainAgent, GreedySettings
 from sfw_gym.core.config import setting
-from sfw_gym.navigation.candidates import footprint_bits, ray_cells, unknown_bits_at
+from sfw_gym.navigation.candidates import (
+    footprint_bits,
+    ray_buffer,
+    ray_cells,
+    unknown_bits_at,
+)
 from sfw_gym.navigation.menu import FEATURES
 from sfw_gym.navigation.planning import CostField, WallBand, wall_cost_term, wall_distance_m
 from sfw_gym.navigation.prediction import (
@@ -274,12 +279,13 @@ def _predicted_gains(
     log_odds, belief, p_free, spread, routers, cells, footprint, radius, origin, res, penalty
 ):  # pragma: no cover (compiled)
     seen = np.zeros(belief.shape, np.int64)
+    buf = ray_buffer(belief.shape)
     out = np.zeros(len(cells))
     for i in range(len(cells)):
         mark = i + 1
         r0, c0 = cells[i, 0], cells[i, 1]
         total = footprint_bits(log_odds, belief, r0, c0, footprint, seen, mark)
-        ray, _ = ray_cells(r0, c0, routers[i], radius, origin, res, belief.shape)
+        ray, _ = ray_cells(r0, c0, routers[i], radius, origin, res, belief.shape, buf)
         reach = 1.0
         for k in range(len(ray)):
             r, c = ray[k, 0], ray[k, 1]

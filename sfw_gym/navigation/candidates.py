@@ -99,6 +99,7 @@ __all__ = [
     "footprint_bits",
     "greedy_choice",
     "proven_on_bounded_paths",
+    "ray_buffer",
     "ray_cells",
     "unknown_bits_at",
 ]
@@ -652,18 +653,20 @@ def footprint_bits(log_odds, belief, r0, c0, footprint, seen, mark):  # pragma: 
 
 
 @njit(cache=True)
-def ray_cells(r0, c0, target, radius, origin, res, shape):  # pragma: no cover (compiled)
+def ray_cells(r0, c0, target, radius, origin, res, shape, buf):  # pragma: no cover (compiled)
     """``(K, 2)`` cells of the ray from cell (r0, c0)'s centre towards the point ``target``,
     sampled every half cell, from beyond ``radius`` (m; the robot's footprint) to the target or
     the grid's edge (a cell repeats where several samples fall in it), and whether it reached
-    the target inside the grid."""
+    the target inside the grid. The cells are a view of ``buf`` ``(M, 2)`` when it is long
+    enough (kernels that walk many rays pass one, :func:`ray_buffer`), valid until the next
+    call with it."""
     h, w = shape
     x0 = origin[0] + (c0 + 0.5) * res
     y0 = origin[1] + (r0 + 0.5) * res
     dx, dy = target[0] - x0, target[1] - y0
     length = np.hypot(dx, dy)
     n = int(np.ceil(length / (0.5 * res)))
-    out = np.empty((n, 2), np.int64)
+    out = buf if len(buf) >= n else np.empty((n, 2), np.int64)
     k = 0
     for j in range(1, n + 1):
         t = j / n
@@ -676,6 +679,13 @@ def ray_cells(r0, c0, target, radius, origin, res, shape):  # pragma: no cover (
         out[k, 0], out[k, 1] = r, c
         k += 1
     return out[:k], True
+
+
+@njit(cache=True)
+def ray_buffer(shape):  # pragma: no cover (compiled)
+    """A buffer for :func:`ray_cells` long enough for any ray between two points of a grid of
+    ``shape`` (samples every half cell along its diagonal)."""
+    return np.empty((int(2 * np.hypot(shape[0], shape[1])) + 4, 2), np.int64)
 
 
 @njit(cache=True)
