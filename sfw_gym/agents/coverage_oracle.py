@@ -232,7 +232,21 @@ class CoverageOracle(OracleAgent):
 
 @njit(cache=True)
 def _gain_at(
-    log_odds, belief, zone, routers, r0, c0, footprint, radius, origin, res, seen, mark, weight, buf
+    log_odds,
+    belief,
+    zone,
+    walls,
+    routers,
+    r0,
+    c0,
+    footprint,
+    radius,
+    origin,
+    res,
+    seen,
+    mark,
+    weight,
+    buf,
 ):  # pragma: no cover (compiled)
     """The unknown bits at the robot's footprint on cell (r0, c0) plus those on the ray towards
     its strongest router, from beyond the footprint's ``radius`` to the first truly non-free
@@ -240,16 +254,14 @@ def _gain_at(
     ``mark`` where counted)."""
     total = footprint_bits(log_odds, belief, r0, c0, footprint, seen, mark)
     router = routers[zone[r0, c0]]
-    cells, reached = ray_cells(r0, c0, router, radius, origin, res, belief.shape, buf)
+    cells, reached = ray_cells(r0, c0, router, radius, origin, res, walls, buf)
     ray = 0.0
     for k in range(len(cells)):
         r, c = cells[k, 0], cells[k, 1]
-        if zone[r, c] < 0:
-            return total + weight * ray  # a true wall: the free stretch ends
         if seen[r, c] != mark:
             seen[r, c] = mark
             ray += unknown_bits_at(log_odds, belief, r, c)
-    return total + (ray if reached else weight * ray)  # left the grid: as a wall
+    return total + (ray if reached else weight * ray)  # a true wall (or the grid's edge)
 
 
 @njit(cache=True)
@@ -259,6 +271,7 @@ def _gains(
     """:func:`_gain_at` of each cell."""
     seen = np.zeros(belief.shape, np.int64)
     buf = ray_buffer(belief.shape)
+    walls = zone < 0
     out = np.zeros(len(cells))
     for i in range(len(cells)):
         r, c = cells[i, 0], cells[i, 1]
@@ -266,6 +279,7 @@ def _gains(
             log_odds,
             belief,
             zone,
+            walls,
             routers,
             r,
             c,

@@ -280,12 +280,13 @@ def _predicted_gains(
 ):  # pragma: no cover (compiled)
     seen = np.zeros(belief.shape, np.int64)
     buf = ray_buffer(belief.shape)
+    hopeless = p_free < 1e-3  # the stretch ends there (its reach would fall below 1e-3)
     out = np.zeros(len(cells))
     for i in range(len(cells)):
         mark = i + 1
         r0, c0 = cells[i, 0], cells[i, 1]
         total = footprint_bits(log_odds, belief, r0, c0, footprint, seen, mark)
-        ray, _ = ray_cells(r0, c0, routers[i], radius, origin, res, belief.shape, buf)
+        ray, _ = ray_cells(r0, c0, routers[i], radius, origin, res, hopeless, buf)
         reach = 1.0
         for k in range(len(ray)):
             r, c = ray[k, 0], ray[k, 1]

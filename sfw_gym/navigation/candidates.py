@@ -653,14 +653,15 @@ def footprint_bits(log_odds, belief, r0, c0, footprint, seen, mark):  # pragma: 
 
 
 @njit(cache=True)
-def ray_cells(r0, c0, target, radius, origin, res, shape, buf):  # pragma: no cover (compiled)
+def ray_cells(r0, c0, target, radius, origin, res, blocked, buf):  # pragma: no cover (compiled)
     """``(K, 2)`` cells of the ray from cell (r0, c0)'s centre towards the point ``target``,
-    sampled every half cell, from beyond ``radius`` (m; the robot's footprint) to the target or
-    the grid's edge (a cell repeats where several samples fall in it), and whether it reached
-    the target inside the grid. The cells are a view of ``buf`` ``(M, 2)`` when it is long
+    sampled every half cell, from beyond ``radius`` (m; the robot's footprint) to the target,
+    the grid's edge or the first cell where ``blocked`` (bool, the grid's shape) holds (not
+    included; a cell repeats where several samples fall in it), and whether it reached the
+    target. The cells are a view of ``buf`` ``(M, 2)`` when it is long
     enough (kernels that walk many rays pass one, :func:`ray_buffer`), valid until the next
     call with it."""
-    h, w = shape
+    h, w = blocked.shape
     x0 = origin[0] + (c0 + 0.5) * res
     y0 = origin[1] + (r0 + 0.5) * res
     dx, dy = target[0] - x0, target[1] - y0
@@ -674,7 +675,7 @@ def ray_cells(r0, c0, target, radius, origin, res, shape, buf):  # pragma: no co
             continue
         r = int(np.floor((y0 + dy * t - origin[1]) / res))
         c = int(np.floor((x0 + dx * t - origin[0]) / res))
-        if not (0 <= r < h and 0 <= c < w):
+        if not (0 <= r < h and 0 <= c < w) or blocked[r, c]:
             return out[:k], False
         out[k, 0], out[k, 1] = r, c
         k += 1

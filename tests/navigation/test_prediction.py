@@ -127,8 +127,13 @@ def test_a_ray_stops_at_the_grid_s_edge_and_says_whether_it_reached_its_target()
     from sfw_gym.navigation.candidates import ray_buffer, ray_cells
 
     origin, buf = np.zeros(2), ray_buffer((1, 10))
-    cells, reached = ray_cells(0, 0, np.array([4.5, 0.5]), 0.4, origin, 1.0, (1, 10), buf)
+    open_ = np.zeros((1, 10), bool)
+    cells, reached = ray_cells(0, 0, np.array([4.5, 0.5]), 0.4, origin, 1.0, open_, buf)
     assert reached and cells[:, 1].tolist() == [1, 1, 2, 2, 3, 3, 4, 4]  # half-cell samples
-    cells, reached = ray_cells(0, 0, np.array([14.5, 0.5]), 0.4, origin, 1.0, (1, 10), buf[:2])
+    cells, reached = ray_cells(0, 0, np.array([14.5, 0.5]), 0.4, origin, 1.0, open_, buf[:2])
     assert len(cells) == 18  # a buffer too short: a fresh array
     assert not reached and cells[:, 1].max() == 9
+    wall = open_.copy()
+    wall[0, 3] = True
+    cells, reached = ray_cells(0, 0, np.array([4.5, 0.5]), 0.4, origin, 1.0, wall, buf)
+    assert not reached and cells[:, 1].tolist() == [1, 1, 2, 2]  # stops before the wall
