@@ -31,6 +31,7 @@ AGENTS: dict[str, str] = {
     # the learned agents, named by what trains them (sfw-gym train ppo_mask / train ppo)
     "regions-ppo": "sfw_gym.rl.agent:RegionsPPOAgent",
     "goals-ppo": "sfw_gym.rl.agent:PPOAgent",
+    "wheels-ppo": "sfw_gym.rl.wheels_agent:WheelsPPOAgent",
     "waypoint-ppo": "sfw_gym.rl.waypoint_agent:WaypointPPOAgent",
     # greedy bits per metre on the learned map predictor's map
     "predict-explore": "sfw_gym.rl.predict_explore:PredictExploreAgent",

@@ -23,8 +23,11 @@ def data_path(*parts: str) -> Path:
     return Path(str(resources.files("sfw_gym").joinpath("data", *parts)))
 
 
-#: The shipped pretrained policy (trained by ``sfw-gym train ppo``).
+#: The earlier waypoint policy (``sfw-gym train ppo`` with the waypoint block of issue 6).
 DEFAULT_WAYPOINT_MODEL_DIR = data_path("agents", "ppo", "SfW-Explore-v0_1")
+#: The shipped PPO on the wheels (``sfw-gym train ppo --env SfW-Explore-v0``, from scratch):
+#: rl-zoo's latest ``ppo`` run of ``SfW-Explore-v0``, so ``rl_zoo3.enjoy`` replays it.
+DEFAULT_WHEELS_MODEL_DIR = data_path("agents", "ppo", "SfW-Explore-v0_2")
 #: The shipped candidate-goal explorer (trained by ``sfw-gym train ppo_mask``).
 DEFAULT_MODEL_DIR = data_path("agents", "ppo_mask", "SfW-ExploreGoals-v0_1")
 #: The shipped region explorer (``sfw-gym train ppo_mask --env SfW-ExploreRegions-v0``).

@@ -178,6 +178,14 @@ def parse_policy_kwargs(text: str) -> dict[str, Any]:
             return {value(k): value(v) for k, v in zip(node.keys, node.values, strict=True)}  # type: ignore[arg-type]
         if isinstance(node, ast.Constant):
             return node.value
+        if (  # a signed number: log_std_init=-0.5
+            isinstance(node, ast.UnaryOp)
+            and isinstance(node.op, ast.USub | ast.UAdd)
+            and isinstance(node.operand, ast.Constant)
+            and isinstance(node.operand.value, int | float)
+            and not isinstance(node.operand.value, bool)
+        ):
+            return -node.operand.value if isinstance(node.op, ast.USub) else node.operand.value
         raise ConfigError(f"policy_kwargs: only dict(...) and literals are allowed: {text!r}")
 
     try:

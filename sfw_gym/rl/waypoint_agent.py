@@ -87,21 +87,25 @@ class WaypointPPOAgent(Agent):
         config_path = folder / "config.yml"
         hint = f"train one with `sfw-gym train ppo --out {folder}` or pass path="
         if not config_path.is_file():
-            raise ConfigError(f"WaypointPPOAgent: {config_path} not found; {hint}")
+            raise ConfigError(f"{type(self).__name__}: {config_path} not found; {hint}")
         try:
             model_path = Path(path) if Path(path).suffix == ".zip" else find_model(folder)
         except ConfigError as exc:
-            raise ConfigError(f"WaypointPPOAgent: {exc}; {hint}") from None
+            raise ConfigError(f"{type(self).__name__}: {exc}; {hint}") from None
         if not model_path.is_file():
-            raise ConfigError(f"WaypointPPOAgent: {model_path} not found; {hint}")
+            raise ConfigError(f"{type(self).__name__}: {model_path} not found; {hint}")
         try:
             config = yaml.safe_load(config_path.read_text(encoding="utf-8")) or {}
         except yaml.YAMLError as exc:
-            raise ConfigError(f"WaypointPPOAgent: {config_path}: not valid YAML ({exc})") from None
+            raise ConfigError(f"{type(self).__name__}: {config_path}: not valid YAML ({exc})") from None
         self.waypoints = waypoint_settings(config)
+        self._check_policy_kind(folder)
         self.model = _load_model(str(model_path), device)
         if self.waypoints is None:
             self.action_types = ("continuous",)  # type: ignore[misc]  # this model's only
+
+    def _check_policy_kind(self, folder: Path) -> None:
+        """Refuse a model this agent cannot drive (any SB3 PPO model is fine here)."""
 
     def _distribution(self, obs: dict[str, np.ndarray]) -> Any:
         """The policy's action distribution for ``obs`` (a ``torch.distributions`` object)."""
@@ -129,7 +133,7 @@ class WaypointPPOAgent(Agent):
         dist = self._distribution(obs)
         if not isinstance(dist, torch.distributions.Normal):
             raise ConfigError(
-                f"WaypointPPOAgent: cannot sample the {type(dist).__name__} actions of "
+                f"{type(self).__name__}: cannot sample the {type(dist).__name__} actions of "
                 f"{self.settings.path} with the agent's generator; use deterministic=True"
             )
         mean = dist.loc[0].cpu().numpy().astype(np.float64)
@@ -154,7 +158,7 @@ class WaypointPPOAgent(Agent):
         if differ:
             got = {k: np.shape(obs.get(k)) for k in differ}
             raise ConfigError(
-                f"WaypointPPOAgent: the policy in {self.settings.path} was trained on observations "
+                f"{type(self).__name__}: the policy in {self.settings.path} was trained on observations "
                 f"{differ}; this env gives {got} (map_px, crop_px and n_routers must match)"
             )
         self._obs_checked = True
