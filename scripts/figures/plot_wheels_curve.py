@@ -31,6 +31,17 @@ from sfw_gym.evaluation.stats import mean_ci95
 
 ENV_ID = "SfW-Explore-v0"
 COLUMNS = ("steps", "episode", "return", "coverage")
+#: What SB3 logs per PPO update (and sfw-gym train per head), in the diagnostics table.
+DIAGNOSTICS = (
+    "train/explained_variance",
+    "train/entropy_loss",
+    "train/std",
+    "train/approx_kl",
+    "train/clip_fraction",
+    "train/grad_norm_features",
+    "train/grad_norm_actor",
+    "train/grad_norm_critic",
+)
 
 
 def evaluate_vector(act, episodes: int, seed: int, env_kwargs: dict) -> tuple[np.ndarray, ...]:
@@ -145,6 +156,26 @@ def _interval(values: list[float]) -> tuple[float, float, float]:
     return mean, mean - half, mean + half
 
 
+def training_diagnostics(run: Path) -> list[str]:
+    """Markdown rows: each of :data:`DIAGNOSTICS` averaged over the first, middle and last
+    tenth of the run's PPO updates (from its TensorBoard log)."""
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+
+    rows = []
+    for folder in sorted((run / "tb").glob("*")):
+        events = EventAccumulator(str(folder))
+        events.Reload()
+        for tag in DIAGNOSTICS:
+            if tag not in events.Tags()["scalars"]:
+                continue
+            values = np.array([e.value for e in events.Scalars(tag)])
+            k, n = max(1, len(values) // 10), len(values)
+            parts = (values[:k], values[n // 2 - k // 2 : n // 2 - k // 2 + k], values[-k:])
+            cells = " | ".join(f"{part.mean():.4g}" for part in parts)
+            rows.append(f"| {run.name} | {tag.removeprefix('train/')} | {cells} |")
+    return rows
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("runs", type=Path, nargs="+")
@@ -190,6 +221,10 @@ def main() -> None:
     fig.tight_layout()
     args.out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(args.out, dpi=110)
+    print("\n| run | logged per update | first tenth | middle tenth | last tenth |")
+    print("|---|---|---:|---:|---:|")
+    for run in runs:
+        print("\n".join(training_diagnostics(run)))
     print("levels:", json.dumps(levels))
     print(f"wrote {args.out}")
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # What a new user gets from the wheel, with no checkout in sight: build it, install it in a fresh
 # venv in a temp folder, and run there (1) the light core without torch, (2) with the [rl] extra,
-# WaypointPPOAgent(), PPOAgent(), `sfw-gym demo` and `sfw-gym train ppo`. CI runs this after the tests.
+# wheels-ppo, WaypointPPOAgent(), PPOAgent(), `sfw-gym demo` and `sfw-gym train ppo`. CI runs this after the tests.
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/../.." && pwd)"
 python="${PYTHON:-python3}"
@@ -34,6 +34,7 @@ PY
 
 "$py" -m pip install --quiet torch==2.13.0  # the CPU build (an unpinned torch pulls CUDA)
 "$py" -m pip install --quiet "$wheel[rl]"
+"$py" -c "from sfw_gym.agents import make_agent; a = make_agent('wheels-ppo'); print('wheels-ppo loads', a.settings.path)"
 "$py" -c "from sfw_gym.rl import WaypointPPOAgent; a = WaypointPPOAgent(); print('WaypointPPOAgent() loads', a.settings.path)"
 "$py" -c "from sfw_gym.rl import PPOAgent; a = PPOAgent(); print('PPOAgent() loads', a.settings.path)"
 "$py" -c "from sfw_gym.rl import RegionsPPOAgent; a = RegionsPPOAgent(); print('RegionsPPOAgent() loads', a.settings.path)"

@@ -60,6 +60,8 @@ PROJECT_KEYS = frozenset({"behaviour_cloning", "fine_tuning", "use_masking"})
 _ZOO_KEYS = frozenset({"policy", "n_timesteps", "n_envs", "env_wrapper", "env_kwargs"})
 _PPO_KEYS = {
     "target_kl",
+    "use_sde",
+    "sde_sample_freq",
     "n_steps",
     "batch_size",
     "n_epochs",

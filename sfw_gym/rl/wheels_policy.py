@@ -80,7 +80,7 @@ class EgoMaps(BaseFeaturesExtractor):
     def __init__(
         self,
         observation_space: spaces.Dict,
-        features_dim: int = 256,
+        features_dim: int = 128,
         local_px: int = 24,
         map_px: int = 32,
     ) -> None:
@@ -90,8 +90,8 @@ class EgoMaps(BaseFeaturesExtractor):
         state_shape = observation_space["state"].shape
         assert local_shape is not None and map_shape is not None and state_shape is not None
         self.local_px, self.map_px = local_px, map_px
-        self.local_cnn, local_out = _cnn(int(local_shape[0]), local_px, (16, 32))
-        self.map_cnn, map_out = _cnn(int(map_shape[0]), map_px, (16, 32, 32))
+        self.local_cnn, local_out = _cnn(int(local_shape[0]), local_px, (8, 16))
+        self.map_cnn, map_out = _cnn(int(map_shape[0]), map_px, (8, 16, 16))
         self.head = nn.Sequential(
             nn.Linear(local_out + map_out + int(state_shape[0]), features_dim), nn.ReLU()
         )
@@ -106,8 +106,9 @@ class EgoMaps(BaseFeaturesExtractor):
             local, ego_grid(sin, cos, centre, self.local_px), align_corners=False
         )
         image = observations["map"]
-        belief = image[:, :1] * 2 - 1
-        image = torch.cat([belief, image[:, 1:]], dim=1)
+        scale = torch.ones(image.shape[1], 1, 1, dtype=image.dtype, device=image.device)
+        scale[0] = 2.0  # the belief channel only: 2 b - 1, the others as they are
+        image = torch.addcmul(-(scale - 1), image, scale)
         grid = ego_grid(sin, cos, robot_centre(observations["map"][:, 1]), self.map_px)
         return local, F.grid_sample(image, grid, align_corners=False)
 

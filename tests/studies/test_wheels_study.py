@@ -1,0 +1,72 @@
+"""``scripts/studies/wheels_study.py`` and ``scripts/figures/plot_wheels_curve.py``: the figures
+the wheels-ppo page quotes, checked against hand-computed cases."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import sfw_gym  # noqa: F401
+
+SCRIPTS = Path(__file__).resolve().parents[2] / "scripts"
+
+
+def _load(relative: str):
+    spec = importlib.util.spec_from_file_location(Path(relative).stem, SCRIPTS / relative)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_return_from_a_record_is_what_the_env_paid():
+    """Summed rewards of a real episode equal 0.01 · bits − 0.1 · contact steps of its record."""
+    study = _load("studies/wheels_study.py")
+    env = gym.make("SfW-ExploreSmall-v0")
+    _, info = env.reset(seed=5)
+    start, total = info["entropy_bits"], 0.0
+    for _ in range(150):  # straight ahead: some mapping, then a wall and contact
+        _, reward, terminated, truncated, info = env.step(np.array([1.0, 0.0], np.float32))
+        total += reward
+        if terminated or truncated:
+            break
+    record = {
+        "info_gain_total_bits": start - info["entropy_bits"],
+        "collisions": info["collisions"],
+    }
+    assert info["collisions"] > 0
+    assert study.episode_return(record, 0.01, 0.1) == pytest.approx(total, abs=1e-9)
+
+
+def test_the_geometric_mean_ratio_of_hand_made_plans():
+    study = _load("studies/wheels_study.py")
+    reference = np.array([0.5, 0.8, 0.4, 0.6])
+    other = reference * np.array([0.5, 2.0, 1.0, 1.0])  # ratios 1/2, 2, 1, 1: geometric mean 1
+    mean, low, high = study.geometric_mean_ratio(reference, other)
+    assert mean == pytest.approx(1.0) and low < 1.0 < high
+    mean, low, high = study.geometric_mean_ratio(reference, 0.6 * reference)  # all alike
+    assert mean == low == high == pytest.approx(0.6)
+    zero = study.geometric_mean_ratio(np.array([0.5, 0.0]), np.array([0.25, 0.3]))
+    assert zero[0] == pytest.approx(0.5)  # the plan with a zero is left out
+
+
+def test_tenths_take_the_first_and_last_tenth_of_the_evaluations():
+    curve = _load("figures/plot_wheels_curve.py")
+    rows = [
+        {"steps": s, "episode": e, "return": float(s) + e, "coverage": 0.0}
+        for s in range(1, 21)  # 20 evaluations: a tenth is 2 of them
+        for e in range(2)
+    ]
+    (m0, lo0, hi0), (m1, lo1, hi1) = curve.tenths(rows, "return")
+    assert m0 == pytest.approx(np.mean([1, 2, 2, 3]))  # steps 1 and 2, episodes 0 and 1
+    assert m1 == pytest.approx(np.mean([19, 20, 20, 21]))
+    sd = np.std([1, 2, 2, 3], ddof=1)
+    from scipy import stats
+
+    half = stats.t.ppf(0.975, 3) * sd / math.sqrt(4)
+    assert hi0 - m0 == pytest.approx(half) and m0 - lo0 == pytest.approx(half)
+    assert lo1 > hi0
