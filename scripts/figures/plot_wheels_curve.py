@@ -21,6 +21,7 @@ import json
 import math
 import re
 from pathlib import Path
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -28,6 +29,7 @@ import yaml
 
 import sfw_gym  # noqa: F401  (registration)
 from sfw_gym.evaluation.stats import mean_ci95
+from sfw_gym.rl.training import native_action_repeat, wrapper_specs
 
 ENV_ID = "SfW-Explore-v0"
 COLUMNS = ("steps", "episode", "return", "coverage")
@@ -63,11 +65,27 @@ def evaluate_vector(act, episodes: int, seed: int, env_kwargs: dict) -> tuple[np
     return returns, coverage
 
 
-def policy_act(model_path: Path):
+def policy_act(model_path: Path, repeat: int = 1):
+    """The deterministic policy of a checkpoint as a batched ``act(obs)``, deciding every
+    ``repeat`` calls and holding its actions in between (the run's ActionRepeat)."""
     from stable_baselines3 import PPO
 
     model = PPO.load(model_path, device="cpu")
-    return lambda obs: model.predict(obs, deterministic=True)[0]
+    held: dict[str, Any] = {"calls": 0, "actions": None}
+
+    def act(obs: dict[str, np.ndarray]) -> np.ndarray:
+        if held["calls"] % repeat == 0:
+            held["actions"] = model.predict(obs, deterministic=True)[0]
+        held["calls"] += 1
+        return held["actions"]
+
+    return act
+
+
+def run_repeat(config: dict[str, Any]) -> int:
+    """The action repeat a run was trained with (1: none)."""
+    wrappers = wrapper_specs(config.get("hyperparameters", {}).get("env_wrapper"))
+    return native_action_repeat(wrappers) or 1
 
 
 def evaluate_run(run: Path, episodes: int, seed: int) -> list[dict[str, float]]:
@@ -86,12 +104,12 @@ def evaluate_run(run: Path, episodes: int, seed: int) -> list[dict[str, float]]:
         if (m := re.fullmatch(r"ppo_(\d+)_steps\.zip", path.name))
     )
     config = yaml.safe_load((run / "config.yml").read_text(encoding="utf-8"))
-    for steps, path in checkpoints:
+    repeat = run_repeat(config)
+    for decisions, path in checkpoints:
+        steps = decisions * repeat  # env steps
         if steps in done:
             continue
-        returns, coverage = evaluate_vector(
-            policy_act(path), episodes, seed, config.get("env_kwargs") or {}
-        )
+        returns, coverage = evaluate_vector(policy_act(path, repeat), episodes, seed, {})
         rows += [
             {"steps": steps, "episode": i, "return": returns[i], "coverage": coverage[i]}
             for i in range(episodes)
@@ -208,8 +226,9 @@ def main() -> None:
             print(f"| {config.get('seed')} | {metric} | {m0:.3f} [{lo0:.3f}, {hi0:.3f}] | "
                   f"{m1:.3f} [{lo1:.3f}, {hi1:.3f}] | {'yes' if lo1 > hi0 else 'no'} |")
         wall = float(config.get("total_wall_time_s") or config.get("wall_time_s") or 0.0)
-        print(f"  {run}: {config['steps']:,} steps in {wall / 60:.0f} min, "
-              f"{config['steps'] / max(wall, 1e-9):.0f} steps/s")
+        env_steps = config["steps"] * run_repeat(config)
+        print(f"  {run}: {env_steps:,} env steps ({config['steps']:,} decisions) in "
+              f"{wall / 60:.0f} min, {env_steps / max(wall, 1e-9):.0f} env steps/s")
     for ax, metric in zip(axes, ("return", "coverage"), strict=True):
         for (name, level), style in zip(levels.items(), (":", "--", "-."), strict=True):
             ax.axhline(level[metric], color="grey", linestyle=style, label=name)

@@ -39,6 +39,8 @@ class Policy(NamedTuple):
     example: int = 0  # a run's timesteps, for the help's time estimate
 
 
+#: Decisions a second of one wheels-ppo training run (docs/results/training.md).
+WHEELS_DECISIONS_PER_S = 300.0
 #: By env id (and ``env`` for any other env, with no wrapper in its hyperparameters).
 POLICIES = {
     # 30,000 decisions in ~35 min, 9 of them cloning (the shipped SfW-ExploreRegions-v0_1)
@@ -57,7 +59,16 @@ POLICIES = {
         0.0,
         200_000,
     ),
-    # ppo.yml wraps SfW-Explore-v0 in WaypointWrapper: ~48 waypoints/s (SfW-Explore-v0_1's run)
+    # ppo.yml's SfW-Explore-v0 block: a wheel command every 4 env steps (ActionRepeat);
+    # WHEELS_DECISIONS_PER_S from the shipped runs (SfW-Explore-v0_2)
+    "wheels": Policy(
+        "the wheels policy of wheels-ppo, from scratch",
+        "one decision (a wheel command held for 4 env steps)",
+        WHEELS_DECISIONS_PER_S,
+        0.0,
+        500_000,
+    ),
+    # an older block wrapped SfW-Explore-v0 in WaypointWrapper: ~48 waypoints/s (v0_1's run)
     "waypoint": Policy(
         "the block-waypoint policy of waypoint-ppo",
         "one waypoint (about 35 env steps, at most 60)",
@@ -80,6 +91,8 @@ def policy_of(env_id: str, params: dict[str, Any]) -> Policy:
     """What training on ``env_id`` with the hyperparameter block ``params`` learns."""
     if "WaypointWrapper" in str(params.get("env_wrapper")):
         return POLICIES["waypoint"]
+    if "ActionRepeat" in str(params.get("env_wrapper")):
+        return POLICIES["wheels"]
     return POLICIES.get(env_id.rpartition(":")[2], POLICIES["env"])
 
 
@@ -93,7 +106,7 @@ def describe() -> str:
     for env_id, key, algo in (
         ("SfW-ExploreRegions-v0", "SfW-ExploreRegions-v0", "ppo_mask"),
         ("SfW-ExploreGoals-v0", "SfW-ExploreGoals-v0", "ppo_mask"),
-        (f"{DEFAULT_ENV} (the default --env)", "waypoint", "ppo"),
+        (f"{DEFAULT_ENV} (the default --env)", "wheels", "ppo"),
     ):
         policy = POLICIES[key]
         took = duration(policy.fixed_s + policy.example / (policy.per_second or 1.0))
@@ -185,6 +198,11 @@ def add_options(parser: argparse.ArgumentParser) -> None:
         default=None,
         help=f"with --backend rllib: a Ray cluster's address ('auto') (default: {LOCAL_RAY})",
     )
+    parser.add_argument(
+        "--device",
+        default="auto",
+        help="PyTorch device of the policy: auto (a GPU where there is one), cpu, cuda, ...",
+    )
     parser.add_argument("--resume", action="store_true", help="continue from the last checkpoint")
     add_no_progress(parser)
 
@@ -238,6 +256,7 @@ def run(args: argparse.Namespace) -> int:
         progress_bar=not args.no_progress,
         num_threads=args.num_threads or None,
         vec_env=args.vec_env,
+        device=args.device,
     )
     print(
         f"trained {args.env} to "

@@ -262,6 +262,20 @@ def _make_env_fn(env_id: str, env_kwargs: dict[str, Any], wrappers: list[tuple[s
     return make
 
 
+#: The one env wrapper the native vector env applies itself (SB3VecEnv's ``action_repeat``).
+ACTION_REPEAT = "sfw_gym.envs.action_repeat.ActionRepeat"
+
+
+def native_action_repeat(wrappers: list[tuple[str, dict]]) -> int | None:
+    """The action repeat with which the native vector env steps envs wrapped so (1 unwrapped),
+    or None when the wrappers need envs of their own (SubprocVecEnv)."""
+    if not wrappers:
+        return 1
+    if len(wrappers) == 1 and wrappers[0][0] == ACTION_REPEAT:
+        return int(wrappers[0][1].get("repeat", 4))
+    return None
+
+
 #: ``vec_env`` choices of `train_ppo`: the native vector env in this process (each sub-env a
 #: bare env; with an ``env_wrapper``, SubprocVecEnv instead), or SB3's worker processes.
 VEC_ENVS = ("native", "subproc")
@@ -281,7 +295,8 @@ def _make_venv(
     # Workers start by forkserver and have not imported sfw_gym: name the module in the id.
     qualified = env_id if ":" in env_id else f"sfw_gym:{env_id}"
     venv: Any
-    if n_envs > 1 and vec_env == "native" and not wrappers:
+    repeat = native_action_repeat(wrappers)
+    if n_envs > 1 and vec_env == "native" and repeat is not None:
         import gymnasium as gym
 
         from sfw_gym.rl.vec_env import SB3VecEnv
@@ -289,7 +304,8 @@ def _make_venv(
         venv = SB3VecEnv(
             gym.make_vec(
                 qualified, num_envs=n_envs, vectorization_mode="vector_entry_point", **env_kwargs
-            )
+            ),
+            action_repeat=repeat,
         )
     else:
         fns = [_make_env_fn(qualified, env_kwargs, wrappers) for _ in range(n_envs)]

@@ -15,6 +15,8 @@ import gymnasium as gym
 import numpy as np
 from stable_baselines3.common.vec_env.base_vec_env import VecEnv, VecEnvObs, VecEnvStepReturn
 
+from sfw_gym.core.errors import ConfigError
+
 
 def unbatch_infos(infos: dict[str, Any], n: int) -> list[dict[str, Any]]:
     """A vector env's batched infos (arrays and ``_key`` masks) as one dict per sub-env."""
@@ -35,8 +37,11 @@ class SB3VecEnv(VecEnv):
     that takes ``options={"reset_mask": ...}`` (the native SfW env, ``gym.make_vec``'s default
     for the SfW ids). With the same seed it gives what ``DummyVecEnv`` of single envs gives."""
 
-    def __init__(self, venv: gym.vector.VectorEnv) -> None:
+    def __init__(self, venv: gym.vector.VectorEnv, action_repeat: int = 1) -> None:
+        if isinstance(action_repeat, bool) or not isinstance(action_repeat, int) or action_repeat < 1:
+            raise ConfigError(f"action_repeat must be an integer ≥ 1, got {action_repeat!r}")
         self.venv: Any = venv  # its get_attr and envs: the native env's
+        self.action_repeat = action_repeat
         super().__init__(venv.num_envs, venv.single_observation_space, venv.single_action_space)
         self._actions: Any = None
 
@@ -68,6 +73,23 @@ class SB3VecEnv(VecEnv):
         self._actions = actions
 
     def step_wait(self) -> VecEnvStepReturn:
+        """One step of every sub-env, or ``action_repeat`` steps with the same actions (the
+        rewards summed, as :class:`~sfw_gym.envs.action_repeat.ActionRepeat` does per env). A
+        sub-env whose episode ends within the repeats is reset at once, as SB3 does; the repeats
+        left step its new episode with the held action, their rewards not counted (episodes
+        whose step budget is a multiple of the repeat end on a boundary)."""
+        obs, rewards, dones, infos = self._step_once()
+        ended = dones.copy()
+        for _ in range(self.action_repeat - 1):
+            obs, more, more_dones, more_infos = self._step_once()
+            rewards += np.where(ended, 0.0, more).astype(np.float32)
+            for i in range(self.num_envs):
+                if not ended[i]:
+                    infos[i] = more_infos[i]
+            ended |= more_dones
+        return obs, rewards, ended, infos
+
+    def _step_once(self) -> VecEnvStepReturn:
         obs, rewards, terminated, truncated, batched = self.venv.step(self._actions)
         dones = terminated | truncated
         infos = unbatch_infos(batched, self.num_envs)

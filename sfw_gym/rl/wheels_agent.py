@@ -1,17 +1,24 @@
 """``wheels-ppo``: PPO trained from scratch on ``SfW-Explore-v0``'s own wheel commands.
 
 The policy (:class:`sfw_gym.rl.wheels_policy.WheelsPolicy`) reads the env's observation and
-names a (linear, angular) command every step: no planner, no waypoints, no teacher. The agent
-feeds it the observation the env returns, as in training.
+names a (linear, angular) command: no planner, no waypoints, no teacher. A policy trained with
+:class:`~sfw_gym.envs.action_repeat.ActionRepeat` (its run's ``config.yml`` says so) decides
+every ``repeat`` steps and holds its command in between, as in training.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
+
+import yaml
+
+from sfw_gym.agents.base import RobotView
 from sfw_gym.core.data import DEFAULT_WHEELS_MODEL_DIR
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.rl.agent import LearnedAgentSettings
+from sfw_gym.rl.training import native_action_repeat, wrapper_specs
 from sfw_gym.rl.waypoint_agent import WaypointPPOAgent
 
 
@@ -41,3 +48,23 @@ class WheelsPPOAgent(WaypointPPOAgent):
             raise ConfigError(
                 f"WheelsPPOAgent: {folder} holds a waypoint policy; use the waypoint-ppo agent"
             )
+        config = yaml.safe_load((folder / "config.yml").read_text(encoding="utf-8")) or {}
+        wrappers = wrapper_specs(config.get("hyperparameters", {}).get("env_wrapper"))
+        repeat = native_action_repeat(wrappers)
+        if repeat is None:
+            raise ConfigError(
+                f"WheelsPPOAgent: {folder} was trained through {[w for w, _ in wrappers]}, "
+                "which this agent cannot replay"
+            )
+        self.action_repeat = repeat
+
+    def _on_reset(self, view: RobotView) -> None:
+        super()._on_reset(view)
+        self._held, self._command = 0, (0.0, 0.0)
+
+    def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
+        if self._held == 0:  # a decision every action_repeat steps, as in training
+            self._command = super()._act(view, obs)
+            self._held = self.action_repeat
+        self._held -= 1
+        return self._command

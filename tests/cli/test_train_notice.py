@@ -3,18 +3,33 @@ timestep counts, roughly how long it takes, and which command trains the default
 
 from __future__ import annotations
 
-from sfw_gym.cli.train import DEFAULT_AGENT_COMMAND, _print_notice, describe, notice
+from sfw_gym.cli.train import (
+    DEFAULT_AGENT_COMMAND,
+    WHEELS_DECISIONS_PER_S,
+    _print_notice,
+    describe,
+    notice,
+)
 from sfw_gym.core.data import default_hyperparams
 from sfw_gym.rl.training import zoo_hyperparams
 
 
-def test_training_the_default_env_says_it_is_the_waypoint_policy_and_takes_an_hour(capsys):
-    _print_notice("SfW-Explore-v0", default_hyperparams("ppo"), 200_000)
+def test_training_the_default_env_says_it_is_the_wheels_policy_and_how_long(capsys):
+    _print_notice("SfW-Explore-v0", default_hyperparams("ppo"), 500_000)
     line = capsys.readouterr().out
     assert line.count("\n") == 1
+    assert "wheels-ppo, from scratch" in line
+    assert "one timestep is one decision (a wheel command held for 4 env steps)" in line
+    minutes = round(500_000 / WHEELS_DECISIONS_PER_S / 60)
+    assert f"500,000 timesteps take roughly {minutes} min" in line
+    assert f"trained by: {DEFAULT_AGENT_COMMAND}" in line
+
+
+def test_an_older_waypoint_block_says_it_is_the_waypoint_policy():
+    wrapped = {"env_wrapper": [{"sfw_gym.envs.waypoint.WaypointWrapper": {}}]}
+    line = notice("SfW-Explore-v0", wrapped, 200_000)
     assert "waypoint-ppo" in line and "one timestep is one waypoint (about 35 env steps" in line
     assert "200,000 timesteps take roughly 69 min" in line
-    assert f"trained by: {DEFAULT_AGENT_COMMAND}" in line
 
 
 def test_training_the_region_policy_says_it_is_the_default_agent():
@@ -36,6 +51,6 @@ def test_another_env_counts_env_steps_and_rllib_gives_no_time():
 
 def test_the_help_says_it_for_each_env():
     text = describe()
-    for words in ("regions-ppo, the default learned agent", "goals-ppo", "waypoint-ppo"):
+    for words in ("regions-ppo, the default learned agent", "goals-ppo", "wheels-ppo"):
         assert words in text
     assert DEFAULT_AGENT_COMMAND in text and "one env step" in text

@@ -76,3 +76,52 @@ def test_ppo_learns_on_the_adapter():
     model = PPO("MultiInputPolicy", venv, n_steps=16, batch_size=32, n_epochs=1, seed=0)
     model.learn(128)
     assert model.num_timesteps == 128
+
+
+def test_the_action_repeat_holds_each_action_and_sums_the_rewards():
+    """ActionRepeat(env, 4).step equals four steps of the bare env with that action (reward
+    summed, last observation); an episode's end cuts the repeat short."""
+    from sfw_gym.envs.action_repeat import ActionRepeat
+
+    wrapped, bare = ActionRepeat(gym.make(SMALL, max_steps=10), 4), gym.make(SMALL, max_steps=10)
+    wrapped.reset(seed=3)
+    bare.reset(seed=3)
+    rng = np.random.default_rng(1)
+    for expected_steps in (4, 4, 2):  # 10 steps: the last decision gets 2
+        action = rng.uniform(-1, 1, 2).astype(np.float32)
+        obs, reward, terminated, truncated, info = wrapped.step(action)
+        total = 0.0
+        for _ in range(expected_steps):
+            bare_obs, r, bare_term, bare_trunc, _ = bare.step(action)
+            total += r
+        assert reward == pytest.approx(total, abs=1e-12)
+        np.testing.assert_array_equal(obs["state"], bare_obs["state"])
+        assert (terminated, truncated) == (bare_term, bare_trunc)
+    assert truncated and info["max_steps"] == 10
+
+
+def test_the_native_action_repeat_gives_what_the_wrapper_gives_per_env():
+    from stable_baselines3.common.vec_env import DummyVecEnv
+
+    from sfw_gym.envs.action_repeat import ActionRepeat
+    from sfw_gym.rl.vec_env import SB3VecEnv
+
+    n, kwargs = 2, {"max_steps": 40}  # a multiple of the repeat: episodes end on a decision
+    ours = SB3VecEnv(gym.make_vec(SMALL, num_envs=n, **kwargs), action_repeat=4)
+    theirs = DummyVecEnv([lambda: ActionRepeat(gym.make(SMALL, **kwargs), 4)] * n)
+    for venv in (ours, theirs):
+        venv.seed(11)
+    a, b = ours.reset(), theirs.reset()
+    rng = np.random.default_rng(2)
+    ends = 0
+    for _ in range(25):  # 100 env steps: two episodes and a half each
+        np.testing.assert_array_equal(a["map"], b["map"])
+        actions = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
+        a, ra, da, _ = ours.step(actions)
+        b, rb, db, _ = theirs.step(actions)
+        np.testing.assert_allclose(ra, rb, rtol=1e-6)
+        np.testing.assert_array_equal(da, db)
+        ends += int(db.sum())
+    assert ends == 2 * n
+    with pytest.raises(Exception, match="action_repeat must be an integer"):
+        SB3VecEnv(gym.make_vec(SMALL, num_envs=n), action_repeat=0)

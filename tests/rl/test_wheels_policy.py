@@ -13,7 +13,13 @@ import yaml
 import sfw_gym  # noqa: F401
 from sfw_gym.core.data import DEFAULT_HYPERPARAMS
 from sfw_gym.core.errors import ConfigError
-from sfw_gym.rl.training import load_hyperparams, parse_policy_kwargs, train_ppo
+from sfw_gym.rl.training import (
+    load_hyperparams,
+    native_action_repeat,
+    parse_policy_kwargs,
+    train_ppo,
+    wrapper_specs,
+)
 from sfw_gym.rl.wheels_agent import WheelsPPOAgent
 from sfw_gym.rl.wheels_policy import EgoMaps, WheelsPolicy, robot_centre
 
@@ -131,7 +137,8 @@ def test_the_recipe_trains_the_wheels_policy(wheels_run):
 def test_the_shipped_block_is_the_wheels_recipe():
     params = load_hyperparams("SfW-Explore-v0")
     assert params["policy"] == "sfw_gym.rl.wheels_policy.WheelsPolicy"
-    assert "env_wrapper" not in params  # the native vector env steps it unwrapped
+    # the one wrapper the native vector env applies itself
+    assert native_action_repeat(wrapper_specs(params["env_wrapper"])) == 4
 
 
 def run_agent(agent: WheelsPPOAgent, seed: int, steps: int, agent_seed: int = 0) -> np.ndarray:
@@ -150,8 +157,11 @@ def run_agent(agent: WheelsPPOAgent, seed: int, steps: int, agent_seed: int = 0)
 def test_the_agent_same_seed_same_actions_and_sampling_follows_its_own_seed(wheels_run):
     out, _ = wheels_run
     deterministic = WheelsPPOAgent(path=out)
+    assert deterministic.action_repeat == 4  # from the run's config, as trained
     a, b = run_agent(deterministic, 3, 40), run_agent(deterministic, 3, 40)
     assert np.array_equal(a, b)
+    held = a.reshape(10, 4, 2)  # one decision every 4 steps, held
+    assert np.all(held == held[:, :1])
     sampled = WheelsPPOAgent(path=out, deterministic=False)
     torch.manual_seed(0)
     c = run_agent(sampled, 3, 40, agent_seed=1)
@@ -159,6 +169,20 @@ def test_the_agent_same_seed_same_actions_and_sampling_follows_its_own_seed(whee
     d = run_agent(sampled, 3, 40, agent_seed=1)
     assert np.array_equal(c, d)
     assert not np.array_equal(c, run_agent(sampled, 3, 40, agent_seed=2))
+
+
+def test_the_agent_refuses_a_policy_trained_through_another_wrapper(tmp_path):
+    (tmp_path / "config.yml").write_text(
+        yaml.safe_dump(
+            {
+                "env_id": "SfW-Explore-v0",
+                "hyperparameters": {"env_wrapper": "gymnasium.wrappers.TimeLimit"},
+            }
+        )
+    )
+    (tmp_path / "SfW-Explore-v0.zip").write_bytes(b"")
+    with pytest.raises(ConfigError, match="cannot replay"):
+        WheelsPPOAgent(path=tmp_path)
 
 
 def test_the_agent_refuses_a_waypoint_policy_folder(tmp_path):
