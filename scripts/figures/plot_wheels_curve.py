@@ -2,7 +2,7 @@
 with random actions', random waypoints' and frontier's levels drawn in (rl-zoo's benchmark plots).
 
     python scripts/figures/plot_wheels_curve.py RUN [RUN ...] [--episodes 5] [--seed 1000000]
-        [--out docs/figures/wheels_ppo_curve.png] [--write-docs docs/results/training.md]
+        [--out docs/figures/wheels_ppo_curve.png] [--write-docs]
 
 Each RUN is a ``sfw-gym train ppo --env SfW-Explore-v0`` output folder (one training seed). Every
 checkpoint in ``RUN/checkpoints`` is evaluated, its policy deterministic, on the same held-out
@@ -10,7 +10,8 @@ validation plans (env seeds ``--seed`` + i, never trained on), the episodes step
 the native vector env; the figures are cached in ``RUN/heldout.csv`` so that a rerun evaluates
 only new checkpoints. The levels are measured on the same plans. Printed: per seed, the mean of
 the first and of the last tenth of the evaluations with 95 % t-intervals over their episodes,
-and the run's steps per second and wall time from its ``config.yml``.
+the run's steps per second and wall time from its ``config.yml``, and the PPO diagnostics of
+its TensorBoard log; ``--write-docs`` writes these tables into docs/results/training.md.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import csv
 import json
 import math
 import re
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -31,7 +33,11 @@ import sfw_gym  # noqa: F401  (registration)
 from sfw_gym.evaluation.stats import mean_ci95
 from sfw_gym.rl.training import native_action_repeat, wrapper_specs
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))  # _docs
+from _docs import command_line, write_block
+
 ENV_ID = "SfW-Explore-v0"
+DETERMINISTIC = True
 COLUMNS = ("steps", "episode", "return", "coverage")
 #: What SB3 logs per PPO update (and sfw-gym train per head), in the diagnostics table.
 DIAGNOSTICS = (
@@ -75,7 +81,7 @@ def policy_act(model_path: Path, repeat: int = 1):
 
     def act(obs: dict[str, np.ndarray]) -> np.ndarray:
         if held["calls"] % repeat == 0:
-            held["actions"] = model.predict(obs, deterministic=True)[0]
+            held["actions"] = model.predict(obs, deterministic=DETERMINISTIC)[0]
         held["calls"] += 1
         return held["actions"]
 
@@ -114,8 +120,11 @@ def evaluate_run(run: Path, episodes: int, seed: int) -> list[dict[str, float]]:
             {"steps": steps, "episode": i, "return": returns[i], "coverage": coverage[i]}
             for i in range(episodes)
         ]
-        print(f"{run.name} {steps:>9,} steps: return {returns.mean():6.2f}, "
-              f"coverage {coverage.mean():.3f}", flush=True)
+        print(
+            f"{run.name} {steps:>9,} steps: return {returns.mean():6.2f}, "
+            f"coverage {coverage.mean():.3f}",
+            flush=True,
+        )
         with cache.open("w", encoding="utf-8", newline="") as fh:
             writer = csv.DictWriter(fh, fieldnames=COLUMNS)
             writer.writeheader()
@@ -141,16 +150,13 @@ def reference_levels(episodes: int, seed: int) -> dict[str, dict[str, float]]:
             if name == "random waypoints":
                 env = WaypointWrapper(env)
                 env.action_space.seed(seed + i)
-                obs, info = env.reset(seed=seed + i)
-                act = lambda _obs: env.action_space.sample()  # noqa: E731
-            else:
-                obs, info = env.reset(seed=seed + i)
-                agent = make_agent("frontier")
-                agent.reset(env, seed=seed + i)
-                act = agent.act
+            obs, info = env.reset(seed=seed + i)
+            agent = make_agent("frontier")
+            agent.reset(env, seed=seed + i)
             done = False
             while not done:
-                obs, reward, terminated, truncated, info = env.step(act(obs))
+                action = env.action_space.sample() if name != "frontier" else agent.act(obs)
+                obs, reward, terminated, truncated, info = env.step(action)
                 ret[i] += float(reward)
                 done = terminated or truncated
             cov[i] = info["coverage"]
@@ -200,6 +206,7 @@ def main() -> None:
     p.add_argument("--episodes", type=int, default=5)
     p.add_argument("--seed", type=int, default=1_000_000, help="first held-out env seed")
     p.add_argument("--out", type=Path, default=Path("docs/figures/wheels_ppo_curve.png"))
+    p.add_argument("--write-docs", action="store_true", help="the tables into training.md")
     args = p.parse_args()
     import matplotlib
 
@@ -215,7 +222,8 @@ def main() -> None:
         levels_file.write_text(json.dumps(levels, indent=1), encoding="utf-8")
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4))
-    print("\n| seed | metric | first tenth | last tenth | rose |\n|---|---|---|---|---|")
+    rose = ["| seed | metric | first tenth | last tenth | rose |", "|---|---|---|---|---|"]
+    times = ["| seed | env steps (decisions) | wall time | env steps/s |", "|---|---|---|---|"]
     for run, rows in runs.items():
         config = yaml.safe_load((run / "config.yml").read_text(encoding="utf-8"))
         steps = np.array(sorted({r["steps"] for r in rows}))
@@ -223,12 +231,16 @@ def main() -> None:
             mean = [np.mean([r[metric] for r in rows if r["steps"] == s]) for s in steps]
             ax.plot(steps, mean, marker=".", label=f"seed {config.get('seed')}")
             (m0, lo0, hi0), (m1, lo1, hi1) = tenths(rows, metric)
-            print(f"| {config.get('seed')} | {metric} | {m0:.3f} [{lo0:.3f}, {hi0:.3f}] | "
-                  f"{m1:.3f} [{lo1:.3f}, {hi1:.3f}] | {'yes' if lo1 > hi0 else 'no'} |")
+            rose.append(
+                f"| {config.get('seed')} | {metric} | {m0:.3f} [{lo0:.3f}, {hi0:.3f}] | "
+                f"{m1:.3f} [{lo1:.3f}, {hi1:.3f}] | {'yes' if lo1 > hi0 else 'no'} |"
+            )
         wall = float(config.get("total_wall_time_s") or config.get("wall_time_s") or 0.0)
         env_steps = config["steps"] * run_repeat(config)
-        print(f"  {run}: {env_steps:,} env steps ({config['steps']:,} decisions) in "
-              f"{wall / 60:.0f} min, {env_steps / max(wall, 1e-9):.0f} env steps/s")
+        times.append(
+            f"| {config.get('seed')} | {env_steps:,} ({config['steps']:,}) | {wall / 60:.0f} min "
+            f"| {env_steps / max(wall, 1e-9):,.0f} |"
+        )
     for ax, metric in zip(axes, ("return", "coverage"), strict=True):
         for (name, level), style in zip(levels.items(), (":", "--", "-."), strict=True):
             ax.axhline(level[metric], color="grey", linestyle=style, label=name)
@@ -240,11 +252,26 @@ def main() -> None:
     fig.tight_layout()
     args.out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(args.out, dpi=110)
-    print("\n| run | logged per update | first tenth | middle tenth | last tenth |")
-    print("|---|---|---:|---:|---:|")
-    for run in runs:
-        print("\n".join(training_diagnostics(run)))
-    print("levels:", json.dumps(levels))
+    diagnostics = [
+        "| run | logged per update | first tenth | middle tenth | last tenth |",
+        "|---|---|---:|---:|---:|",
+        *(row for run in runs for row in training_diagnostics(run)),
+    ]
+    level_rows = ["| level | return | coverage |", "|---|---:|---:|"] + [
+        f"| {name} | {level['return']:.2f} | {level['coverage']:.3f} |"
+        for name, level in levels.items()
+    ]
+    blocks = {
+        "wheels_curve": [f"`{command_line()}`:", "", *rose, "", *level_rows],
+        "wheels_time": times,
+        "wheels_diagnostics": diagnostics,
+    }
+    for lines in blocks.values():
+        print("\n".join(lines) + "\n")
+    if args.write_docs:
+        page = Path(__file__).resolve().parents[2] / "docs" / "results" / "training.md"
+        for name, lines in blocks.items():
+            write_block(page, name, lines)
     print(f"wrote {args.out}")
 
 

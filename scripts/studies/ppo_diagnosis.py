@@ -184,9 +184,7 @@ def ranking(
     out: dict[str, list[dict[str, Any]] | None] = {}
     for b in behaviours:
         try:
-            out[b] = [
-                run_episode(env, b, seed0 + i, trace=b in traced) for i in range(episodes)
-            ]
+            out[b] = [run_episode(env, b, seed0 + i, trace=b in traced) for i in range(episodes)]
         except ConfigError as exc:
             print(f"  {env_id}: {b} n/a ({exc})")
             out[b] = None

@@ -1,8 +1,9 @@
 """PPO on the wheels against frontier and random actions, paired on the same plans and seeds.
 
-    python scripts/studies/wheels_study.py --episodes 50 --seed 2000000 --out runs/wheels_test
+    python scripts/studies/wheels_study.py --episodes 50 --seed 2000000 --out runs/wheels_test \
+        --write-docs wheels_test
     python scripts/studies/wheels_study.py --episodes 11 \
-        --floorplans ../shared/floorplans/houseexpo --out runs/wheels_hx
+        --floorplans ../shared/floorplans/houseexpo --out runs/wheels_hx --write-docs wheels_hx
     python scripts/studies/wheels_study.py --model runs/wheels_s1 --episodes 10 \
         --seed 1000000 --out runs/wheels_val      # a run of one's own, on validation seeds
 
@@ -12,12 +13,14 @@ on the env's defaults (3,000 steps). Prints per agent the mean coverage and retu
 own reward: 0.01 per bit less 0.1 per contact step, recomputed from the record), the geometric
 mean of the per-plan coverage ratios to frontier's, and the return's paired difference from
 random actions', each with a 95 % paired bootstrap interval (the package's ``bootstrap_ci``).
+``--write-docs NAME`` writes the table into the block NAME of docs/results/training.md.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +28,9 @@ import numpy as np
 from sfw_gym.envs.config import RewardConfig
 from sfw_gym.evaluation.runner import evaluate
 from sfw_gym.evaluation.stats import bootstrap_ci
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))  # _docs
+from _docs import command_line, write_block
 
 WHEELS = "sfw_gym.rl.wheels_agent:WheelsPPOAgent"
 #: The rows: label → (agent name or entry point, parameters).
@@ -59,6 +65,7 @@ def main() -> None:
     p.add_argument("--model", default=None, help="wheels-ppo's model folder (default: shipped)")
     p.add_argument("--out", default="runs/wheels_study")
     p.add_argument("--workers", type=int, default=2)
+    p.add_argument("--write-docs", default=None, metavar="BLOCK", help="training.md's block")
     args = p.parse_args()
 
     names, params = [], {}
@@ -87,7 +94,8 @@ def main() -> None:
     frontier, rand = column("frontier", "coverage"), column("random", "return")
     lines = [
         f"{len(episodes)} paired episodes (seed {args.seed}"
-        + (f", plans {args.floorplans}" if args.floorplans else "") + ")",
+        + (f", plans {args.floorplans}" if args.floorplans else "")
+        + ")",
         "",
         "| agent | coverage | coverage ÷ frontier (geometric mean, 95 % CI) | return "
         "| return − random actions' (95 % CI) | contact steps |",
@@ -109,6 +117,9 @@ def main() -> None:
             f"{column(name, 'collisions').mean():.0f} |"
         )
     text = "\n".join(lines)
+    if args.write_docs:
+        page = Path(__file__).resolve().parents[2] / "docs" / "results" / "training.md"
+        write_block(page, args.write_docs, [f"`{command_line()}`:", "", *lines])
     Path(args.out, "wheels.md").write_text(text + "\n", encoding="utf-8")
     Path(args.out, "wheels.json").write_text(json.dumps(summary, indent=1), encoding="utf-8")
     print(text)

@@ -113,4 +113,8 @@ def __getattr__(name: str) -> Any:
         from sfw_gym.envs.waypoint import WaypointWrapper
 
         return WaypointWrapper
+    if name == "ActionRepeat":
+        from sfw_gym.envs.action_repeat import ActionRepeat
+
+        return ActionRepeat
     raise AttributeError(name)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import math
 from pathlib import Path
@@ -447,6 +448,12 @@ class SfWExploreEnv(gym.Env):
     def trajectory(self) -> np.ndarray:
         """The true positions so far, ``(n, 2)``, one per reading (a read-only view)."""
         return self.true_path.view
+
+    def set_max_steps(self, max_steps: int) -> None:
+        """The step budget (``max_steps``) of the episodes that start from the next reset on:
+        a training curriculum's stage (``sfw_gym.rl.training``); the running episode keeps its."""
+        explore = dataclasses.replace(self.config.explore, max_steps=max_steps)
+        self.config = dataclasses.replace(self.config, explore=explore)
 
     # ------------------------------------------------------------------------------ robot's view
     def robot_view(self) -> RobotView:

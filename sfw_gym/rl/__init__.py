@@ -13,4 +13,11 @@ from sfw_gym.rl.training import load_hyperparams, train_ppo
 from sfw_gym.rl.waypoint_agent import WaypointPPOAgent
 from sfw_gym.rl.wheels_agent import WheelsPPOAgent
 
-__all__ = ["PPOAgent", "RegionsPPOAgent", "WaypointPPOAgent", "WheelsPPOAgent", "load_hyperparams", "train_ppo"]
+__all__ = [
+    "PPOAgent",
+    "RegionsPPOAgent",
+    "WaypointPPOAgent",
+    "WheelsPPOAgent",
+    "load_hyperparams",
+    "train_ppo",
+]

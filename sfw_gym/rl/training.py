@@ -54,8 +54,8 @@ ALGOS = ("ppo", "ppo_mask")
 #: there that it does not know to the model's constructor.
 PROJECT_BLOCK = "sfw_gym"
 #: The keys of the project block: behaviour cloning before PPO, AnchoredMaskablePPO's
-#: fine-tuning, the no-mask ablation.
-PROJECT_KEYS = frozenset({"behaviour_cloning", "fine_tuning", "use_masking"})
+#: fine-tuning, the no-mask ablation, the training episodes' curriculum (:func:`curriculum`).
+PROJECT_KEYS = frozenset({"behaviour_cloning", "fine_tuning", "use_masking", "curriculum"})
 #: The keys rl-zoo reads from an env id's block (the rest of :data:`_PPO_KEYS` go to PPO).
 _ZOO_KEYS = frozenset({"policy", "n_timesteps", "n_envs", "env_wrapper", "env_kwargs"})
 _PPO_KEYS = {
@@ -237,6 +237,50 @@ def import_dotted(name: str) -> Any:
         raise ConfigError(f"cannot import {name!r}: {exc}") from None
 
 
+def curriculum_stages(value: Any) -> list[tuple[int, int]]:
+    """The project block's ``curriculum``: a list of ``{from_timestep: T, max_steps: N}``, the
+    training episodes' step budget from timestep T on (before the first: ``env_kwargs``'), as
+    sorted ``(T, N)`` pairs."""
+    if value is None:
+        return []
+    stages = []
+    for entry in value if isinstance(value, list) else [value]:
+        if not (isinstance(entry, dict) and set(entry) == {"from_timestep", "max_steps"}):
+            raise ConfigError(
+                f"curriculum: each stage is {{from_timestep: T, max_steps: N}}, got {entry!r}"
+            )
+        start, steps = entry["from_timestep"], entry["max_steps"]
+        if not all(isinstance(v, int) and not isinstance(v, bool) for v in (start, steps)) or (
+            start < 0 or steps < 1
+        ):
+            raise ConfigError(f"curriculum: T must be ≥ 0 and N ≥ 1 (integers), got {entry!r}")
+        stages.append((start, steps))
+    return sorted(stages)
+
+
+def episode_budget_curriculum(stages: list[tuple[int, int]], venv: Any) -> Any:
+    """An SB3 callback that sets the training envs' step budget (``set_max_steps``) to the
+    :func:`curriculum_stages` stage due at each rollout's start, for the episodes that begin
+    from then on (a resumed run's too)."""
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    class EpisodeBudgetCurriculum(BaseCallback):
+        def _init_callback(self) -> None:
+            self.current: int | None = None
+
+        def _on_rollout_start(self) -> None:
+            due = [steps for start, steps in stages if start <= self.model.num_timesteps]
+            if due and due[-1] != self.current:
+                self.current = due[-1]
+                venv.env_method("set_max_steps", self.current)
+                logger.info("curriculum: episodes of %d steps from now on", self.current)
+
+        def _on_step(self) -> bool:
+            return True
+
+    return EpisodeBudgetCurriculum()
+
+
 def latest_checkpoint(out_dir: Path, algo: str = "ppo") -> tuple[Path, int] | None:
     """The checkpoint with the most env steps in ``OUT/checkpoints``, if any."""
     found = []
@@ -387,6 +431,7 @@ def train_ppo(
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise ConfigError(f"{name} must be an integer ≥ 1, got {value!r}")
     fine_tuning = dict(params.get("fine_tuning") or {})
+    stages = curriculum_stages(params.get("curriculum"))
     if algo == "ppo":
         if fine_tuning:
             raise ConfigError("fine_tuning needs algo ppo_mask (a cloned candidate policy)")
@@ -486,6 +531,7 @@ def train_ppo(
                 evaluations.n_calls = start_steps // n_envs  # and keeps their schedule
             callbacks = CallbackList(
                 [
+                    *([episode_budget_curriculum(stages, venv)] if stages else []),
                     *grad_norms,
                     resumable_checkpoints(
                         checkpoint_every, out / "checkpoints", algo, venv, eval_env

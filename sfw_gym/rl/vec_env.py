@@ -38,7 +38,11 @@ class SB3VecEnv(VecEnv):
     for the SfW ids). With the same seed it gives what ``DummyVecEnv`` of single envs gives."""
 
     def __init__(self, venv: gym.vector.VectorEnv, action_repeat: int = 1) -> None:
-        if isinstance(action_repeat, bool) or not isinstance(action_repeat, int) or action_repeat < 1:
+        if (
+            isinstance(action_repeat, bool)
+            or not isinstance(action_repeat, int)
+            or action_repeat < 1
+        ):
             raise ConfigError(f"action_repeat must be an integer ≥ 1, got {action_repeat!r}")
         self.venv: Any = venv  # its get_attr and envs: the native env's
         self.action_repeat = action_repeat

@@ -97,7 +97,9 @@ class WaypointPPOAgent(Agent):
         try:
             config = yaml.safe_load(config_path.read_text(encoding="utf-8")) or {}
         except yaml.YAMLError as exc:
-            raise ConfigError(f"{type(self).__name__}: {config_path}: not valid YAML ({exc})") from None
+            raise ConfigError(
+                f"{type(self).__name__}: {config_path}: not valid YAML ({exc})"
+            ) from None
         self.waypoints = waypoint_settings(config)
         self._check_policy_kind(folder)
         self.model = _load_model(str(model_path), device)
@@ -158,8 +160,9 @@ class WaypointPPOAgent(Agent):
         if differ:
             got = {k: np.shape(obs.get(k)) for k in differ}
             raise ConfigError(
-                f"{type(self).__name__}: the policy in {self.settings.path} was trained on observations "
-                f"{differ}; this env gives {got} (map_px, crop_px and n_routers must match)"
+                f"{type(self).__name__}: the policy in {self.settings.path} was trained on "
+                f"observations {differ}; this env gives {got} (map_px, crop_px and n_routers "
+                "must match)"
             )
         self._obs_checked = True
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 from typing import Any
 
 import torch
-import torch.nn.functional as F  # noqa: N812
+import torch.nn.functional as F
 from gymnasium import spaces
 from stable_baselines3.common.policies import MultiInputActorCriticPolicy
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
@@ -48,7 +48,7 @@ def ego_grid(sin: torch.Tensor, cos: torch.Tensor, centre: torch.Tensor, size: i
 
 def robot_centre(trajectory: torch.Tensor) -> torch.Tensor:
     """The robot's normalised (x, y) on the ``map`` image: the mean of its marker's pixels."""
-    n, h, w = trajectory.shape
+    _, h, w = trajectory.shape
     mark = (trajectory >= ROBOT_MARK).float()
     count = mark.sum(dim=(1, 2)).clamp(min=1.0)
     rows = torch.arange(h, dtype=trajectory.dtype, device=trajectory.device)
@@ -102,9 +102,7 @@ class EgoMaps(BaseFeaturesExtractor):
         sin, cos = state[:, SIN_INDEX], state[:, COS_INDEX]
         local = observations["local"] * 2 - 1
         centre = torch.zeros(state.shape[0], 2, dtype=state.dtype, device=state.device)
-        local = F.grid_sample(
-            local, ego_grid(sin, cos, centre, self.local_px), align_corners=False
-        )
+        local = F.grid_sample(local, ego_grid(sin, cos, centre, self.local_px), align_corners=False)
         image = observations["map"]
         scale = torch.ones(image.shape[1], 1, 1, dtype=image.dtype, device=image.device)
         scale[0] = 2.0  # the belief channel only: 2 b - 1, the others as they are
@@ -136,7 +134,11 @@ class WheelsPolicy(MultiInputActorCriticPolicy):
             "actor": [
                 *self.mlp_extractor.policy_net.parameters(),
                 *self.action_net.parameters(),
-                *([self.log_std] if isinstance(self.log_std, nn.Parameter) else []),
+                *(
+                    [self.log_std]
+                    if isinstance(getattr(self, "log_std", None), nn.Parameter)
+                    else []
+                ),
             ],
             "critic": [*self.mlp_extractor.value_net.parameters(), *self.value_net.parameters()],
         }

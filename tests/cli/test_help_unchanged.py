@@ -86,6 +86,13 @@ CORRECTIONS: dict[str, list[tuple[str, str]]] = {
             "CPU threads (1 suits the small networks; 0: PyTorch's own choice) --backend",
         ),
         ("(stable-baselines3, default)", "(stable-baselines3)"),
+        # --device (issue 50): the long runs on a GPU where there is one
+        ("[--address ADDRESS] [--resume]", "[--address ADDRESS] [--device DEVICE] [--resume]"),
+        (
+            "cluster's address ('auto') --resume",
+            "cluster's address ('auto') --device DEVICE PyTorch device of the policy: auto (a GPU "
+            "where there is one), cpu, cuda,... --resume",
+        ),
     ],
 }
 

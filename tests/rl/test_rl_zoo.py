@@ -105,14 +105,15 @@ def test_rl_zoo_trains_from_the_shipped_hyperparameters(
 
 def test_rl_zoo_enjoy_replays_the_shipped_agent(tmp_path):
     """The shipped wheels policy, found by rl-zoo as the latest ``ppo`` run of the env
-    (``agents/ppo/SfW-Explore-v0_2``) and loaded with no custom unpickler: one whole episode."""
+    (``agents/ppo/SfW-Explore-v0_2``) and loaded with no custom unpickler, on the env its saved
+    config makes: ActionRepeat around the env with the training's kwargs (600-step episodes;
+    rl-zoo knows nothing of sfw-gym's curriculum). 300 decisions: two whole episodes."""
     out = zoo(
-        "enjoy", "--algo", "ppo", "--env", "SfW-Explore-v0", "-f", "agents", "-n", "3000",
+        "enjoy", "--algo", "ppo", "--env", "SfW-Explore-v0", "-f", "agents", "-n", "300",
         "--no-render", "--device", "cpu", "--reward-log", str(tmp_path), *COMMON,
     )  # fmt: skip
     assert "Loading agents/ppo/SfW-Explore-v0_2/SfW-Explore-v0.zip" in out
-    (episode,) = episodes(tmp_path)
-    assert int(episode[1]) <= 3000  # the env's own limit (or the coverage target before it)
+    assert [int(e[1]) for e in episodes(tmp_path)] == [600, 600]  # env steps, 150 decisions each
 
 
 def test_rl_zoo_enjoy_replays_a_run_of_sfw_gym_train(tmp_path):

@@ -17,6 +17,7 @@ import pytest
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.rl.training import (
     DEFAULT_HYPERPARAMS,
+    curriculum_stages,
     latest_checkpoint,
     load_hyperparams,
     parse_policy_kwargs,
@@ -29,8 +30,10 @@ SMALL_ID = "SfW-ExploreSmall-v0"
 
 def test_hyperparams_load_for_every_block():
     params = load_hyperparams("SfW-Explore-v0")
-    assert params["policy"] == "sfw_gym.rl.policy.WaypointPolicy"
-    assert params["env_wrapper"][0]["sfw_gym.envs.waypoint.WaypointWrapper"]["grid_cells"] == 8
+    assert params["policy"] == "sfw_gym.rl.wheels_policy.WheelsPolicy"
+    assert params["env_wrapper"][0]["sfw_gym.envs.action_repeat.ActionRepeat"]["repeat"] == 4
+    assert params["policy_kwargs"]["log_std_init"] == -2.0  # a signed number, parsed
+    assert params["curriculum"] == [{"from_timestep": 250_000, "max_steps": 3000}]
     small = load_hyperparams("SfW-ExploreSmall-v0")
     assert small["policy_kwargs"]["net_arch"] == {"pi": [64], "vf": [64]}
     with pytest.raises(ConfigError, match="no hyperparameters"):
@@ -509,3 +512,40 @@ def test_n_envs_step_in_the_native_vector_env_unless_wrapped_or_told_otherwise(t
             venv.close()
     with pytest.raises(ConfigError, match="unknown vec_env 'dummy'"):
         train_ppo(SMALL_ID, 64, tmp_path / "run", vec_env="dummy", progress_bar=False)
+
+
+@pytest.mark.slow
+def test_the_curriculum_lengthens_the_episodes_that_start_after_its_stage(tmp_path):
+    """Episodes of env_kwargs' 40 steps until timestep 128, then of the stage's 20; the episodes
+    running at the switch keep their budget (monitor lengths, in order per sub-env)."""
+    import pandas as pd
+    import yaml
+
+    block = {
+        "policy": "MultiInputPolicy", "n_envs": 2, "n_steps": 32, "batch_size": 32,
+        "n_epochs": 1, "env_kwargs": {"max_steps": 40},
+        "policy_kwargs": "dict(net_arch=[8])",
+    }  # fmt: skip
+    project = {"SfW-ExploreSmall-v0": {"curriculum": [{"from_timestep": 128, "max_steps": 20}]}}
+    hyper = tmp_path / "ppo.yml"
+    hyper.write_text(yaml.safe_dump({"SfW-ExploreSmall-v0": block, "sfw_gym": project}))
+    train_ppo(
+        "SfW-ExploreSmall-v0", 320, tmp_path, hyperparams_path=hyper, eval_every=10**6,
+        progress_bar=False,
+    )  # fmt: skip
+    lengths = pd.read_csv(tmp_path / "train_0.monitor.csv", skiprows=1)["l"].tolist()
+    # each sub-env steps 64 times before the switch: its first episode (40) ends before it,
+    # its second (begun at step 40) keeps its 40; every episode begun after it has 20
+    assert lengths[:4] == [40, 40, 40, 40] and set(lengths) == {40, 20}
+    first_short = lengths.index(20)
+    assert all(length == 20 for length in lengths[first_short:])
+    assert sum(lengths) <= 320
+
+
+def test_a_malformed_curriculum_is_named():
+    assert curriculum_stages(None) == []
+    assert curriculum_stages([{"from_timestep": 9, "max_steps": 3}, {"from_timestep": 0,
+                              "max_steps": 5}]) == [(0, 5), (9, 3)]  # fmt: skip
+    for bad in ({"from_timestep": 1}, [{"from_timestep": -1, "max_steps": 3}], ["600"]):
+        with pytest.raises(ConfigError, match="curriculum"):
+            curriculum_stages(bad)

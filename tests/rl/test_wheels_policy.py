@@ -194,3 +194,20 @@ def test_the_agent_refuses_a_waypoint_policy_folder(tmp_path):
     (tmp_path / "SfW-Explore-v0.zip").write_bytes(b"")
     with pytest.raises(ConfigError):
         WheelsPPOAgent(path=tmp_path)
+
+
+@pytest.mark.slow
+def test_the_discrete_block_trains_the_same_policy_on_three_actions(tmp_path):
+    from stable_baselines3 import PPO
+
+    block = dict(yaml.safe_load(DEFAULT_HYPERPARAMS.read_text())["SfW-ExploreDiscrete-v0"])
+    block.update(n_envs=2, n_steps=32, batch_size=32, n_epochs=1)
+    hyper = tmp_path / "ppo.yml"
+    hyper.write_text(yaml.safe_dump({"SfW-ExploreDiscrete-v0": block}))
+    train_ppo(
+        "SfW-ExploreDiscrete-v0", 64, tmp_path / "run", hyperparams_path=hyper,
+        eval_every=10**9, progress_bar=False,
+    )  # fmt: skip
+    model = PPO.load(tmp_path / "run" / "SfW-ExploreDiscrete-v0.zip", device="cpu")
+    assert isinstance(model.policy, WheelsPolicy)
+    assert model.action_space == gym.spaces.Discrete(3)

@@ -61,7 +61,7 @@ def test_tenths_take_the_first_and_last_tenth_of_the_evaluations():
         for s in range(1, 21)  # 20 evaluations: a tenth is 2 of them
         for e in range(2)
     ]
-    (m0, lo0, hi0), (m1, lo1, hi1) = curve.tenths(rows, "return")
+    (m0, lo0, hi0), (m1, lo1, _) = curve.tenths(rows, "return")
     assert m0 == pytest.approx(np.mean([1, 2, 2, 3]))  # steps 1 and 2, episodes 0 and 1
     assert m1 == pytest.approx(np.mean([19, 20, 20, 21]))
     sd = np.std([1, 2, 2, 3], ddof=1)
