@@ -2,7 +2,7 @@
 with random actions', random waypoints' and frontier's levels drawn in (rl-zoo's benchmark plots).
 
     python scripts/figures/plot_wheels_curve.py RUN [RUN ...] [--episodes 5] [--seed 1000000]
-        [--out docs/figures/wheels_ppo_curve.png] [--write-docs]
+        [--stride 1] [--out docs/figures/wheels_ppo_curve.png] [--write-docs]
 
 Each RUN is a ``sfw-gym train ppo --env SfW-Explore-v0`` output folder (one training seed). Every
 checkpoint in ``RUN/checkpoints`` is evaluated, its policy deterministic, on the same held-out
@@ -94,8 +94,9 @@ def run_repeat(config: dict[str, Any]) -> int:
     return native_action_repeat(wrappers) or 1
 
 
-def evaluate_run(run: Path, episodes: int, seed: int) -> list[dict[str, float]]:
-    """Every checkpoint of ``run`` on the held-out plans (cached in ``run/heldout.csv``)."""
+def evaluate_run(run: Path, episodes: int, seed: int, stride: int = 1) -> list[dict[str, float]]:
+    """Every ``stride``-th checkpoint of ``run``, counted back from its last, on the held-out
+    plans (cached in ``run/heldout.csv``)."""
     cache = run / "heldout.csv"
     rows: list[dict[str, float]] = []
     if cache.is_file():
@@ -111,7 +112,7 @@ def evaluate_run(run: Path, episodes: int, seed: int) -> list[dict[str, float]]:
     )
     config = yaml.safe_load((run / "config.yml").read_text(encoding="utf-8"))
     repeat = run_repeat(config)
-    for decisions, path in checkpoints:
+    for decisions, path in checkpoints[::-1][::stride][::-1]:
         steps = decisions * repeat  # env steps
         if steps in done:
             continue
@@ -205,6 +206,9 @@ def main() -> None:
     p.add_argument("runs", type=Path, nargs="+")
     p.add_argument("--episodes", type=int, default=5)
     p.add_argument("--seed", type=int, default=1_000_000, help="first held-out env seed")
+    p.add_argument(
+        "--stride", type=int, default=1, help="every STRIDE-th checkpoint (from the last)"
+    )
     p.add_argument("--out", type=Path, default=Path("docs/figures/wheels_ppo_curve.png"))
     p.add_argument("--write-docs", action="store_true", help="the tables into training.md")
     args = p.parse_args()
@@ -213,7 +217,7 @@ def main() -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    runs = {run: evaluate_run(run, args.episodes, args.seed) for run in args.runs}
+    runs = {run: evaluate_run(run, args.episodes, args.seed, args.stride) for run in args.runs}
     levels_file = args.runs[0].parent / f"levels_{args.seed}_{args.episodes}.json"
     if levels_file.is_file():
         levels = json.loads(levels_file.read_text(encoding="utf-8"))

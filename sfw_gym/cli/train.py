@@ -39,8 +39,9 @@ class Policy(NamedTuple):
     example: int = 0  # a run's timesteps, for the help's time estimate
 
 
-#: Decisions a second of one wheels-ppo training run (docs/results/training.md).
-WHEELS_DECISIONS_PER_S = 300.0
+#: Decisions a second of one wheels-ppo training run, measured with three side by side on 2
+#: cores (the shipped runs, docs/results/training.md); one alone is faster.
+WHEELS_DECISIONS_PER_S = 377.0
 #: By env id (and ``env`` for any other env, with no wrapper in its hyperparameters).
 POLICIES = {
     # 30,000 decisions in ~35 min, 9 of them cloning (the shipped SfW-ExploreRegions-v0_1)
