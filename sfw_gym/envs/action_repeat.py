@@ -15,12 +15,15 @@ import gymnasium as gym
 
 from sfw_gym.core.errors import ConfigError
 
+#: The repeat of the shipped recipe (a decision every 0.8 s at the env's 0.2 s a step).
+DEFAULT_REPEAT = 4
+
 
 class ActionRepeat(gym.Wrapper):
     """Each action held for ``repeat`` steps of ``env`` (fewer when the episode ends first); the
     reward is their sum, the observation and info the last step's."""
 
-    def __init__(self, env: gym.Env, repeat: int = 4) -> None:
+    def __init__(self, env: gym.Env, repeat: int = DEFAULT_REPEAT) -> None:
         if isinstance(repeat, bool) or not isinstance(repeat, int) or repeat < 1:
             raise ConfigError(f"ActionRepeat: repeat must be an integer ≥ 1, got {repeat!r}")
         super().__init__(env)

@@ -54,7 +54,7 @@ ALGOS = ("ppo", "ppo_mask")
 #: there that it does not know to the model's constructor.
 PROJECT_BLOCK = "sfw_gym"
 #: The keys of the project block: behaviour cloning before PPO, AnchoredMaskablePPO's
-#: fine-tuning, the no-mask ablation, the training episodes' curriculum (:func:`curriculum`).
+#: fine-tuning, the no-mask ablation, the training episodes' curriculum (:func:`curriculum_stages`).
 PROJECT_KEYS = frozenset({"behaviour_cloning", "fine_tuning", "use_masking", "curriculum"})
 #: The keys rl-zoo reads from an env id's block (the rest of :data:`_PPO_KEYS` go to PPO).
 _ZOO_KEYS = frozenset({"policy", "n_timesteps", "n_envs", "env_wrapper", "env_kwargs"})
@@ -316,7 +316,9 @@ def native_action_repeat(wrappers: list[tuple[str, dict]]) -> int | None:
     if not wrappers:
         return 1
     if len(wrappers) == 1 and wrappers[0][0] == ACTION_REPEAT:
-        return int(wrappers[0][1].get("repeat", 4))
+        from sfw_gym.envs.action_repeat import DEFAULT_REPEAT
+
+        return int(wrappers[0][1].get("repeat", DEFAULT_REPEAT))
     return None
 
 

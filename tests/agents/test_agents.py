@@ -259,7 +259,7 @@ def _reachable(obj: Any, stop: tuple[type, ...]) -> list[Any]:
 
 def env_for(name: str, **kwargs: Any) -> gym.Env:
     """SMALL, except for the shipped learned agents, which need the default 64 x 64 observations."""
-    learned = ("regions-ppo", "goals-ppo", "waypoint-ppo")
+    learned = ("regions-ppo", "goals-ppo", "waypoint-ppo", "wheels-ppo")
     return gym.make("SfW-Explore-v0" if name in learned else SMALL, **kwargs)
 
 
@@ -324,11 +324,18 @@ def test_robot_view_handle_shows_only_the_documented_fields():
 
 # ------------------------------------------------------------------------------ interface
 @pytest.mark.parametrize("name", sorted(AGENTS))
-def test_every_agent_builds_without_arguments_and_drives_both_action_types(name):
+def test_every_agent_builds_without_arguments_and_drives_the_action_types_it_has(name):
     agent = agent_class(name)()
     assert agent.name == name
     assert isinstance(agent.params(), dict)
-    for env_kwargs in ({}, {"action_type": "discrete"}):
+    kinds = [{}, {"action_type": "discrete"}]
+    if "discrete" not in agent.action_types:  # wheels-ppo: a policy of continuous commands
+        discrete = env_for(name, action_type="discrete")
+        discrete.reset(seed=1)
+        with pytest.raises(ConfigError, match="supports action types"):
+            agent.reset(discrete, seed=1)
+        kinds = [{}]
+    for env_kwargs in kinds:
         env = env_for(name, **env_kwargs)
         obs, _ = env.reset(seed=1)
         agent.reset(env, seed=1)
