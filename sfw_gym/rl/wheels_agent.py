@@ -17,13 +17,12 @@ import yaml
 from sfw_gym.agents.base import RobotView
 from sfw_gym.core.data import DEFAULT_WHEELS_MODEL_DIR
 from sfw_gym.core.errors import ConfigError
-from sfw_gym.rl.agent import LearnedAgentSettings
 from sfw_gym.rl.training import native_action_repeat, wrapper_specs
-from sfw_gym.rl.waypoint_agent import WaypointPPOAgent
+from sfw_gym.rl.waypoint_agent import WaypointPPOAgent, WaypointPPOSettings
 
 
 @dataclass(frozen=True)
-class WheelsPPOSettings(LearnedAgentSettings):
+class WheelsPPOSettings(WaypointPPOSettings):
     """:class:`WheelsPPOAgent`'s parameters: by default the shipped policy."""
 
     path: str = str(DEFAULT_WHEELS_MODEL_DIR)
@@ -61,10 +60,12 @@ class WheelsPPOAgent(WaypointPPOAgent):
     def _on_reset(self, view: RobotView) -> None:
         super()._on_reset(view)
         self._held, self._command = 0, (0.0, 0.0)
+        self.n_decisions = 0  # the policy's commands this episode
 
     def _act(self, view: RobotView, obs: Any) -> tuple[float, float]:
         if self._held == 0:  # a decision every action_repeat steps, as in training
             self._command = super()._act(view, obs)
             self._held = self.action_repeat
+            self.n_decisions += 1
         self._held -= 1
         return self._command
