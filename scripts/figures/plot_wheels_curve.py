@@ -37,7 +37,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))  # _
 from _docs import command_line, write_block
 
 ENV_ID = "SfW-Explore-v0"
-DETERMINISTIC = True
 COLUMNS = ("steps", "episode", "return", "coverage")
 #: What SB3 logs per PPO update (and sfw-gym train per head), in the diagnostics table.
 DIAGNOSTICS = (
@@ -81,7 +80,7 @@ def policy_act(model_path: Path, repeat: int = 1):
 
     def act(obs: dict[str, np.ndarray]) -> np.ndarray:
         if held["calls"] % repeat == 0:
-            held["actions"] = model.predict(obs, deterministic=DETERMINISTIC)[0]
+            held["actions"] = model.predict(obs, deterministic=True)[0]
         held["calls"] += 1
         return held["actions"]
 
@@ -94,9 +93,16 @@ def run_repeat(config: dict[str, Any]) -> int:
     return native_action_repeat(wrappers) or 1
 
 
+def every_nth(checkpoints: list[Any], stride: int) -> list[Any]:
+    """Every ``stride``-th of the checkpoints counted back from the last, and the first (where
+    the curve starts), in order."""
+    chosen = checkpoints[::-1][::stride][::-1]
+    return checkpoints[:1] + chosen if chosen[:1] != checkpoints[:1] else chosen
+
+
 def evaluate_run(run: Path, episodes: int, seed: int, stride: int = 1) -> list[dict[str, float]]:
-    """Every ``stride``-th checkpoint of ``run``, counted back from its last, on the held-out
-    plans (cached in ``run/heldout.csv``)."""
+    """The checkpoints of ``run`` that :func:`every_nth` picks, on the held-out plans (cached in
+    ``run/heldout.csv``)."""
     cache = run / "heldout.csv"
     rows: list[dict[str, float]] = []
     if cache.is_file():
@@ -112,7 +118,7 @@ def evaluate_run(run: Path, episodes: int, seed: int, stride: int = 1) -> list[d
     )
     config = yaml.safe_load((run / "config.yml").read_text(encoding="utf-8"))
     repeat = run_repeat(config)
-    for decisions, path in checkpoints[::-1][::stride][::-1]:
+    for decisions, path in every_nth(checkpoints, stride):
         steps = decisions * repeat  # env steps
         if steps in done:
             continue
@@ -152,11 +158,12 @@ def reference_levels(episodes: int, seed: int) -> dict[str, dict[str, float]]:
                 env = WaypointWrapper(env)
                 env.action_space.seed(seed + i)
             obs, info = env.reset(seed=seed + i)
-            agent = make_agent("frontier")
-            agent.reset(env, seed=seed + i)
+            agent = make_agent("frontier") if name == "frontier" else None
+            if agent is not None:
+                agent.reset(env, seed=seed + i)
             done = False
             while not done:
-                action = env.action_space.sample() if name != "frontier" else agent.act(obs)
+                action = agent.act(obs) if agent is not None else env.action_space.sample()
                 obs, reward, terminated, truncated, info = env.step(action)
                 ret[i] += float(reward)
                 done = terminated or truncated

@@ -101,13 +101,14 @@ class WaypointPPOAgent(Agent):
                 f"{type(self).__name__}: {config_path}: not valid YAML ({exc})"
             ) from None
         self.waypoints = waypoint_settings(config)
-        self._check_policy_kind(folder)
+        self._check_policy_kind(folder, config)
         self.model = _load_model(str(model_path), device)
         if self.waypoints is None:
             self.action_types = ("continuous",)  # type: ignore[misc]  # this model's only
 
-    def _check_policy_kind(self, folder: Path) -> None:
-        """Refuse a model this agent cannot drive (any SB3 PPO model is fine here)."""
+    def _check_policy_kind(self, folder: Path, config: dict[str, Any]) -> None:
+        """Refuse a model this agent cannot drive, from its run's ``config`` (any SB3 PPO model
+        is fine here)."""
 
     def _distribution(self, obs: dict[str, np.ndarray]) -> Any:
         """The policy's action distribution for ``obs`` (a ``torch.distributions`` object)."""

@@ -12,8 +12,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from sfw_gym.agents.base import RobotView
 from sfw_gym.core.data import DEFAULT_WHEELS_MODEL_DIR
 from sfw_gym.core.errors import ConfigError
@@ -38,16 +36,14 @@ class WheelsPPOAgent(WaypointPPOAgent):
     """
 
     name = "wheels-ppo"
-    action_types = ("continuous",)
     settings_class = WheelsPPOSettings
     settings: WheelsPPOSettings
 
-    def _check_policy_kind(self, folder: Path) -> None:
+    def _check_policy_kind(self, folder: Path, config: dict[str, Any]) -> None:
         if self.waypoints is not None:
             raise ConfigError(
                 f"WheelsPPOAgent: {folder} holds a waypoint policy; use the waypoint-ppo agent"
             )
-        config = yaml.safe_load((folder / "config.yml").read_text(encoding="utf-8")) or {}
         wrappers = wrapper_specs(config.get("hyperparameters", {}).get("env_wrapper"))
         repeat = native_action_repeat(wrappers)
         if repeat is None:

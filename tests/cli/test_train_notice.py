@@ -54,3 +54,20 @@ def test_the_help_says_it_for_each_env():
     for words in ("regions-ppo, the default learned agent", "goals-ppo", "wheels-ppo"):
         assert words in text
     assert DEFAULT_AGENT_COMMAND in text and "one env step" in text
+
+
+def test_device_reaches_the_training(monkeypatch):
+    """``--device cuda`` is handed to train_ppo (the policy's torch device); auto by default."""
+    import sfw_gym.rl.training as training
+    from sfw_gym.cli import main
+
+    seen = []
+
+    def fake_train(*args, **kwargs):
+        seen.append(kwargs["device"])
+        return {"steps": 0, "wall_time_s": 0.0, "model": "none"}
+
+    monkeypatch.setattr(training, "train_ppo", fake_train)
+    for extra, device in (([], "auto"), (["--device", "cuda"], "cuda")):
+        assert main(["train", "ppo", "--env", "SfW-ExploreSmall-v0", "--no-progress", *extra]) == 0
+    assert seen == ["auto", "cuda"]

@@ -117,10 +117,17 @@ def test_the_native_action_repeat_gives_what_the_wrapper_gives_per_env():
     for _ in range(25):  # 100 env steps: two episodes and a half each
         np.testing.assert_array_equal(a["map"], b["map"])
         actions = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
-        a, ra, da, _ = ours.step(actions)
-        b, rb, db, _ = theirs.step(actions)
+        a, ra, da, ia = ours.step(actions)
+        b, rb, db, ib = theirs.step(actions)
         np.testing.assert_allclose(ra, rb, rtol=1e-6)
         np.testing.assert_array_equal(da, db)
+        for x, y in zip(ia, ib, strict=True):  # the last step's info, the terminal observation
+            assert x["coverage"] == y["coverage"] and x["max_steps"] == y["max_steps"]
+            assert ("terminal_observation" in x) == ("terminal_observation" in y)
+            if "terminal_observation" in y:
+                np.testing.assert_array_equal(
+                    x["terminal_observation"]["state"], y["terminal_observation"]["state"]
+                )
         ends += int(db.sum())
     assert ends == 2 * n
     with pytest.raises(Exception, match="action_repeat must be an integer"):

@@ -537,6 +537,7 @@ def test_the_curriculum_lengthens_the_episodes_that_start_after_its_stage(tmp_pa
     # each sub-env steps 64 times before the switch: its first episode (40) ends before it,
     # its second (begun at step 40) keeps its 40; every episode begun after it has 20
     assert lengths[:4] == [40, 40, 40, 40] and set(lengths) == {40, 20}
+    assert lengths.count(40) == 4  # the stage is due at timestep 128 itself, not later
     first_short = lengths.index(20)
     assert all(length == 20 for length in lengths[first_short:])
     assert sum(lengths) <= 320

@@ -84,6 +84,7 @@ def test_the_map_view_is_centred_on_the_robot_marker():
         _, image = views(0.0, torch.full((1, 1, 48, 48), UNKNOWN), robot_rc=rc)
         marker = np.argwhere(image[1].numpy() > 0.99)
         assert np.allclose(marker.mean(axis=0), (31.5, 31.5), atol=0.6)
+        assert abs(np.median(image[0].numpy())) < 0.01  # the belief: unknown reads 0
         free = np.argwhere(image[0].numpy() > 0.5)
         if len(free):  # in the view unless the map's edge cuts it
             assert np.allclose(free.mean(axis=0), (31.5 - 10, 31.5), atol=1.0)
@@ -188,12 +189,24 @@ def test_the_agent_refuses_a_policy_trained_through_another_wrapper(tmp_path):
 def test_the_agent_refuses_a_waypoint_policy_folder(tmp_path):
     (tmp_path / "config.yml").write_text(
         yaml.safe_dump(
-            {"hyperparameters": {"env_wrapper": "sfw_gym.envs.waypoint.WaypointWrapper"}}
+            {
+                "env_id": "SfW-Explore-v0",
+                "hyperparameters": {"env_wrapper": "sfw_gym.envs.waypoint.WaypointWrapper"},
+            }
         )
     )
     (tmp_path / "SfW-Explore-v0.zip").write_bytes(b"")
-    with pytest.raises(ConfigError):
+    with pytest.raises(ConfigError, match="holds a waypoint policy"):
         WheelsPPOAgent(path=tmp_path)
+
+
+def test_the_shipped_agent_refuses_the_discrete_env_by_name():
+    """Its policy names continuous wheel commands: on three discrete actions it would not act
+    as trained."""
+    env = gym.make("SfW-ExploreDiscrete-v0")
+    env.reset(seed=0)
+    with pytest.raises(ConfigError, match="supports action types"):
+        WheelsPPOAgent().reset(env, seed=0)
 
 
 @pytest.mark.slow

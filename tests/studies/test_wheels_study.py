@@ -70,3 +70,30 @@ def test_tenths_take_the_first_and_last_tenth_of_the_evaluations():
     half = stats.t.ppf(0.975, 3) * sd / math.sqrt(4)
     assert hi0 - m0 == pytest.approx(half) and m0 - lo0 == pytest.approx(half)
     assert lo1 > hi0
+
+
+def test_the_curve_evaluates_every_nth_checkpoint_back_from_the_last_and_the_first():
+    curve = _load("figures/plot_wheels_curve.py")
+    assert curve.every_nth(list(range(10)), 3) == [0, 3, 6, 9]
+    assert curve.every_nth(list(range(9)), 3) == [0, 2, 5, 8]  # the first, where it starts
+    assert curve.every_nth(list(range(4)), 1) == [0, 1, 2, 3]
+    assert curve.every_nth([], 3) == []
+
+
+def test_the_training_diagnostics_average_each_tenth_of_the_updates(tmp_path):
+    """A TensorBoard log of 20 updates: the rows give the mean of the first 2, the middle 2 and
+    the last 2 values of each logged quantity."""
+    from torch.utils.tensorboard import SummaryWriter
+
+    curve = _load("figures/plot_wheels_curve.py")
+    run = tmp_path / "run"
+    writer = SummaryWriter(str(run / "tb" / "ppo_1"))
+    for step in range(20):
+        writer.add_scalar("train/approx_kl", float(step), step)
+        writer.add_scalar("train/grad_norm_actor", 2.0 * step, step)
+    writer.close()
+    rows = curve.training_diagnostics(run)
+    assert rows == [
+        "| run | approx_kl | 0.5 | 9.5 | 18.5 |",
+        "| run | grad_norm_actor | 1 | 19 | 37 |",
+    ]
