@@ -36,6 +36,8 @@ class WheelsPPOAgent(WaypointPPOAgent):
     """
 
     name = "wheels-ppo"
+    # declared on the class, before any model is loaded (the registry's readers see it)
+    action_types = ("continuous",)
     settings_class = WheelsPPOSettings
     settings: WheelsPPOSettings
 
