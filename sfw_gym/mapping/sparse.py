@@ -68,6 +68,13 @@ from sfw_gym.mapping.raycast import ray_buffer_size, traverse_grid
 _LN2 = math.log(2.0)
 # Indices into the float64 `state` array of the kernel.
 _S_ENTROPY, _S_UID, _S_PREV_X, _S_PREV_Y, _S_HAS_PREV, _S_N_TOUCHED, _S_N_CHANGED = range(7)
+#: Where an update's bits came from (:attr:`SparseInverseKVisibility.last_gain_by_source`):
+#: the footprint (rule 1); the ray's Delta k = 0 pieces in sight of the router (k = 0 at both
+#: ends); its Delta k = 0 pieces behind walls (equal k > 0); its pieces past the robot (the
+#: extension, any Delta k); wall evidence (Delta k > 0 pieces between router and robot, bumps).
+GAIN_SOURCES = ("footprint", "line_of_sight", "out_of_sight", "past_robot", "walls")
+_SRC_FOOT, _SRC_LOS, _SRC_OOS, _SRC_PAST, _SRC_WALL = range(7, 12)
+_N_STATE = 12
 # Indices into the float64 `params` array of the kernel.
 (
     _P_RES,
@@ -265,6 +272,7 @@ def _ray_update(k_robot, gx, gy, router_g, extend, params, traj, maps, track, ra
     anc_j[n_anc] = i_r
     anc_s[n_anc] = dist
     anc_k[n_anc] = k_robot
+    a_robot = n_anc  # the robot's anchor: the pieces from it on are the extension
     n_anc += 1
     if extend:
         n_anc = _push_anchors(traj, ray, l_tot, i_r + 1, n, anchors, n_anc)
@@ -273,6 +281,7 @@ def _ray_update(k_robot, gx, gy, router_g, extend, params, traj, maps, track, ra
     lmax = params[_P_LMAX]
     free = params[_P_FREE]
     k_sat = traj[1].shape[0]
+    state = track[3]
     gain = 0.0
     for a in range(n_anc - 1):
         j0 = anc_j[a] + 1
@@ -282,11 +291,12 @@ def _ray_update(k_robot, gx, gy, router_g, extend, params, traj, maps, track, ra
         dk = anc_k[a + 1] - anc_k[a]
         if anc_k[a] >= k_sat and anc_k[a + 1] >= k_sat:
             continue  # both ends read "K or more": the walls between them are unknown
+        piece = 0.0
         if dk == 0:
             for j in range(j0, j1):
                 cell = rows[j] * n_cols + cols[j]
                 if lo[cell] > lmin:  # cheap skip of saturated cells (most of them)
-                    gain += _apply(cell, free, lmax, lmin, maps, track)
+                    piece += _apply(cell, free, lmax, lmin, maps, track)
         elif dk > 0:
             # A wall keeps a robot radius from every trajectory point (the router is none)
             # and lies where the map does not already know free space.
@@ -299,8 +309,100 @@ def _ray_update(k_robot, gx, gy, router_g, extend, params, traj, maps, track, ra
             s_b = min(s_b, t1[j_hi - 1] * l_tot)
             if s_b - s_a <= 1e-9:
                 continue
-            gain += _wall_piece(s_a, s_b, dk, j0, j1, ray, l_tot, n_cols, params, maps, track)
+            piece = _wall_piece(s_a, s_b, dk, j0, j1, ray, l_tot, n_cols, params, maps, track)
+        if a >= a_robot:
+            state[_SRC_PAST] += piece
+        elif dk > 0:
+            state[_SRC_WALL] += piece
+        elif anc_k[a] == 0:
+            state[_SRC_LOS] += piece
+        else:
+            state[_SRC_OOS] += piece
+        gain += piece
     return gain
+
+
+@njit(cache=True)
+def _footprint_update(gx, gy, bumped, heading, params, maps, track, n_rows, n_cols):
+    """Rule 1: the footprint free; a bump marks the contact cell ahead occupied. Returns the
+    bits gained (and adds them to the update's sources)."""
+    lo = maps[0]
+    state = track[3]
+    res = params[_P_RES]
+    lmin = params[_P_LMIN]
+    lmax = params[_P_LMAX]
+    rad = params[_P_RADIUS] / res
+    rc = int(np.floor(gx))
+    rr = int(np.floor(gy))
+    r_lo = max(int(np.floor(gy - rad)) - 1, 0)
+    r_hi = min(int(np.floor(gy + rad)) + 1, n_rows - 1)
+    c_lo = max(int(np.floor(gx - rad)) - 1, 0)
+    c_hi = min(int(np.floor(gx + rad)) + 1, n_cols - 1)
+    foot = params[_P_FOOT]
+    gain = 0.0
+    for i in range(r_lo, r_hi + 1):
+        for j in range(c_lo, c_hi + 1):
+            ddx = j + 0.5 - gx
+            ddy = i + 0.5 - gy
+            if (ddx * ddx + ddy * ddy <= rad * rad or (i == rr and j == rc)) and lo[
+                i * n_cols + j
+            ] > lmin:
+                gain += _apply(i * n_cols + j, foot, lmax, lmin, maps, track)
+    state[_SRC_FOOT] += gain
+    if bumped and heading == heading:
+        reach = rad + 0.5
+        bc = int(np.floor(gx + reach * np.cos(heading)))
+        br = int(np.floor(gy + reach * np.sin(heading)))
+        if 0 <= br < n_rows and 0 <= bc < n_cols and not (br == rr and bc == rc):
+            bump = _apply(br * n_cols + bc, params[_P_BUMP], lmax, lmin, maps, track)
+            state[_SRC_WALL] += bump
+            gain += bump
+    return gain
+
+
+@njit(cache=True)
+def _begin_update(state):
+    """A new update: a new stamp, nothing touched, no bits from any source yet."""
+    state[_S_UID] += 1.0
+    state[_S_N_TOUCHED] = 0.0
+    state[_S_N_CHANGED] = 0.0
+    for i in range(_SRC_FOOT, _N_STATE):
+        state[i] = 0.0
+
+
+@njit(cache=True)
+def _trajectory_cells(gx, gy, params, state, ray, n_rows, n_cols):
+    """The raster cells this reading marks: the segment from the previous position (if
+    closer than ``trajectory_gap_max_m``, in ``ray[0:2][:n]``; returns ``n``) and the current
+    cell (the caller's); moves the previous position here."""
+    rows, cols, t0, t1 = ray
+    n_traj = 0
+    if state[_S_HAS_PREV] > 0.0:
+        px = state[_S_PREV_X]
+        py = state[_S_PREV_Y]
+        if params[_P_RES] * np.sqrt((gx - px) ** 2 + (gy - py) ** 2) <= params[_P_GAP]:
+            n_traj = traverse_grid(px, py, gx, gy, n_rows, n_cols, rows, cols, t0, t1)
+    state[_S_PREV_X] = gx
+    state[_S_PREV_Y] = gy
+    state[_S_HAS_PREV] = 1.0
+    return n_traj
+
+
+@njit(cache=True)
+def _classify_touched(maps, track):
+    """The classes of the touched cells; records those whose class changed."""
+    _, _, u8, cls, classified, _, _ = maps
+    touched, old_cls, changed, state = track
+    n_c = 0
+    for i in range(np.int64(state[_S_N_TOUCHED])):
+        cell = touched[i]
+        c = u8_class(u8[cell])
+        cls[cell] = c
+        classified[cell] = c != CLASS_UNKNOWN
+        if c != old_cls[i]:
+            changed[n_c] = cell
+            n_c += 1
+    state[_S_N_CHANGED] = n_c
 
 
 @njit(cache=True)
@@ -332,45 +434,17 @@ def _update_kernel(
             return np.nan, False
     thresholds = kest[KERNEL_ARG_THRESHOLDS]
     n_thr = kest[KERNEL_ARG_N_THR]
-    lo, _, u8, cls, classified, _, _ = maps
-    touched, old_cls, changed, state = track
-    rows, cols, t0, t1 = ray
+    state = track[3]
+    rows, cols = ray[0], ray[1]
     n_rows = raster.shape[1]
     n_cols = raster.shape[2]
     n_r = rssi.shape[0]
     res = params[_P_RES]
-    lmin = params[_P_LMIN]
-    lmax = params[_P_LMAX]
-    state[_S_UID] += 1.0
-    state[_S_N_TOUCHED] = 0.0
-    state[_S_N_CHANGED] = 0.0
+    _begin_update(state)
     for r in range(n_r):
         dist_buf[r] = res * np.sqrt((gx - routers_g[r, 0]) ** 2 + (gy - routers_g[r, 1]) ** 2)
     due = add_samples(rssi, dist_buf, *kest, feature, k_out)
-    gain = 0.0
-    # Rule 1: footprint free; a bump marks the contact cell ahead occupied.
-    rad = params[_P_RADIUS] / res
-    rc = int(np.floor(gx))
-    rr = int(np.floor(gy))
-    r_lo = max(int(np.floor(gy - rad)) - 1, 0)
-    r_hi = min(int(np.floor(gy + rad)) + 1, n_rows - 1)
-    c_lo = max(int(np.floor(gx - rad)) - 1, 0)
-    c_hi = min(int(np.floor(gx + rad)) + 1, n_cols - 1)
-    foot = params[_P_FOOT]
-    for i in range(r_lo, r_hi + 1):
-        for j in range(c_lo, c_hi + 1):
-            ddx = j + 0.5 - gx
-            ddy = i + 0.5 - gy
-            if (ddx * ddx + ddy * ddy <= rad * rad or (i == rr and j == rc)) and lo[
-                i * n_cols + j
-            ] > lmin:
-                gain += _apply(i * n_cols + j, foot, lmax, lmin, maps, track)
-    if bumped and heading == heading:
-        reach = rad + 0.5
-        bc = int(np.floor(gx + reach * np.cos(heading)))
-        br = int(np.floor(gy + reach * np.sin(heading)))
-        if 0 <= br < n_rows and 0 <= bc < n_cols and not (br == rr and bc == rc):
-            gain += _apply(br * n_cols + bc, params[_P_BUMP], lmax, lmin, maps, track)
+    gain = _footprint_update(gx, gy, bumped, heading, params, maps, track, n_rows, n_cols)
     # Router selection: the strongest raw RSSI (the paper), or every heard router.
     n_sel = 0
     if policy_all:
@@ -393,12 +467,9 @@ def _update_kernel(
             k_out[r], gx, gy, routers_g[r], extend, params, traj, maps, track, ray, anchors
         )
     # Trajectory raster (after the rays, so this reading is not its own anchor).
-    n_traj = 0
-    if state[_S_HAS_PREV] > 0.0:
-        px = state[_S_PREV_X]
-        py = state[_S_PREV_Y]
-        if res * np.sqrt((gx - px) ** 2 + (gy - py) ** 2) <= params[_P_GAP]:
-            n_traj = traverse_grid(px, py, gx, gy, n_rows, n_cols, rows, cols, t0, t1)
+    n_traj = _trajectory_cells(gx, gy, params, state, ray, n_rows, n_cols)
+    rr = int(np.floor(gy))
+    rc = int(np.floor(gx))
     for r in range(n_r):
         if k_out[r] < 0:
             continue
@@ -406,20 +477,7 @@ def _update_kernel(
         for j in range(n_traj):
             raster[r, rows[j], cols[j]] = f
         raster[r, rr, rc] = f
-    state[_S_PREV_X] = gx
-    state[_S_PREV_Y] = gy
-    state[_S_HAS_PREV] = 1.0
-    # Classes of the touched cells; record those whose class changed.
-    n_c = 0
-    for i in range(np.int64(state[_S_N_TOUCHED])):
-        cell = touched[i]
-        c = u8_class(u8[cell])
-        cls[cell] = c
-        classified[cell] = c != CLASS_UNKNOWN
-        if c != old_cls[i]:
-            changed[n_c] = cell
-            n_c += 1
-    state[_S_N_CHANGED] = n_c
+    _classify_touched(maps, track)
     state[_S_ENTROPY] -= gain
     return gain, due
 
@@ -504,7 +562,7 @@ class SparseInverseKVisibility:
             self._stamp,
         )
         self._changed = np.empty(touched_cap, np.int64)
-        self._state = np.zeros(7, np.float64)
+        self._state = np.zeros(_N_STATE, np.float64)
         self._track = (
             np.empty(touched_cap, np.int64),
             np.empty(touched_cap, np.int8),
@@ -668,6 +726,13 @@ class SparseInverseKVisibility:
     def entropy_bits(self) -> float:
         """Total map entropy in bits (cells outside ``outer_bounds_m`` excluded)."""
         return float(self._state[_S_ENTROPY])
+
+    @property
+    def last_gain_by_source(self) -> dict[str, float]:
+        """The last update's bits by where they came from (:data:`GAIN_SOURCES`); they sum to
+        its gain."""
+        bits = self._state[_SRC_FOOT:_N_STATE].tolist()
+        return dict(zip(GAIN_SOURCES, bits, strict=True))
 
     @property
     def last_changed_cells(self) -> np.ndarray:
