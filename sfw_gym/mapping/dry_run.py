@@ -93,7 +93,7 @@ class DryRun:
             ``(N,)`` bits per reading.
         """
         if self.mapper.n_updates != self._n_updates:
-            raise ConfigError("DryRun: the mapper has been updated since the snapshot; take a new one")
+            raise ConfigError("DryRun: the mapper was updated since the snapshot; take a new one")
         grid = self.mapper.grid
         g = grid.world_to_grid(np.asarray(xy, np.float64).reshape(-1, 2))
         n = len(g)
@@ -107,7 +107,8 @@ class DryRun:
         ):
             raise ConfigError("DryRun.path_gains: every position must lie inside the grid")
         if n and ((router < -1) | (router >= self.mapper.n_routers)).any():
-            raise ConfigError(f"DryRun.path_gains: router indices must be -1..{self.mapper.n_routers - 1}")
+            top = self.mapper.n_routers - 1
+            raise ConfigError(f"DryRun.path_gains: router indices must be -1..{top}")
         bounds = np.append(np.zeros(1, np.int64) if starts is None else starts, n).astype(np.int64)
         if bounds[0] != 0 or (np.diff(bounds) < 0).any():
             raise ConfigError(f"DryRun.path_gains: starts must ascend from 0, got {starts!r}")
@@ -151,15 +152,32 @@ def feature_for_k(k, thresholds, n_thr):
 
 @njit(cache=True)
 def _dry_paths(
-    g, router, k, bounds, routers_g, extend, params, thresholds, n_thr, base_maps, base_raster,
-    base_state, maps, raster, track, ray, anchors, undo_log, out,
+    g,
+    router,
+    k,
+    bounds,
+    routers_g,
+    extend,
+    params,
+    thresholds,
+    n_thr,
+    base_maps,
+    base_raster,
+    base_state,
+    maps,
+    raster,
+    track,
+    ray,
+    anchors,
+    undo_log,
+    out,
 ):  # pragma: no cover (compiled)
     undo, dirty, raster_undo, raster_dirty, mark_box = undo_log
     lo, ent, u8, cls, classified, _, _ = maps
     b_lo, b_ent, b_u8, b_cls, b_classified, _, _ = base_maps
     state = track[3]
     rows, cols = ray[0], ray[1]
-    n_routers, n_rows, n_cols = raster.shape
+    _, n_rows, n_cols = raster.shape
     n_cells = n_rows * n_cols
     flat_raster = raster.reshape(-1)
     flat_base = base_raster.reshape(-1)

@@ -94,10 +94,11 @@ def test_every_path_starts_from_the_snapshot_and_the_mapper_is_untouched():
     dry = DryRun(m)
     path = np.array([(3.05 + 0.1 * i, 1.25) for i in range(10)])
     alone = dry.path_gains(path, np.zeros(10, int), np.ones(10, int))
-    both = dry.path_gains(np.concatenate([path, path]), np.zeros(20, int), np.ones(20, int), [0, 10])
+    pair = np.concatenate([path, path])
+    both = dry.path_gains(pair, np.zeros(20, int), np.ones(20, int), [0, 10])
     np.testing.assert_array_equal(both[:10], alone)
     np.testing.assert_array_equal(both[10:], alone)
-    twice = dry.path_gains(np.concatenate([path, path]), np.zeros(20, int), np.ones(20, int))
+    twice = dry.path_gains(pair, np.zeros(20, int), np.ones(20, int))
     np.testing.assert_array_equal(twice[:10], alone)  # one path: its second half sees the first
     assert not np.array_equal(twice[10:], alone)
     np.testing.assert_array_equal(m.log_odds, before)
@@ -111,7 +112,7 @@ def test_a_snapshot_refuses_after_the_mapper_moved_and_bad_input_is_named():
     with pytest.raises(ConfigError, match="router indices"):
         dry.path_gains(np.array([(1.0, 1.0)]), [3], [0])
     m.update((2.05, 1.05), rssi_k((2.05, 1.05), 0))
-    with pytest.raises(ConfigError, match="updated since the snapshot"):
+    with pytest.raises(ConfigError, match="was updated since the snapshot"):
         dry.path_gains(np.array([(1.0, 1.0)]), [0], [0])
 
 
