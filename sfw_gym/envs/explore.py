@@ -481,6 +481,7 @@ class SfWExploreEnv(gym.Env):
             max_angular_speed_rad_s=cfg.max_angular_speed_rad_s,
             control_period_s=cfg.control_period_s,
             action_type=self.config.explore.action_type,
+            mapper_state=self.mapper.state(),
         )
 
     def ground_truth(self) -> GroundTruth:

@@ -10,8 +10,8 @@ RSSI is read and the k-estimator does not move: a hypothetical reading's k is wr
 raster as a feature that the current thresholds read back as that k. Bumps are not simulated.
 
 After each path the scratch copies are restored (the cells it touched, from the mapper), so
-every path starts from the belief of the snapshot. A snapshot is valid until the mapper's next
-update.
+every path starts from the belief of the snapshot. A snapshot is the dry run's own copy: the
+mapper moves on without it.
 """
 
 from __future__ import annotations
@@ -19,13 +19,24 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from typing import TYPE_CHECKING
+
 from sfw_gym.core.errors import ConfigError
-from sfw_gym.mapping.k_estimation import KERNEL_ARG_N_THR, KERNEL_ARG_THRESHOLDS
+from sfw_gym.mapping.grid import CLASS_UNKNOWN, GridSpec, u8_class
+from sfw_gym.mapping.raycast import ray_buffer_size
 from sfw_gym.mapping.sparse import (
     _N_STATE,
+    _S_HAS_PREV,
     _S_N_TOUCHED,
+    _S_PREV_X,
+    _S_PREV_Y,
     _S_UID,
+    MapperState,
     SparseInverseKVisibility,
+    inside_mask,
+    kernel_params,
+    log_odds_to_u8,
+    touched_capacity,
     _begin_update,
     _classify_touched,
     _footprint_update,
@@ -33,48 +44,96 @@ from sfw_gym.mapping.sparse import (
     _trajectory_cells,
 )
 
+if TYPE_CHECKING:
+    from sfw_gym.navigation.view import RobotView
+
 
 class DryRun:
     """The mapper's update along hypothetical paths, on a snapshot of its belief.
 
     Args:
-        mapper: The mapper to snapshot (read, never changed).
+        grid: The map's geometry.
+        routers_xy: ``(R, 2)`` router positions (world metres).
+        log_odds: ``(H, W)`` the belief's log-odds now (copied).
+        state: The mapper's other state now (:meth:`SparseInverseKVisibility.state`; copied).
+
+    :meth:`of_mapper` and :meth:`of_view` build one from a mapper or from the robot's view.
     """
 
-    def __init__(self, mapper: SparseInverseKVisibility) -> None:
-        if not isinstance(mapper, SparseInverseKVisibility):
-            raise ConfigError(f"mapper must be a SparseInverseKVisibility, got {mapper!r}")
-        self.mapper = mapper
-        self._n_updates = mapper.n_updates
-        n_cells = mapper._lo.size
-        lo, ent, u8, cls, classified, inside, _ = mapper._maps
+    def __init__(
+        self, grid: GridSpec, routers_xy: np.ndarray, log_odds: np.ndarray, state: MapperState
+    ) -> None:
+        cfg = state.config
+        lo = np.ascontiguousarray(log_odds, np.float32).ravel()
+        n_cells = lo.size
+        if lo.shape != (grid.shape[0] * grid.shape[1],):
+            raise ConfigError(f"DryRun: log_odds must have the grid's shape {grid.shape}")
+        self.grid = grid
+        self.n_routers = len(routers_xy)
+        self._routers_g = grid.world_to_grid(np.asarray(routers_xy, np.float64).reshape(-1, 2))
+        self._extend = cfg.extend_past_robot
+        self._params = kernel_params(grid, cfg)
+        self._thresholds = np.ascontiguousarray(state.k_thresholds)
+        self._n_thr = np.ascontiguousarray(state.n_thresholds)
+        ent = np.array(state.cell_entropy_bits, np.float64).ravel()
+        u8, cls = _derived_maps(lo)
+        inside = inside_mask(grid, cfg)
+        self._base = (lo, ent, u8, cls, cls != CLASS_UNKNOWN, inside, np.zeros(0, np.int64))
         # scratch copies (the stamp starts afresh: only its equality with the update's uid counts)
         self._maps = (
             lo.copy(),
             ent.copy(),
             u8.copy(),
             cls.copy(),
-            classified.copy(),
+            cls != CLASS_UNKNOWN,
             inside,
             np.zeros(n_cells, np.int64),
         )
-        self._raster = mapper._raster.copy()
-        cap = mapper._changed.size
-        self._state = mapper._state.copy()
-        self._state[_S_UID] = 0.0
+        self._base_raster = np.array(state.trajectory_features, np.float32)
+        self._raster = self._base_raster.copy()
+        self._state = np.zeros(_N_STATE, np.float64)
+        if state.previous_xy is not None:
+            gx, gy = grid.world_to_grid(np.asarray(state.previous_xy, np.float64))
+            self._state[_S_PREV_X], self._state[_S_PREV_Y], self._state[_S_HAS_PREV] = gx, gy, 1
+        self._base_state = self._state.copy()
+        cap = touched_capacity(grid, cfg, self.n_routers)
         self._track = (
             np.empty(cap, np.int64),
             np.empty(cap, np.int8),
             np.empty(cap, np.int64),
             self._state,
         )
-        self._ray = tuple(np.empty_like(a) for a in mapper._ray)
-        self._anchors = tuple(np.empty_like(a) for a in mapper._anchors)
+        ray_n = ray_buffer_size(grid.shape)
+        self._ray = (
+            np.empty(ray_n, np.int64),
+            np.empty(ray_n, np.int64),
+            np.empty(ray_n, np.float64),
+            np.empty(ray_n, np.float64),
+        )
+        self._anchors = (
+            np.empty(ray_n + 2, np.int64),
+            np.empty(ray_n + 2, np.float64),
+            np.empty(ray_n + 2, np.int64),
+        )
         self._undo = np.empty(n_cells, np.int64)
         self._dirty = np.zeros(n_cells, np.int64)
         self._raster_undo = np.empty(self._raster.size, np.int64)
         self._raster_dirty = np.zeros(self._raster.size, np.int64)
         self._mark = np.zeros(1, np.int64)
+
+    @classmethod
+    def of_mapper(cls, mapper: SparseInverseKVisibility) -> DryRun:
+        """A snapshot of ``mapper`` now."""
+        if not isinstance(mapper, SparseInverseKVisibility):
+            raise ConfigError(f"mapper must be a SparseInverseKVisibility, got {mapper!r}")
+        return cls(mapper.grid, mapper.routers_xy, mapper.log_odds, mapper.state())
+
+    @classmethod
+    def of_view(cls, view: RobotView) -> DryRun:
+        """A snapshot of the robot's own mapper, as its view shows it."""
+        if view.mapper_state is None:
+            raise ConfigError("DryRun.of_view: this view carries no mapper_state")
+        return cls(view.grid, view.routers_xy, view.log_odds, view.mapper_state)
 
     def path_gains(
         self, xy: np.ndarray, router: np.ndarray, k: np.ndarray, starts: np.ndarray | None = None
@@ -92,9 +151,7 @@ class DryRun:
         Returns:
             ``(N,)`` bits per reading.
         """
-        if self.mapper.n_updates != self._n_updates:
-            raise ConfigError("DryRun: the mapper was updated since the snapshot; take a new one")
-        grid = self.mapper.grid
+        grid = self.grid
         g = grid.world_to_grid(np.asarray(xy, np.float64).reshape(-1, 2))
         n = len(g)
         router = np.broadcast_to(np.asarray(router, np.int64), (n,))
@@ -106,27 +163,26 @@ class DryRun:
             and (g[:, 1] < grid.shape[0]).all()
         ):
             raise ConfigError("DryRun.path_gains: every position must lie inside the grid")
-        if n and ((router < -1) | (router >= self.mapper.n_routers)).any():
-            top = self.mapper.n_routers - 1
+        if n and ((router < -1) | (router >= self.n_routers)).any():
+            top = self.n_routers - 1
             raise ConfigError(f"DryRun.path_gains: router indices must be -1..{top}")
         bounds = np.append(np.zeros(1, np.int64) if starts is None else starts, n).astype(np.int64)
         if bounds[0] != 0 or (np.diff(bounds) < 0).any():
             raise ConfigError(f"DryRun.path_gains: starts must ascend from 0, got {starts!r}")
-        m = self.mapper
         out = np.zeros(n, np.float64)
         _dry_paths(
             np.ascontiguousarray(g),
             np.ascontiguousarray(router),
             np.ascontiguousarray(k),
             bounds,
-            m._routers_g,
-            m.config.extend_past_robot,
-            m._params,
-            m._kest[KERNEL_ARG_THRESHOLDS],
-            m._kest[KERNEL_ARG_N_THR],
-            m._maps,
-            m._raster,
-            m._state,
+            self._routers_g,
+            self._extend,
+            self._params,
+            self._thresholds,
+            self._n_thr,
+            self._base,
+            self._base_raster,
+            self._base_state,
             self._maps,
             self._raster,
             self._track,
@@ -136,6 +192,18 @@ class DryRun:
             out,
         )
         return out
+
+
+@njit(cache=True)
+def _derived_maps(lo):  # pragma: no cover (compiled)
+    """Per cell, as the mapper keeps them: the uint8 belief and the class."""
+    n = lo.size
+    u8 = np.empty(n, np.uint8)
+    cls = np.empty(n, np.int8)
+    for i in range(n):
+        u8[i] = log_odds_to_u8(np.float64(lo[i]))
+        cls[i] = u8_class(u8[i])
+    return u8, cls
 
 
 @njit(cache=True)

@@ -48,6 +48,7 @@ after the rays (the segment from the previous position, if closer than
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
@@ -482,6 +483,69 @@ def _update_kernel(
     return gain, due
 
 
+def kernel_params(grid: GridSpec, cfg: MapperConfig) -> np.ndarray:
+    """The kernel's float64 parameter array (indices ``_P_*``)."""
+    return np.array(
+        [
+            grid.resolution_m,
+            cfg.robot_radius_m,
+            cfg.free_log_odds,
+            cfg.footprint_log_odds,
+            cfg.bump_log_odds,
+            cfg.wall_peak_probability,
+            cfg.wall_ref_length_m,
+            cfg.wall_sigma_fraction,
+            cfg.wall_sigma_min_m,
+            cfg.log_odds_min,
+            cfg.log_odds_max,
+            cfg.trajectory_gap_max_m,
+            cfg.wall_cap_factor,
+        ],
+        dtype=np.float64,
+    )
+
+
+def inside_mask(grid: GridSpec, cfg: MapperConfig) -> np.ndarray:
+    """Flat bool per cell: inside ``outer_bounds_m`` (every cell without bounds)."""
+    inside = np.ones(grid.shape[0] * grid.shape[1], np.bool_)
+    if cfg.outer_bounds_m is not None:
+        xs, ys = grid.cell_centres()
+        xmin, ymin, xmax, ymax = cfg.outer_bounds_m
+        inside[:] = ((xs >= xmin) & (xs <= xmax) & (ys >= ymin) & (ys <= ymax)).ravel()
+    return inside
+
+
+def touched_capacity(grid: GridSpec, cfg: MapperConfig, n_routers: int) -> int:
+    """The most cells one update can touch: the footprint's box, a bump, every router's ray."""
+    rad_cells = math.ceil(cfg.robot_radius_m / grid.resolution_m) + 2
+    return (2 * rad_cells + 1) ** 2 + 2 + n_routers * ray_buffer_size(grid.shape)
+
+
+@dataclass(frozen=True)
+class MapperState:
+    """What the mapper keeps besides its log-odds, as read-only views
+    (:meth:`SparseInverseKVisibility.state`): enough to run its update dry
+    (:class:`~sfw_gym.mapping.dry_run.DryRun`). The robot's own, never the ground truth.
+
+    Attributes:
+        config: The mapper's configuration.
+        trajectory_features: ``(R, H, W)`` float32, per router the filtered RSSI feature of the
+            last reading taken in each cell (NaN where the trajectory never passed).
+        k_thresholds: ``(R, max_k)`` the k-estimator's thresholds per router (the first
+            ``n_thresholds[r]`` in use).
+        n_thresholds: ``(R,)`` how many thresholds each router uses.
+        cell_entropy_bits: ``(H, W)`` float64, each cell's entropy as the mapper keeps it.
+        previous_xy: Where the last reading was taken (world metres), None before the first.
+    """
+
+    config: MapperConfig
+    trajectory_features: np.ndarray
+    k_thresholds: np.ndarray
+    n_thresholds: np.ndarray
+    cell_entropy_bits: np.ndarray
+    previous_xy: tuple[float, float] | None
+
+
 class SparseInverseKVisibility:
     """Online occupancy map from positions and RSSI: sparse inverse k-visibility (Alg. 2).
 
@@ -514,37 +578,15 @@ class SparseInverseKVisibility:
         self.routers_xy.flags.writeable = False
         self.n_routers = n_r = routers.shape[0]
         self._routers_g = grid.world_to_grid(routers)
-        self._params = np.array(
-            [
-                grid.resolution_m,
-                cfg.robot_radius_m,
-                cfg.free_log_odds,
-                cfg.footprint_log_odds,
-                cfg.bump_log_odds,
-                cfg.wall_peak_probability,
-                cfg.wall_ref_length_m,
-                cfg.wall_sigma_fraction,
-                cfg.wall_sigma_min_m,
-                cfg.log_odds_min,
-                cfg.log_odds_max,
-                cfg.trajectory_gap_max_m,
-                cfg.wall_cap_factor,
-            ],
-            dtype=np.float64,
-        )
+        self._params = kernel_params(grid, cfg)
         self._policy_all = cfg.router_policy == "all"
         self._k_estimator = KEstimator(n_r, cfg)
         self._kest = self._k_estimator._kernel_args()
         h, w = grid.shape
         n_cells = h * w
-        inside = np.ones(n_cells, np.bool_)
-        if cfg.outer_bounds_m is not None:
-            xs, ys = grid.cell_centres()
-            xmin, ymin, xmax, ymax = cfg.outer_bounds_m
-            inside[:] = ((xs >= xmin) & (xs <= xmax) & (ys >= ymin) & (ys <= ymax)).ravel()
+        inside = inside_mask(grid, cfg)
         ray_n = ray_buffer_size(grid.shape)
-        rad_cells = math.ceil(cfg.robot_radius_m / grid.resolution_m) + 2
-        touched_cap = (2 * rad_cells + 1) ** 2 + 2 + n_r * ray_n
+        touched_cap = touched_capacity(grid, cfg, n_r)
         self._lo = np.zeros(n_cells, np.float32)
         self._ent = np.ones(n_cells, np.float64)
         self._u8 = np.full(n_cells, U8_UNKNOWN, np.uint8)
@@ -726,6 +768,22 @@ class SparseInverseKVisibility:
     def entropy_bits(self) -> float:
         """Total map entropy in bits (cells outside ``outer_bounds_m`` excluded)."""
         return float(self._state[_S_ENTROPY])
+
+    def state(self) -> MapperState:
+        """The mapper's state besides its log-odds, as read-only views (:class:`MapperState`)."""
+        st = self._state
+        previous = None
+        if st[_S_HAS_PREV] > 0.0:
+            res, (x0, y0) = self.grid.resolution_m, self.grid.origin_xy
+            previous = (x0 + st[_S_PREV_X] * res, y0 + st[_S_PREV_Y] * res)
+        views = []
+        kest = self._kest
+        ent = self._ent.reshape(self.grid.shape)
+        for a in (self._raster, kest[KERNEL_ARG_THRESHOLDS], kest[KERNEL_ARG_N_THR], ent):
+            v = a.view()
+            v.flags.writeable = False
+            views.append(v)
+        return MapperState(self.config, *views, previous)
 
     @property
     def last_gain_by_source(self) -> dict[str, float]:

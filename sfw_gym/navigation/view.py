@@ -10,6 +10,7 @@ import numpy as np
 
 from sfw_gym.core.constants import NOT_HEARD_DBM
 from sfw_gym.mapping.grid import GridSpec, belief_classes
+from sfw_gym.mapping.sparse import MapperState
 from sfw_gym.world.robot import RobotConfig
 
 
@@ -34,6 +35,9 @@ class RobotView:
         radius_m: The robot's radius.
         max_linear_speed_m_s, max_angular_speed_rad_s, control_period_s: Its motion limits.
         action_type: ``"continuous"`` or ``"discrete"``.
+        mapper_state: The rest of the robot's own mapper (its trajectory raster and k
+            thresholds, read-only): what a dry run of its update needs
+            (:class:`~sfw_gym.mapping.dry_run.DryRun`); None on a hand-made view.
     """
 
     belief_u8: np.ndarray
@@ -49,6 +53,7 @@ class RobotView:
     max_angular_speed_rad_s: float
     control_period_s: float
     action_type: str
+    mapper_state: MapperState | None = None
 
     @classmethod
     def hand_made(

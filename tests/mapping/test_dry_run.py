@@ -28,7 +28,7 @@ def h(lo: float) -> float:
 
 def dry_and_real(mapper, p, k):
     """The dry run's bits for a reading at ``p`` with ``k``, and a twin's real update's."""
-    dry = DryRun(mapper).path_gains(np.array([p]), [0], [k])[0]
+    dry = DryRun.of_mapper(mapper).path_gains(np.array([p]), [0], [k])[0]
     twin = copy.deepcopy(mapper)
     real = twin.update(p, rssi_k(p, k))
     assert twin.last_k.tolist() == [k]
@@ -59,12 +59,13 @@ def test_a_dry_path_equals_the_real_updates_along_it():
     m = SparseInverseKVisibility(GRID, [ROUTER], EXACT)
     path = [(1.05 + 0.1 * i, 1.05 + 0.02 * i) for i in range(30)]
     ks = [0 if x < 2.6 else 1 for x, _ in path]  # a wall at 2.6 m
-    dry = DryRun(m).path_gains(np.array(path), np.zeros(30, int), np.array(ks))
+    dry = DryRun.of_mapper(m).path_gains(np.array(path), np.zeros(30, int), np.array(ks))
     real = [m.update(q, rssi_k(q, kq)) for q, kq in zip(path, ks, strict=True)]
     np.testing.assert_allclose(dry, real, atol=1e-12)
 
 
 def test_the_dry_run_on_random_walks_equals_the_env_mapper():
+    """From the env's mapper mid-episode (thresholds fitted, a long trajectory raster)."""
     env = gym.make("SfW-Explore-v0")
     env.reset(seed=5)
     u = env.unwrapped
@@ -80,7 +81,7 @@ def test_the_dry_run_on_random_walks_equals_the_env_mapper():
             real = twin.update(xy[0], rssi)
             router = int(twin.last_routers[0]) if len(twin.last_routers) else -1
             k = int(twin.last_k[router]) if router >= 0 else 0
-            dry = DryRun(m).path_gains(xy, [router], [k])[0]
+            dry = DryRun.of_mapper(m).path_gains(xy, [router], [k])[0]
             assert dry == pytest.approx(real, abs=1e-9)
             checked += real > 0
         env.step(np.array([abs(rng.uniform(-1, 1)), rng.uniform(-1, 1)]))
@@ -91,7 +92,7 @@ def test_every_path_starts_from_the_snapshot_and_the_mapper_is_untouched():
     m = SparseInverseKVisibility(GRID, [ROUTER], EXACT)
     m.update((2.05, 1.05), rssi_k((2.05, 1.05), 0))
     before = m.log_odds.copy()
-    dry = DryRun(m)
+    dry = DryRun.of_mapper(m)
     path = np.array([(3.05 + 0.1 * i, 1.25) for i in range(10)])
     alone = dry.path_gains(path, np.zeros(10, int), np.ones(10, int))
     pair = np.concatenate([path, path])
@@ -104,16 +105,33 @@ def test_every_path_starts_from_the_snapshot_and_the_mapper_is_untouched():
     np.testing.assert_array_equal(m.log_odds, before)
 
 
-def test_a_snapshot_refuses_after_the_mapper_moved_and_bad_input_is_named():
+def test_a_snapshot_is_its_own_copy_and_bad_input_is_named():
     m = SparseInverseKVisibility(GRID, [ROUTER], EXACT)
-    dry = DryRun(m)
+    dry = DryRun.of_mapper(m)
+    p = np.array([(3.05, 1.05)])
+    first = dry.path_gains(p, [0], [0])
+    m.update((3.05, 1.05), rssi_k((3.05, 1.05), 0))  # the mapper moves on
+    np.testing.assert_array_equal(dry.path_gains(p, [0], [0]), first)
+    assert DryRun.of_mapper(m).path_gains(p, [0], [0])[0] != first[0]
     with pytest.raises(ConfigError, match="inside the grid"):
         dry.path_gains(np.array([(99.0, 1.0)]), [0], [0])
     with pytest.raises(ConfigError, match="router indices"):
         dry.path_gains(np.array([(1.0, 1.0)]), [3], [0])
-    m.update((2.05, 1.05), rssi_k((2.05, 1.05), 0))
-    with pytest.raises(ConfigError, match="was updated since the snapshot"):
-        dry.path_gains(np.array([(1.0, 1.0)]), [0], [0])
+    with pytest.raises(ConfigError, match="starts must ascend"):
+        dry.path_gains(np.array([(1.0, 1.0)] * 3), [0], [0], [0, 2, 1])
+
+
+def test_the_robot_view_snapshots_the_same_mapper():
+    env = gym.make("SfW-Explore-v0")
+    env.reset(seed=1)
+    for _ in range(60):
+        env.step(np.array([0.8, 0.3]))
+    u = env.unwrapped
+    xy = np.array(u.pose_estimate[:2]) + np.array([[0.1 * i, 0.05 * i] for i in range(8)])
+    args = (np.zeros(8, int), np.arange(8) % 2)
+    from_view = DryRun.of_view(u.robot_view()).path_gains(xy, *args)
+    np.testing.assert_array_equal(from_view, DryRun.of_mapper(u.mapper).path_gains(xy, *args))
+    assert from_view.sum() > 0
 
 
 @pytest.mark.parametrize("n_thr", [0, 1, 3])
