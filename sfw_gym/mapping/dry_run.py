@@ -16,10 +16,10 @@ mapper moves on without it.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numba import njit
-
-from typing import TYPE_CHECKING
 
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.mapping.grid import CLASS_UNKNOWN, GridSpec, u8_class
@@ -33,15 +33,15 @@ from sfw_gym.mapping.sparse import (
     _S_UID,
     MapperState,
     SparseInverseKVisibility,
-    inside_mask,
-    kernel_params,
-    log_odds_to_u8,
-    touched_capacity,
     _begin_update,
     _classify_touched,
     _footprint_update,
     _ray_update,
     _trajectory_cells,
+    inside_mask,
+    kernel_params,
+    log_odds_to_u8,
+    touched_capacity,
 )
 
 if TYPE_CHECKING:
