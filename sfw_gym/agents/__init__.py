@@ -35,9 +35,13 @@ AGENTS: dict[str, str] = {
     "waypoint-ppo": "sfw_gym.rl.waypoint_agent:WaypointPPOAgent",
     # greedy bits per metre on the learned map predictor's map
     "predict-explore": "sfw_gym.rl.predict_explore:PredictExploreAgent",
+    # predict-explore's candidates ranked by the mapper's update run dry along their paths
+    "rollout-explore": "sfw_gym.rl.predict_explore:RolloutExploreAgent",
     # privileged: they read the ground truth (sfw_gym.agents.oracles); run only when named
     "oracle-coverage": "sfw_gym.agents.coverage_oracle:CoverageOracle",
     "oracle-regions": "sfw_gym.agents.region_oracle:RegionOracle",
+    # the candidate of rollout-explore's menu that truly gains most: the ceiling of its ranking
+    "oracle-rollout": "sfw_gym.agents.rollout_explore:RolloutOracle",
     # the coverage oracle less one piece of its knowledge each: where the ceiling lives
     "oracle-belief-paths": "sfw_gym.agents.coverage_oracle:BeliefPathsOracle",
     "oracle-frontier-targets": "sfw_gym.agents.coverage_oracle:FrontierTargetsOracle",

@@ -224,7 +224,7 @@ class PredictiveExplorer(GreedyInfoGainAgent):
         cost = metres + self.settings.turn_cost_m_per_rad * turn + self.settings.distance_offset_m
         score = self.expected_gain(view, targets) / cost
         self.candidates = list(zip(map(tuple, targets.tolist()), score.tolist(), strict=True))
-        i = self._keep_or_switch(targets, score)
+        i = self._pick(view, paths, targets, goals, score)
         if i < len(menu):
             self._log_decision(menu, i)
         else:
@@ -233,6 +233,18 @@ class PredictiveExplorer(GreedyInfoGainAgent):
         self._resume()
         target = (int(targets[i, 0]), int(targets[i, 1]))
         return Goal((int(goals[i, 0]), int(goals[i, 1])), target, "frontier")
+
+    def _pick(
+        self,
+        view: RobotView,
+        paths: CostField,
+        targets: np.ndarray,
+        goals: np.ndarray,
+        score: np.ndarray,
+    ) -> int:
+        """The candidate to drive to, given each one's ``score`` (expected bits per metre):
+        :meth:`_keep_or_switch` here; a subclass may rank them otherwise."""
+        return self._keep_or_switch(targets, score)
 
     def _keep_or_switch(self, targets: np.ndarray, score: np.ndarray) -> int:
         """The best candidate, unless the current goal's target is still one whose score is

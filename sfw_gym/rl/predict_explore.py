@@ -11,6 +11,7 @@ from sfw_gym.agents.predict_explore import (
     PredictExploreSettings,
     PredictiveExplorer,
 )
+from sfw_gym.agents.rollout_explore import RolloutExplorer, RolloutExploreSettings
 from sfw_gym.core.config import setting
 from sfw_gym.navigation.prediction import MapPredictor
 from sfw_gym.rl.map_predictor import LearnedMapPredictor
@@ -39,6 +40,33 @@ class PredictExploreAgent(PredictiveExplorer):
 
     settings_class = LearnedPredictExploreSettings
     settings: LearnedPredictExploreSettings
+
+    def make_predictor(self) -> MapPredictor:
+        if self.settings.predictor == "learned":
+            return LearnedMapPredictor(self.settings.path or None)
+        return super().make_predictor()
+
+
+@dataclass(frozen=True)
+class LearnedRolloutExploreSettings(RolloutExploreSettings):
+    """:class:`~sfw_gym.agents.rollout_explore.RolloutExploreSettings` with the learned
+    predictor (``path`` as :class:`LearnedPredictExploreSettings`)."""
+
+    predictor: str = setting("learned", choices=("learned", *BASELINE_PREDICTORS))
+    path: str = ""
+
+    def validate(self) -> None:
+        object.__setattr__(self, "path", str(self.path))
+
+
+class RolloutExploreAgent(RolloutExplorer):
+    """Predict-explore's menu re-ranked by the dry-run rate of each path, on the learned
+    predictor's map (see :mod:`sfw_gym.agents.rollout_explore`)."""
+
+    name = "rollout-explore"
+
+    settings_class = LearnedRolloutExploreSettings
+    settings: LearnedRolloutExploreSettings
 
     def make_predictor(self) -> MapPredictor:
         if self.settings.predictor == "learned":
