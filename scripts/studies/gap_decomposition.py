@@ -33,7 +33,7 @@ from sfw_gym.mapping.grid import belief_classes
 from sfw_gym.mapping.sparse import GAIN_SOURCES
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
-from _docs import write_block
+from _docs import RESULTS, write_block
 
 ORACLE = "sfw_gym.agents.coverage_oracle:CoverageOracle"
 GIVE_UP = {"paths": {"plan_on": "belief"}, "targets": {"targets_from": "frontiers"},
@@ -148,7 +148,7 @@ def main() -> None:
     text = tables(by, seeds, args)
     print(text)
     if args.write_docs:
-        write_block("docs/results/rollout.md", "gap_decomposition", text)
+        write_block(RESULTS / "rollout.md", "gap_decomposition", text.splitlines())
 
 
 def tables(by: dict, seeds: list[int], args: argparse.Namespace) -> str:

@@ -34,7 +34,7 @@ from sfw_gym.navigation.path_gain import best_prefix_rate, path_totals, walls_cr
 from sfw_gym.rl.predict_explore import RolloutExploreAgent
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
-from _docs import write_block
+from _docs import RESULTS, write_block
 
 MODELS = (
     "expected bits per metre (today's)",
@@ -132,7 +132,7 @@ def main() -> None:
     text = "\n".join(lines)
     print(text)
     if args.write_docs:
-        write_block("docs/results/rollout.md", "ranking_study", text)
+        write_block(RESULTS / "rollout.md", "ranking_study", text.splitlines())
 
 
 if __name__ == "__main__":

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +32,9 @@ from sfw_gym.agents import is_privileged
 from sfw_gym.evaluation.report import PRIVILEGED_NOTE, agent_label
 from sfw_gym.evaluation.runner import evaluate
 from sfw_gym.evaluation.stats import compare_paired
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+from _docs import RESULTS, command_line, write_block
 
 #: The tuned heuristics of DESIGN.md's sweep: name → (table label, entry point, parameters).
 TUNED = {
@@ -64,6 +68,12 @@ def main() -> None:
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--max-steps", type=int, default=None, help="the episodes' step budget")
     p.add_argument("--budgets", default="", help="comma-separated steps: coverage at each")
+    p.add_argument(
+        "--write-docs",
+        default=None,
+        metavar="PAGE:BLOCK",
+        help="also write the tables into block BLOCK of docs/results/PAGE",
+    )
     args = p.parse_args()
 
     agents, params, label = [], json.loads(args.agent_params), {}
@@ -166,6 +176,9 @@ def main() -> None:
     text = "\n".join(lines)
     Path(args.out, "ratios.md").write_text(text + "\n", encoding="utf-8")
     print(text)
+    if args.write_docs:
+        page, block = args.write_docs.split(":")
+        write_block(RESULTS / page, block, [f"`{command_line()}`:", "", *lines])
 
 
 def curve_at(curve: list[list[float]], step: int) -> tuple[float, float]:

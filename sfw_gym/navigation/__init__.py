@@ -8,6 +8,12 @@ from __future__ import annotations
 from sfw_gym.navigation.candidates import CandidateSettings, GoalFinder, candidate_goals
 from sfw_gym.navigation.frontiers import Frontier, find_frontiers, frontier_mask, hidden_rooms
 from sfw_gym.navigation.menu import FEATURES, SOURCES, CandidateGoals
+from sfw_gym.navigation.path_gain import (
+    best_prefix_rate,
+    path_totals,
+    readings_along,
+    walls_crossed,
+)
 from sfw_gym.navigation.planning import (
     CostField,
     PurePursuit,
@@ -35,6 +41,7 @@ __all__ = [
     "GoalFinder",
     "PurePursuit",
     "WaypointDriver",
+    "best_prefix_rate",
     "block_features",
     "candidate_goals",
     "cost_field",
@@ -42,9 +49,12 @@ __all__ = [
     "find_frontiers",
     "frontier_mask",
     "hidden_rooms",
+    "path_totals",
     "plan_path",
+    "readings_along",
     "router_scores",
     "to_discrete",
     "traversal_costs",
+    "walls_crossed",
     "waypoint_goal_xy",
 ]
