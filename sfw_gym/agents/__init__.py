@@ -41,7 +41,7 @@ AGENTS: dict[str, str] = {
     "oracle-coverage": "sfw_gym.agents.coverage_oracle:CoverageOracle",
     "oracle-regions": "sfw_gym.agents.region_oracle:RegionOracle",
     # the candidate of rollout-explore's menu that truly gains most: the ceiling of its ranking
-    "oracle-rollout": "sfw_gym.agents.rollout_explore:RolloutOracle",
+    "oracle-rollout": "sfw_gym.rl.predict_explore:RolloutOracleAgent",
     # the coverage oracle less one piece of its knowledge each: where the ceiling lives
     "oracle-belief-paths": "sfw_gym.agents.coverage_oracle:BeliefPathsOracle",
     "oracle-frontier-targets": "sfw_gym.agents.coverage_oracle:FrontierTargetsOracle",

@@ -12,7 +12,8 @@ score is the best-prefix rate (:func:`~sfw_gym.navigation.path_gain.best_prefix_
 readings' total (``rank_by``), and the expected bits per metre breaks ties. The learned agent
 is ``rollout-explore`` (:class:`sfw_gym.rl.predict_explore.RolloutExploreAgent`).
 
-:class:`RolloutOracle` (privileged, ``oracle-rollout``) takes, of the same menu, the candidate
+:class:`RolloutOracle` (privileged; ``oracle-rollout`` with the learned predictor,
+:class:`sfw_gym.rl.predict_explore.RolloutOracleAgent`) takes, of the same menu, the candidate
 that truly gains most in ``horizon_steps``: a copy of the env's mapper updated along each
 candidate's readings with the true radio's readings there (the radio's own noise, drawn from
 the oracle's generator). It is the ceiling of any ranker on this menu: what a perfect gain
@@ -79,7 +80,7 @@ class RolloutExplorer(PredictiveExplorer):
 
     Attributes:
         last_ranked: The latest re-ranking: candidate indices, best first by expected bits per
-            metre, and the rate of each (bits per step), for studies.
+            metre, and the score of each (``rank_by``), for studies.
     """
 
     name = "rollout-explore-nearest"
@@ -156,24 +157,25 @@ class RolloutExplorer(PredictiveExplorer):
         return best_prefix_rate(gains, starts, self.settings.min_prefix_steps)
 
 
+@dataclass(frozen=True)
+class RolloutOracleSettings(RolloutExploreSettings):
+    """:class:`RolloutExploreSettings`, ranking by the readings' total: the most bits in
+    ``horizon_steps``."""
+
+    rank_by: str = setting("total", choices=RANK_BY)
+
+
 class RolloutOracle(OracleAgent, RolloutExplorer):
     """The candidate that truly gains most in ``horizon_steps`` (privileged; module doc)."""
 
-    name = "oracle-rollout"
+    name = "oracle-rollout-nearest"
+
+    settings_class = RolloutOracleSettings
+    settings: RolloutOracleSettings
 
     def path_bits(self, view: RobotView, xy: np.ndarray, starts: np.ndarray) -> np.ndarray:
         """Bits per reading along the paths, from the env's own mapper fed the true radio."""
         return true_path_bits(self._env, xy, starts, self.rng)
-
-    def _pick(self, view, paths, targets, goals, score) -> int:  # type: ignore[no-untyped-def]
-        top = self.top_candidates(score)
-        if len(top) < 2:
-            return int(np.argmax(score))
-        xy, starts = self.readings(view, paths, goals[top])
-        gains = self.path_bits(view, xy, starts)
-        total = path_totals(gains, starts)
-        self.last_ranked = (top, total)
-        return int(top[np.lexsort((-score[top], -total))[0]])
 
 
 def true_path_bits(

@@ -1,6 +1,8 @@
-"""``predict-explore``: :class:`~sfw_gym.agents.predict_explore.PredictiveExplorer` reading the
-learned map predictor (:class:`~sfw_gym.rl.map_predictor.LearnedMapPredictor`, shipped in the
-package; a folder of one's own with ``path``)."""
+"""The agents that read the learned map predictor
+(:class:`~sfw_gym.rl.map_predictor.LearnedMapPredictor`, shipped in the package; a folder of
+one's own with ``path``): ``predict-explore``
+(:class:`~sfw_gym.agents.predict_explore.PredictiveExplorer`), ``rollout-explore`` and the
+rollout oracle (:mod:`sfw_gym.agents.rollout_explore`)."""
 
 from __future__ import annotations
 
@@ -11,17 +13,23 @@ from sfw_gym.agents.predict_explore import (
     PredictExploreSettings,
     PredictiveExplorer,
 )
-from sfw_gym.agents.rollout_explore import RolloutExplorer, RolloutExploreSettings
+from sfw_gym.agents.rollout_explore import (
+    RolloutExplorer,
+    RolloutExploreSettings,
+    RolloutOracle,
+    RolloutOracleSettings,
+)
 from sfw_gym.core.config import setting
 from sfw_gym.navigation.prediction import MapPredictor
 from sfw_gym.rl.map_predictor import LearnedMapPredictor
 
 
 @dataclass(frozen=True)
-class LearnedPredictExploreSettings(PredictExploreSettings):
-    """:class:`PredictExploreSettings` with the learned predictor.
+class LearnedPredictorSettings:
+    """The learned predictor's settings, mixed into each agent's own.
 
     Attributes:
+        predictor: ``"learned"`` (default), or a predictor that learns nothing.
         path: The predictor's folder (``model.pt``, ``config.json``; default: the shipped one).
     """
 
@@ -32,7 +40,23 @@ class LearnedPredictExploreSettings(PredictExploreSettings):
         object.__setattr__(self, "path", str(self.path))
 
 
-class PredictExploreAgent(PredictiveExplorer):
+class LearnedPredictorMixin:
+    """``make_predictor`` of an agent whose settings mix in :class:`LearnedPredictorSettings`."""
+
+    settings: LearnedPredictorSettings
+
+    def make_predictor(self) -> MapPredictor:
+        if self.settings.predictor == "learned":
+            return LearnedMapPredictor(self.settings.path or None)
+        return super().make_predictor()  # type: ignore[misc]
+
+
+@dataclass(frozen=True)
+class LearnedPredictExploreSettings(LearnedPredictorSettings, PredictExploreSettings):
+    """:class:`PredictExploreSettings` with the learned predictor."""
+
+
+class PredictExploreAgent(LearnedPredictorMixin, PredictiveExplorer):
     """Greedy bits per metre on the learned predictor's map (see
     :mod:`sfw_gym.agents.predict_explore`)."""
 
@@ -41,25 +65,14 @@ class PredictExploreAgent(PredictiveExplorer):
     settings_class = LearnedPredictExploreSettings
     settings: LearnedPredictExploreSettings
 
-    def make_predictor(self) -> MapPredictor:
-        if self.settings.predictor == "learned":
-            return LearnedMapPredictor(self.settings.path or None)
-        return super().make_predictor()
-
 
 @dataclass(frozen=True)
-class LearnedRolloutExploreSettings(RolloutExploreSettings):
+class LearnedRolloutExploreSettings(LearnedPredictorSettings, RolloutExploreSettings):
     """:class:`~sfw_gym.agents.rollout_explore.RolloutExploreSettings` with the learned
-    predictor (``path`` as :class:`LearnedPredictExploreSettings`)."""
-
-    predictor: str = setting("learned", choices=("learned", *BASELINE_PREDICTORS))
-    path: str = ""
-
-    def validate(self) -> None:
-        object.__setattr__(self, "path", str(self.path))
+    predictor."""
 
 
-class RolloutExploreAgent(RolloutExplorer):
+class RolloutExploreAgent(LearnedPredictorMixin, RolloutExplorer):
     """Predict-explore's menu re-ranked by the dry-run rate of each path, on the learned
     predictor's map (see :mod:`sfw_gym.agents.rollout_explore`)."""
 
@@ -68,7 +81,18 @@ class RolloutExploreAgent(RolloutExplorer):
     settings_class = LearnedRolloutExploreSettings
     settings: LearnedRolloutExploreSettings
 
-    def make_predictor(self) -> MapPredictor:
-        if self.settings.predictor == "learned":
-            return LearnedMapPredictor(self.settings.path or None)
-        return super().make_predictor()
+
+@dataclass(frozen=True)
+class LearnedRolloutOracleSettings(LearnedPredictorSettings, RolloutOracleSettings):
+    """:class:`~sfw_gym.agents.rollout_explore.RolloutOracleSettings` with the learned
+    predictor: ``rollout-explore``'s own menu."""
+
+
+class RolloutOracleAgent(LearnedPredictorMixin, RolloutOracle):
+    """The rollout oracle on ``rollout-explore``'s menu (privileged; see
+    :mod:`sfw_gym.agents.rollout_explore`)."""
+
+    name = "oracle-rollout"
+
+    settings_class = LearnedRolloutOracleSettings
+    settings: LearnedRolloutOracleSettings

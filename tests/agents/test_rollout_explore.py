@@ -27,7 +27,7 @@ def drive(agent, env_id=SMALL, steps=120, seed=4):
 
 
 def test_the_oracle_is_privileged_and_the_explorer_is_not():
-    assert AGENTS["oracle-rollout"].endswith(":RolloutOracle")
+    assert AGENTS["oracle-rollout"].endswith(":RolloutOracleAgent")
     assert is_privileged("oracle-rollout")
     assert not is_privileged("rollout-explore")
     assert issubclass(agent_class("rollout-explore"), RolloutExplorer)
