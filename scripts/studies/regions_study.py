@@ -86,6 +86,9 @@ def main() -> None:
         else:
             agents.append(name)
             label[name] = agent_label(name, is_privileged(name))
+            if params.get(name):  # a variant: name its settings
+                settings = ", ".join(f"{k}={v}" for k, v in params[name].items())
+                label[name] = f"{label[name]} ({settings})"
     if args.model and "regions-ppo" in agents:
         params.setdefault("regions-ppo", {})["path"] = args.model
     result = evaluate(

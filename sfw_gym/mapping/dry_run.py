@@ -16,7 +16,7 @@ mapper moves on without it.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -43,9 +43,6 @@ from sfw_gym.mapping.sparse import (
     log_odds_to_u8,
     touched_capacity,
 )
-
-if TYPE_CHECKING:
-    from sfw_gym.navigation.view import RobotView
 
 
 class DryRun:
@@ -129,8 +126,9 @@ class DryRun:
         return cls(mapper.grid, mapper.routers_xy, mapper.log_odds, mapper.state())
 
     @classmethod
-    def of_view(cls, view: RobotView) -> DryRun:
-        """A snapshot of the robot's own mapper, as its view shows it."""
+    def of_view(cls, view: Any) -> DryRun:
+        """A snapshot of the robot's own mapper, as its view
+        (:class:`~sfw_gym.navigation.view.RobotView`, a layer above) shows it."""
         if view.mapper_state is None:
             raise ConfigError("DryRun.of_view: this view carries no mapper_state")
         return cls(view.grid, view.routers_xy, view.log_odds, view.mapper_state)

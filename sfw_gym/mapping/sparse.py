@@ -521,6 +521,12 @@ def touched_capacity(grid: GridSpec, cfg: MapperConfig, n_routers: int) -> int:
     return (2 * rad_cells + 1) ** 2 + 2 + n_routers * ray_buffer_size(grid.shape)
 
 
+def _read_only_view(a: np.ndarray) -> np.ndarray:
+    view = a.view()
+    view.flags.writeable = False
+    return view
+
+
 @dataclass(frozen=True)
 class MapperState:
     """What the mapper keeps besides its log-odds, as read-only views
@@ -776,14 +782,15 @@ class SparseInverseKVisibility:
         if st[_S_HAS_PREV] > 0.0:
             res, (x0, y0) = self.grid.resolution_m, self.grid.origin_xy
             previous = (x0 + st[_S_PREV_X] * res, y0 + st[_S_PREV_Y] * res)
-        views = []
         kest = self._kest
-        ent = self._ent.reshape(self.grid.shape)
-        for a in (self._raster, kest[KERNEL_ARG_THRESHOLDS], kest[KERNEL_ARG_N_THR], ent):
-            v = a.view()
-            v.flags.writeable = False
-            views.append(v)
-        return MapperState(self.config, *views, previous)
+        return MapperState(
+            config=self.config,
+            trajectory_features=_read_only_view(self._raster),
+            k_thresholds=_read_only_view(kest[KERNEL_ARG_THRESHOLDS]),
+            n_thresholds=_read_only_view(kest[KERNEL_ARG_N_THR]),
+            cell_entropy_bits=_read_only_view(self._ent.reshape(self.grid.shape)),
+            previous_xy=previous,
+        )
 
     @property
     def last_gain_by_source(self) -> dict[str, float]:
