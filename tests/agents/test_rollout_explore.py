@@ -3,6 +3,8 @@ oracle is privileged and takes what truly gains most."""
 
 from __future__ import annotations
 
+import copy
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -35,7 +37,7 @@ def test_the_oracle_is_privileged_and_the_explorer_is_not():
 
 def test_the_goal_is_the_best_ranked_path_not_the_best_bits_per_metre():
     agent = RolloutExplorer(walls_from="belief")
-    env, _ = drive(agent)
+    drive(agent)
     top, rate = agent.last_ranked
     assert len(top) >= 2
     chosen = agent.decisions[-1].target_rc
@@ -49,7 +51,7 @@ def test_the_goal_is_the_best_ranked_path_not_the_best_bits_per_metre():
 
 def test_the_oracles_choice_gains_most_in_truth():
     oracle = make_agent("oracle-rollout", predictor="nearest")
-    env, _ = drive(oracle, steps=60)
+    drive(oracle, steps=60)
     top, total = oracle.last_ranked
     chosen = oracle.decisions[-1].target_rc
     targets = [c for c, _ in oracle.candidates]
@@ -67,3 +69,18 @@ def test_true_path_bits_reads_a_copy_of_the_mapper():
     bits = true_path_bits(u, xy, np.array([0, 1]), np.random.default_rng(0))
     assert bits[0] > 0 and bits[1] == pytest.approx(bits[0], rel=0.5)  # each path from the snapshot
     np.testing.assert_array_equal(u.mapper.log_odds, before)
+
+
+def test_true_path_bits_are_the_mappers_gain_from_the_true_radio():
+    env = gym.make(SMALL, radio={"noise_sigma_db": 0.0})
+    env.reset(seed=3)
+    for _ in range(30):
+        env.step(np.array([0.6, 0.2]))
+    u = env.unwrapped
+    x, y, _ = u.pose_estimate
+    xy = np.array([(x, y), (x + 0.1, y)])
+    bits = true_path_bits(u, xy, np.array([0]), np.random.default_rng(0))
+    twin = copy.deepcopy(u.mapper)
+    radio = u.ground_truth().radio
+    expected = [twin.update(p, radio.measure(p).astype(float)) for p in xy]
+    np.testing.assert_allclose(bits, expected, atol=1e-12)
