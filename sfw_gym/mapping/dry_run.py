@@ -23,7 +23,6 @@ from numba import njit
 
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.mapping.grid import CLASS_UNKNOWN, GridSpec, u8_class
-from sfw_gym.mapping.raycast import ray_buffer_size
 from sfw_gym.mapping.sparse import (
     _N_STATE,
     _S_HAS_PREV,
@@ -39,9 +38,9 @@ from sfw_gym.mapping.sparse import (
     _ray_update,
     _trajectory_cells,
     inside_mask,
+    kernel_buffers,
     kernel_params,
     log_odds_to_u8,
-    touched_capacity,
 )
 
 
@@ -93,24 +92,8 @@ class DryRun:
             gx, gy = grid.world_to_grid(np.asarray(state.previous_xy, np.float64))
             self._state[_S_PREV_X], self._state[_S_PREV_Y], self._state[_S_HAS_PREV] = gx, gy, 1
         self._base_state = self._state.copy()
-        cap = touched_capacity(grid, cfg, self.n_routers)
-        self._track = (
-            np.empty(cap, np.int64),
-            np.empty(cap, np.int8),
-            np.empty(cap, np.int64),
-            self._state,
-        )
-        ray_n = ray_buffer_size(grid.shape)
-        self._ray = (
-            np.empty(ray_n, np.int64),
-            np.empty(ray_n, np.int64),
-            np.empty(ray_n, np.float64),
-            np.empty(ray_n, np.float64),
-        )
-        self._anchors = (
-            np.empty(ray_n + 2, np.int64),
-            np.empty(ray_n + 2, np.float64),
-            np.empty(ray_n + 2, np.int64),
+        self._track, self._ray, self._anchors = kernel_buffers(
+            grid, cfg, self.n_routers, self._state
         )
         self._undo = np.empty(n_cells, np.int64)
         self._dirty = np.zeros(n_cells, np.int64)

@@ -527,6 +527,19 @@ def _read_only_view(a: np.ndarray) -> np.ndarray:
     return view
 
 
+def kernel_buffers(
+    grid: GridSpec, cfg: MapperConfig, n_routers: int, state: np.ndarray
+) -> tuple[tuple, tuple, tuple]:
+    """The kernel's scratch: the touched-cell tracking (around ``state``), the ray's cells and
+    the anchors' buffers."""
+    cap = touched_capacity(grid, cfg, n_routers)
+    n = ray_buffer_size(grid.shape)
+    track = (np.empty(cap, np.int64), np.empty(cap, np.int8), np.empty(cap, np.int64), state)
+    ray = (np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n), np.empty(n))
+    anchors = (np.empty(n + 2, np.int64), np.empty(n + 2), np.empty(n + 2, np.int64))
+    return track, ray, anchors
+
+
 @dataclass(frozen=True)
 class MapperState:
     """What the mapper keeps besides its log-odds, as read-only views
@@ -591,8 +604,6 @@ class SparseInverseKVisibility:
         h, w = grid.shape
         n_cells = h * w
         inside = inside_mask(grid, cfg)
-        ray_n = ray_buffer_size(grid.shape)
-        touched_cap = touched_capacity(grid, cfg, n_r)
         self._lo = np.zeros(n_cells, np.float32)
         self._ent = np.ones(n_cells, np.float64)
         self._u8 = np.full(n_cells, U8_UNKNOWN, np.uint8)
@@ -609,25 +620,9 @@ class SparseInverseKVisibility:
             inside,
             self._stamp,
         )
-        self._changed = np.empty(touched_cap, np.int64)
         self._state = np.zeros(_N_STATE, np.float64)
-        self._track = (
-            np.empty(touched_cap, np.int64),
-            np.empty(touched_cap, np.int8),
-            self._changed,
-            self._state,
-        )
-        self._ray = (
-            np.empty(ray_n, np.int64),
-            np.empty(ray_n, np.int64),
-            np.empty(ray_n, np.float64),
-            np.empty(ray_n, np.float64),
-        )
-        self._anchors = (
-            np.empty(ray_n + 2, np.int64),
-            np.empty(ray_n + 2, np.float64),
-            np.empty(ray_n + 2, np.int64),
-        )
+        self._track, self._ray, self._anchors = kernel_buffers(grid, cfg, n_r, self._state)
+        self._changed = self._track[2]
         self._raster = np.full((n_r, h, w), np.nan, np.float32)
         self._selected = np.zeros(n_r, np.int64)
         self._dist = np.empty(n_r, np.float64)
