@@ -39,6 +39,20 @@ PY
 "$py" -c "from sfw_gym.rl import PPOAgent; a = PPOAgent(); print('PPOAgent() loads', a.settings.path)"
 "$py" -c "from sfw_gym.rl import RegionsPPOAgent; a = RegionsPPOAgent(); print('RegionsPPOAgent() loads', a.settings.path)"
 "$py" -c "from sfw_gym.agents import make_agent; a = make_agent('predict-explore'); p = a.make_predictor(); print('predict-explore loads its predictor', p.path)"
+"$py" - <<'PY'
+import gymnasium as gym
+
+import sfw_gym  # noqa: F401
+from sfw_gym.agents import make_agent
+
+env = gym.make("SfW-ExploreSmall-v0")
+obs, _ = env.reset(seed=0)
+agent = make_agent("rollout-explore")
+agent.reset(env, seed=0)
+for _ in range(40):
+    obs, *_ = env.step(agent.act(obs))
+print("rollout-explore drives from the wheel, dry runs and all:", agent.predictor.path)
+PY
 "$work/venv/bin/sfw-gym" demo --episodes 1 --workers 1 --out "$work/report" --no-progress | tail -3
 "$work/venv/bin/sfw-gym" train ppo --env SfW-ExploreSmall-v0 --timesteps 256 --out "$work/run" \
     --no-progress | tail -2
