@@ -39,6 +39,7 @@ router and, in one compiled kernel:
 
 5. fuses by adding log-odds (Eq. 7), clamped to ``[log_odds_min, log_odds_max]``, and keeps the
    map entropy, the uint8 map and the cell classes up to date for the touched cells only.
+   It counts the update's bits by where they came from (:data:`GAIN_SOURCES`).
 
 The first reading of an update never serves as its own anchor: the trajectory raster is written
 after the rays (the segment from the previous position, if closer than
