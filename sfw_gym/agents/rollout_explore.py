@@ -28,6 +28,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from scipy import ndimage
 
 from sfw_gym.agents.base import RobotView
 from sfw_gym.agents.oracles import OracleAgent
@@ -43,11 +44,16 @@ from sfw_gym.navigation.path_gain import (
     walls_crossed,
 )
 from sfw_gym.navigation.planning import CostField, cells_to_world
+from sfw_gym.navigation.prediction import VISITED_BIT
 
 #: What gives a hypothetical reading its k: the predicted map's walls or the belief's only.
 WALLS_FROM = ("predicted", "belief")
 #: How a path's bits per reading become its score: the best-prefix rate, or their total.
 RANK_BY = ("rate", "total")
+#: The candidates beyond the frontier cells: predict-explore's lattice of unknown cells
+#: predicted free, or every unvisited cell believed or predicted free (a lattice, denser beside
+#: believed or predicted walls).
+MENUS = ("predicted_unknown", "unvisited_free")
 
 
 @dataclass(frozen=True)
@@ -64,6 +70,13 @@ class RolloutExploreSettings(PredictExploreSettings):
             ``"belief"`` (the believed walls only) give each reading's k.
         rank_by: ``"rate"`` (the best-prefix rate: bits per step) or ``"total"`` (the bits of
             all ``horizon_steps`` readings).
+        menu: The candidates besides the frontier cells (:data:`MENUS`):
+            ``"unvisited_free"`` adds every cell believed or predicted free that the robot has
+            not passed within ``visited_margin_m``, every ``beyond_stride_cells`` cells, and every
+            ``wall_stride_cells`` within ``wall_band_m`` of a believed or predicted wall.
+        visited_margin_m: ``"unvisited_free"``: how near the trajectory a cell counts visited.
+        wall_band_m: ``"unvisited_free"``: the band beside walls where candidates are denser.
+        wall_stride_cells: ``"unvisited_free"``: the lattice in that band.
     """
 
     ranked_candidates: int = setting(16, integer=True, ge=1)
@@ -71,6 +84,10 @@ class RolloutExploreSettings(PredictExploreSettings):
     min_prefix_steps: int = setting(5, integer=True, ge=1)
     walls_from: str = setting("predicted", choices=WALLS_FROM)
     rank_by: str = setting("rate", choices=RANK_BY)
+    menu: str = setting("predicted_unknown", choices=MENUS)
+    visited_margin_m: float = setting(0.3, ge=0.0)
+    wall_band_m: float = setting(0.3, ge=0.0)
+    wall_stride_cells: int = setting(3, integer=True, ge=1)
 
 
 class RolloutExplorer(PredictiveExplorer):
@@ -107,6 +124,22 @@ class RolloutExplorer(PredictiveExplorer):
         self.last_ranked = (top, rate)
         best = np.lexsort((-score[top], -rate))[0]  # the rate, then bits per metre
         return int(top[best])
+
+    def _beyond_cells(self, view: RobotView, paths: CostField) -> np.ndarray:
+        s = self.settings
+        if s.menu == "predicted_unknown":
+            return super()._beyond_cells(view, paths)
+        pred = self.prediction(view)
+        res = view.grid.resolution_m
+        visited = (self._codes & VISITED_BIT) > 0
+        near_path = ndimage.distance_transform_edt(~visited) * res <= s.visited_margin_m
+        walls = pred.p_wall >= 0.5
+        beside_wall = ndimage.distance_transform_edt(~walls) * res <= s.wall_band_m
+        lattice = _lattice(view.grid.shape, s.beyond_stride_cells)
+        lattice |= beside_wall & _lattice(view.grid.shape, s.wall_stride_cells)
+        mask = lattice & (pred.p_free >= s.min_p_free) & ~near_path
+        mask &= paths.reachable() & ~self.blacklisted & ~self.finder.frontier(view)
+        return np.argwhere(mask)
 
     def top_candidates(self, score: np.ndarray) -> np.ndarray:
         """The ``ranked_candidates`` best candidates by ``score``, best first."""
@@ -176,6 +209,13 @@ class RolloutOracle(OracleAgent, RolloutExplorer):
     def path_bits(self, view: RobotView, xy: np.ndarray, starts: np.ndarray) -> np.ndarray:
         """Bits per reading along the paths, from the env's own mapper fed the true radio."""
         return true_path_bits(self._env, xy, starts, self.rng)
+
+
+def _lattice(shape: tuple[int, int], stride: int) -> np.ndarray:
+    """Cells every ``stride`` rows and columns."""
+    out = np.zeros(shape, bool)
+    out[stride // 2 :: stride, stride // 2 :: stride] = True
+    return out
 
 
 def true_path_bits(

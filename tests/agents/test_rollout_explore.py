@@ -12,6 +12,8 @@ import pytest
 import sfw_gym  # noqa: F401
 from sfw_gym.agents import AGENTS, agent_class, is_privileged, make_agent
 from sfw_gym.agents.rollout_explore import RolloutExplorer, true_path_bits
+from sfw_gym.mapping import belief_classes
+from sfw_gym.navigation.planning import cost_field
 
 SMALL = "SfW-ExploreSmall-v0"
 
@@ -84,3 +86,24 @@ def test_true_path_bits_are_the_mappers_gain_from_the_true_radio():
     radio = u.ground_truth().radio
     expected = [twin.update(p, radio.measure(p).astype(float)) for p in xy]
     np.testing.assert_allclose(bits, expected, atol=1e-12)
+
+
+def beyond_now(agent, env):
+    """The agent's candidates besides the frontier cells, for the view now."""
+    view = env.unwrapped.robot_view()
+    paths = cost_field(agent._costs(view), view.cell, view.grid.resolution_m)
+    return view, agent._beyond_cells(view, paths)
+
+
+def test_the_unvisited_free_menu_offers_believed_free_cells_away_from_the_path():
+    agent = RolloutExplorer(menu="unvisited_free", walls_from="belief")
+    env, _ = drive(agent, steps=80)
+    view, cells = beyond_now(agent, env)
+    assert belief_classes(view.belief_u8)[0][cells[:, 0], cells[:, 1]].any()  # believed free
+    traj = view.grid.world_to_cell(np.asarray(view.odometry_trajectory))
+    d = np.hypot(*(cells[:, None, :] - traj[None, :, :]).transpose(2, 0, 1)).min(1)
+    assert (d * view.grid.resolution_m > 0.3).all()  # visited_margin_m
+    default = RolloutExplorer(walls_from="belief")
+    env, _ = drive(default, steps=80)
+    view, cells = beyond_now(default, env)
+    assert belief_classes(view.belief_u8)[2][cells[:, 0], cells[:, 1]].all()  # unknown only
