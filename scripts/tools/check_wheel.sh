@@ -10,6 +10,14 @@ trap 'rm -rf "$work"' EXIT
 "$python" -m pip wheel --quiet --no-deps --wheel-dir "$work/dist" "$repo"
 wheel="$(ls "$work"/dist/sfw_gym-*.whl)"
 echo "built $(basename "$wheel") ($(du -h "$wheel" | cut -f1))"
+"$python" - "$wheel" <<'PY'
+import sys, zipfile
+names = zipfile.ZipFile(sys.argv[1]).namelist()
+meta = zipfile.ZipFile(sys.argv[1]).read(next(n for n in names if n.endswith("dist-info/METADATA")))
+assert b"License-Expression: MIT" in meta, "the wheel's metadata names no MIT licence"
+assert any(n.endswith("dist-info/licenses/LICENSE") for n in names), "the wheel carries no LICENSE"
+print("the wheel carries the MIT licence (License-Expression: MIT, LICENSE)")
+PY
 "$python" -m venv "$work/venv"
 py="$work/venv/bin/python"
 cd "$work"  # the checkout is neither the working directory nor on sys.path
