@@ -352,3 +352,21 @@ def test_one_wall_loss_number_means_every_material():
     counts, loss = plan.wall_loss_db(a, b, 12.0)
     assert loss[0] == 12.0 * counts[0]
     assert np.array_equal(plan.wall_loss_db(a, b, dict.fromkeys(MATERIALS, 12.0))[1], loss)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_the_parallel_path_equals_the_serial_one_point_by_point(seed):
+    """From 256 points on the model runs a parallel kernel (chunks of 512): the same mean RSSI
+    and k as the serial one, each point read alone (a generated plan: walls, shadowing)."""
+    plan = generate_floorplan(seed)
+    x0, y0, x1, y1 = plan.bounds
+    rng = np.random.default_rng(seed)
+    candidates = rng.uniform((x0, y0), (x1, y1), (500, 2))
+    routers = candidates[plan.is_free(candidates)][:2]
+    model = RadioModel(plan, routers, RadioConfig(), np.random.default_rng(seed))
+    pts = rng.uniform((x0, y0), (x1, y1), (1100, 2))  # three chunks of 512
+    many_rssi, many_k = model.mean_rssi(pts), model.true_k(pts)
+    one = [(model.mean_rssi(p[None]), model.true_k(p[None])) for p in pts]
+    np.testing.assert_array_equal(many_rssi, np.concatenate([r for r, _ in one]))
+    np.testing.assert_array_equal(many_k, np.concatenate([k for _, k in one]))
+    assert many_k.max() >= 1  # walls were crossed
