@@ -137,3 +137,26 @@ def test_step_budget_scales_with_the_plan_area():
     for bad in (-1.0, float("nan"), "60"):
         with pytest.raises(ConfigError, match="steps_per_m2"):
             gym.make("SfW-Explore-v0", steps_per_m2=bad)
+
+
+@pytest.mark.slow
+def test_steps_to_coverage_are_the_first_steps_at_each_level():
+    """Once reached, ``steps_to_coverage_50`` / ``_90`` are the first steps whose coverage was at
+    least 0.5 / 0.9, read off the episode's own coverage series (and stay once set)."""
+    env = gym.make(SMALL, max_steps=2000)  # seed 3: 0.9 at about step 1,300
+    obs, info = env.reset(seed=3)
+    agent = FrontierAgent()
+    agent.reset(env, seed=3)
+    coverage, infos = [info["coverage"]], []
+    done = False
+    while not done:
+        obs, _, terminated, truncated, info = env.step(agent.act(obs))
+        coverage.append(info["coverage"])
+        infos.append(info)
+        done = terminated or truncated
+    for level, key in ((0.5, "steps_to_coverage_50"), (0.9, "steps_to_coverage_90")):
+        reached = [t for t, c in enumerate(coverage) if c >= level]
+        assert reached, f"the episode never reached {level}: pick a longer one"
+        assert info[key] == reached[0]
+        after, before = infos[reached[0] - 1 :], infos[: reached[0] - 1]
+        assert all(i[key] == reached[0] for i in after) and all(i[key] == -1 for i in before)
