@@ -160,3 +160,21 @@ def test_steps_to_coverage_are_the_first_steps_at_each_level():
         assert info[key] == reached[0]
         after, before = infos[reached[0] - 1 :], infos[: reached[0] - 1]
         assert all(i[key] == reached[0] for i in after) and all(i[key] == -1 for i in before)
+
+
+def test_each_discrete_action_moves_the_robot_as_its_wheel_command_says():
+    """0 drives max_linear_speed x control_period along the heading, 1 and 2 turn in place by
+    +/- max_angular_speed x control_period (the defaults: 0.1 m, 0.3 rad), away from walls."""
+    env = gym.make("SfW-ExploreDiscrete-v0")
+    env.reset(seed=0)
+    robot = env.unwrapped.scene.robot
+    step_m, turn_rad = 0.5 * 0.2, 1.5 * 0.2
+    for action, (dist, dturn) in ((1, (0, turn_rad)), (2, (0, -turn_rad)), (0, (step_m, 0))):
+        x0, y0, t0 = robot.pose
+        env.step(action)
+        x1, y1, t1 = robot.pose
+        assert not robot.bumped
+        assert math.hypot(x1 - x0, y1 - y0) == pytest.approx(dist, abs=1e-9)
+        assert math.remainder(t1 - t0 - dturn, math.tau) == pytest.approx(0.0, abs=1e-9)
+        if dist:
+            assert math.atan2(y1 - y0, x1 - x0) == pytest.approx(t0, abs=1e-6)  # along the heading
