@@ -178,3 +178,34 @@ def test_each_discrete_action_moves_the_robot_as_its_wheel_command_says():
         assert math.remainder(t1 - t0 - dturn, math.tau) == pytest.approx(0.0, abs=1e-9)
         if dist:
             assert math.atan2(y1 - y0, x1 - x0) == pytest.approx(t0, abs=1e-6)  # along the heading
+
+
+def test_the_state_vector_is_scaled_rssi_heard_flags_bump_position_heading_and_known():
+    """Per router (RSSI + 100) / 80 and a heard flag, then the bump, x and y as fractions of the
+    grid's extent, sin and cos of the heading, the known fraction: worked out from the env's
+    own readings, pose and grid."""
+    env = gym.make(SMALL, radio={"sensitivity_dbm": -35.0})  # some readings unheard
+    env.reset(seed=5)
+    u = env.unwrapped
+    seen = set()
+    for t in range(40):
+        obs, *_ = env.step(np.array([0.7, 0.4 if t % 10 < 5 else -0.4]))
+        rssi = u.rssi_history.view[-1].astype(float)
+        x, y, theta = u.pose_estimate
+        (x0, y0), (rows, cols), res = u.grid.origin_xy, u.grid.shape, u.grid.resolution_m
+        heard = rssi > -100
+        n = len(rssi)  # SMALL: as many slots as routers
+        expected = [
+            *np.where(heard, np.clip((rssi + 100) / 80, 0, 1), 0.0),
+            *heard.astype(float),
+            float(u.scene.robot.bumped),
+            (x - x0) / (cols * res),
+            (y - y0) / (rows * res),
+            math.sin(theta),
+            math.cos(theta),
+            u.tracker.known_fraction,
+        ]
+        np.testing.assert_allclose(obs["state"], np.float32(expected), atol=1e-6)
+        assert obs["state"].shape == (2 * n + 6,)
+        seen.update(heard.tolist())
+    assert seen == {True, False}
