@@ -14,9 +14,16 @@ from sklearn.metrics import roc_auc_score
 torch = pytest.importorskip("torch")
 
 from sfw_gym.core.errors import ConfigError  # noqa: E402
-from sfw_gym.navigation.prediction import FREE, OUTSIDE, UNKNOWN, WALL  # noqa: E402
+from sfw_gym.navigation.prediction import (  # noqa: E402
+    FREE,
+    INPUT_CHANNELS,
+    OUTSIDE,
+    UNKNOWN,
+    WALL,
+)
 from sfw_gym.rl.map_predictor import (  # noqa: E402
     DEFAULT_PREDICTOR_DIR,
+    IGNORE,
     LearnedMapPredictor,
     MapPredictorNet,
     PredictorConfig,
@@ -174,3 +181,35 @@ def test_the_shipped_predictor_loads_and_predicts_any_map_size():
         assert m.p_free.shape == shape
         assert np.all(m.p_free[10:20, 10:20] == 1.0)
         assert np.all((m.p_free >= 0) & (m.p_free + m.p_wall <= 1.0 + 1e-5))
+
+
+def loss_case(correct_on_unknown: bool, wrong_on_known: bool, margin: float = 20.0):
+    """2 x 3 cells, 2 heads: the left column unknown, the rest known; one unknown cell IGNOREd
+    (padding)."""
+    labels = torch.tensor([[[FREE, WALL, OUTSIDE], [IGNORE, WALL, FREE]]])
+    inputs = torch.zeros(1, len(INPUT_CHANNELS), 2, 3)
+    inputs[0, INPUT_CHANNELS.index("unknown"), :, 0] = 1.0
+    logits = torch.zeros(1, 2, 3, 2, 3)
+    for r in range(2):
+        for c in range(3):
+            true = int(labels[0, r, c]) if labels[0, r, c] != IGNORE else FREE
+            unknown = c == 0
+            right = (unknown and correct_on_unknown) or (not unknown and not wrong_on_known)
+            cls = true if right else (true + 1) % 3
+            logits[0, :, cls, r, c] = margin
+    return logits, labels, inputs
+
+
+def test_predictor_loss_is_a_weighted_cross_entropy_by_its_limits():
+    """Uniform logits give ln 3 whatever the weights; known cells weigh ``known_weight`` (0: a
+    wrong guess there costs nothing); an IGNOREd cell never counts."""
+    torch.manual_seed(0)
+    logits, labels, inputs = loss_case(True, True)
+    uniform = torch.zeros_like(logits)
+    assert float(predictor_loss(uniform, labels, inputs, 0.1)) == pytest.approx(np.log(3), rel=1e-6)
+    assert float(predictor_loss(logits, labels, inputs, 0.0)) < 1e-6  # only the right ones count
+    wrong_known = float(predictor_loss(logits, labels, inputs, 1.0))
+    assert wrong_known > 5.0  # a wrong guess by 20 nats on known cells, now weighed in
+    ignored = logits.clone()
+    ignored[0, :, :, 1, 0] = torch.tensor([-50.0, 50.0, 0.0])  # wrong for any label: IGNOREd
+    assert float(predictor_loss(ignored, labels, inputs, 0.0)) < 1e-6
