@@ -470,16 +470,16 @@ def test_public_views_have_the_documented_dtypes():
 
 
 def test_log_odds_stop_at_their_clamps_and_the_entropy_follows():
-    """Bumps add +3 to the contact cell until log_odds_max (4), footprints -1 until log_odds_min
-    (-4): after n readings min(3 n, 4) and max(-n, -4), and the map's entropy equals the sum of
-    its cells' entropies at those values."""
-    cfg = replace(EXACT, robot_radius_m=0.17)
+    """Bumps add +3 to the contact cell until log_odds_max (4), footprints -1.5 until
+    log_odds_min (-4): after n readings min(3 n, 4) and max(-1.5 n, -4), and the map's entropy
+    equals the sum of its cells' entropies at those values."""
+    cfg = replace(EXACT, robot_radius_m=0.17, footprint_log_odds=-1.5)
     m = SparseInverseKVisibility(GRID, [ROUTER], cfg)
     contact, here = (10, 32), (10, 30)
     for n in range(1, 7):
         m.update((3.05, 1.05), [-100.0], bumped=True, heading_rad=0.0)
         assert m.log_odds[contact] == pytest.approx(min(3.0 * n, cfg.log_odds_max))
-        assert m.log_odds[here] == pytest.approx(max(-1.0 * n, cfg.log_odds_min))
+        assert m.log_odds[here] == pytest.approx(max(-1.5 * n, cfg.log_odds_min))
     assert m.entropy_bits == pytest.approx(m.recompute_entropy_bits())
     gain = m.update((3.05, 1.05), [-100.0], bumped=True, heading_rad=0.0)
     assert gain == 0.0  # everything it touches is clamped: no bits left to gain
