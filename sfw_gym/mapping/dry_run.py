@@ -60,7 +60,7 @@ class DryRun:
         self, grid: GridSpec, routers_xy: np.ndarray, log_odds: np.ndarray, state: MapperState
     ) -> None:
         cfg = state.config
-        lo = np.ascontiguousarray(log_odds, np.float32).ravel()
+        lo = np.array(log_odds, np.float32).ravel()  # a copy: the mapper moves on
         n_cells = lo.size
         if lo.shape != (grid.shape[0] * grid.shape[1],):
             raise ConfigError(f"DryRun: log_odds must have the grid's shape {grid.shape}")

@@ -523,6 +523,7 @@ def touched_capacity(grid: GridSpec, cfg: MapperConfig, n_routers: int) -> int:
 
 
 def _read_only_view(a: np.ndarray) -> np.ndarray:
+    """A read-only view of ``a``."""
     view = a.view()
     view.flags.writeable = False
     return view
@@ -627,9 +628,7 @@ class SparseInverseKVisibility:
         self._raster = np.full((n_r, h, w), np.nan, np.float32)
         self._selected = np.zeros(n_r, np.int64)
         self._dist = np.empty(n_r, np.float64)
-        self._lo_view = self._read_only(self._lo)
-        self._u8_view = self._read_only(self._u8)
-        self._classified_view = self._read_only(self._classified)
+        self._make_views()
         self.reset()
 
     def reset(self) -> None:
@@ -646,23 +645,33 @@ class SparseInverseKVisibility:
         self._k_estimator.reset()
         self.n_updates = 0
 
-    def _read_only(self, flat: np.ndarray) -> np.ndarray:
-        view = flat.reshape(self.grid.shape).view()
-        view.flags.writeable = False
-        return view
+    _VIEWS = ("_lo_view", "_u8_view", "_classified_view", "_state_views")
+
+    def _make_views(self) -> None:
+        """The read-only views the properties and :meth:`state` hand out (made once: the arrays
+        they show change in place)."""
+        shape = self.grid.shape
+        self._lo_view = _read_only_view(self._lo.reshape(shape))
+        self._u8_view = _read_only_view(self._u8.reshape(shape))
+        self._classified_view = _read_only_view(self._classified.reshape(shape))
+        kest = self._kest
+        self._state_views = (
+            _read_only_view(self._raster),
+            _read_only_view(kest[KERNEL_ARG_THRESHOLDS]),
+            _read_only_view(kest[KERNEL_ARG_N_THR]),
+            _read_only_view(self._ent.reshape(shape)),
+        )
 
     def __getstate__(self) -> dict:
         # Views would unpickle as copies, cut off from the arrays they show: rebuild them.
         state = self.__dict__.copy()
-        for name in ("_lo_view", "_u8_view", "_classified_view"):
+        for name in self._VIEWS:
             del state[name]
         return state
 
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
-        self._lo_view = self._read_only(self._lo)
-        self._u8_view = self._read_only(self._u8)
-        self._classified_view = self._read_only(self._classified)
+        self._make_views()
 
     def update(
         self,
@@ -778,13 +787,13 @@ class SparseInverseKVisibility:
         if st[_S_HAS_PREV] > 0.0:
             res, (x0, y0) = self.grid.resolution_m, self.grid.origin_xy
             previous = (x0 + st[_S_PREV_X] * res, y0 + st[_S_PREV_Y] * res)
-        kest = self._kest
+        raster, thresholds, n_thresholds, entropy = self._state_views
         return MapperState(
             config=self.config,
-            trajectory_features=_read_only_view(self._raster),
-            k_thresholds=_read_only_view(kest[KERNEL_ARG_THRESHOLDS]),
-            n_thresholds=_read_only_view(kest[KERNEL_ARG_N_THR]),
-            cell_entropy_bits=_read_only_view(self._ent.reshape(self.grid.shape)),
+            trajectory_features=raster,
+            k_thresholds=thresholds,
+            n_thresholds=n_thresholds,
+            cell_entropy_bits=entropy,
             previous_xy=previous,
         )
 

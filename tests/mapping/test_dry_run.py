@@ -173,3 +173,16 @@ def test_sources_tell_walls_out_of_sight_and_past_the_robot():
     src = m.last_gain_by_source
     assert src["out_of_sight"] > 0
     assert sum(src.values()) == pytest.approx(gain)
+
+
+def test_a_snapshot_keeps_its_belief_however_often_the_mapper_moves_on():
+    """The snapshot copies the log-odds: runs after the mapper's updates still start from the
+    belief it was taken at (its scratch cells are restored from its own copy, not the mapper)."""
+    m = SparseInverseKVisibility(GRID, [ROUTER], EXACT)
+    m.update((2.05, 1.05), rssi_k((2.05, 1.05), 0))
+    dry = DryRun.of_mapper(m)
+    p = np.array([(3.05, 1.05), (3.15, 1.05)])
+    first = dry.path_gains(p, [0, 0], [0, 0])
+    for x in (3.05, 3.15, 3.25):
+        m.update((x, 1.05), rssi_k((x, 1.05), 0))
+        np.testing.assert_array_equal(dry.path_gains(p, [0, 0], [0, 0]), first)
