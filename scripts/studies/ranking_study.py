@@ -58,10 +58,7 @@ class Probe(RolloutExploreAgent):
         if self.n_picks % self.every == 0 and len(top) >= 4:
             xy, starts = self.readings(view, paths, goals[top])
             grid = view.grid
-            rc = grid.world_to_cell(xy)
-            router = self.finder.strongest_router(view)[
-                np.clip(rc[:, 0], 0, grid.n_rows - 1), np.clip(rc[:, 1], 0, grid.n_cols - 1)
-            ]
+            router = self.reading_routers(view, xy)
             dry = DryRun.of_view(view)
             scores = {MODELS[0]: score[top]}
             for walls, label in (

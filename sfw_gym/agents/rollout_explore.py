@@ -171,13 +171,18 @@ class RolloutExplorer(PredictiveExplorer):
             return belief_classes(view.belief_u8)[1]
         return self.prediction(view).p_wall >= 0.5
 
-    def path_bits(self, view: RobotView, xy: np.ndarray, starts: np.ndarray) -> np.ndarray:
-        """Bits per reading along the paths: the mapper's update run dry."""
+    def reading_routers(self, view: RobotView, xy: np.ndarray) -> np.ndarray:
+        """The router predicted strongest at each reading (the one whose ray the mapper
+        follows)."""
         grid = view.grid
         rc = grid.world_to_cell(xy) if len(xy) else np.zeros((0, 2), np.int64)
         rows = np.clip(rc[:, 0], 0, grid.n_rows - 1)
         cols = np.clip(rc[:, 1], 0, grid.n_cols - 1)
-        router = self.finder.strongest_router(view)[rows, cols]
+        return self.finder.strongest_router(view)[rows, cols]
+
+    def path_bits(self, view: RobotView, xy: np.ndarray, starts: np.ndarray) -> np.ndarray:
+        """Bits per reading along the paths: the mapper's update run dry."""
+        router = self.reading_routers(view, xy)
         k = walls_crossed(view.grid, self.reading_walls(view), view.routers_xy, router, xy)
         return DryRun.of_view(view).path_gains(xy, router, k, starts)
 
