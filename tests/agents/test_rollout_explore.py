@@ -4,6 +4,7 @@ oracle is privileged and takes what truly gains most."""
 from __future__ import annotations
 
 import copy
+import itertools
 
 import gymnasium as gym
 import numpy as np
@@ -12,7 +13,8 @@ import pytest
 import sfw_gym  # noqa: F401
 from sfw_gym.agents import AGENTS, agent_class, is_privileged, make_agent
 from sfw_gym.agents.rollout_explore import RolloutExplorer, true_path_bits
-from sfw_gym.mapping import belief_classes
+from sfw_gym.mapping import DryRun, belief_classes
+from sfw_gym.navigation import walls_crossed
 from sfw_gym.navigation.planning import cost_field
 
 SMALL = "SfW-ExploreSmall-v0"
@@ -107,3 +109,48 @@ def test_the_unvisited_free_menu_offers_believed_free_cells_away_from_the_path()
     env, _ = drive(default, steps=80)
     view, cells = beyond_now(default, env)
     assert belief_classes(view.belief_u8)[2][cells[:, 0], cells[:, 1]].all()  # unknown only
+
+
+@pytest.mark.parametrize("walls_from", ["belief", "predicted"])
+def test_path_bits_follow_the_strongest_router_and_the_walls_between(walls_from):
+    """Each reading's ray is the router the finder predicts strongest in its cell, its k the
+    runs of walls (believed, or predicted) between them: the dry run fed those gives the bits."""
+    agent = RolloutExplorer(walls_from=walls_from)
+    env, _ = drive(agent, steps=60)
+    view = env.unwrapped.robot_view()
+    rows, cols = np.mgrid[1 : view.grid.n_rows : 6, 1 : view.grid.n_cols : 6]
+    xy = view.grid.cell_to_world(np.stack([rows.ravel(), cols.ravel()], 1))  # all over the map
+    starts = np.array([0, len(xy) // 2])
+    zone = agent.finder.strongest_router(view)
+    router = np.array([zone[view.grid.clipped_cell(p)] for p in xy])
+    if walls_from == "belief":
+        walls = belief_classes(view.belief_u8)[1]
+    else:
+        walls = agent.prediction(view).p_wall >= 0.5
+    k = walls_crossed(view.grid, walls, view.routers_xy, router, xy)
+    expected = DryRun.of_view(view).path_gains(xy, router, k, starts)
+    np.testing.assert_array_equal(agent.path_bits(view, xy, starts), expected)
+    assert len(set(router.tolist())) == 2 and k.max() >= 1  # both routers, some walls
+
+
+@pytest.mark.parametrize("rank_by", ["rate", "total"])
+def test_a_path_scores_its_readings_bits_by_rank_by(rank_by):
+    """``rate``: the best-prefix rate over at least min_prefix_steps readings; ``total``: their
+    sum."""
+    agent = RolloutExplorer(walls_from="belief", rank_by=rank_by, min_prefix_steps=3)
+    env, _ = drive(agent, steps=60)
+    view = env.unwrapped.robot_view()
+    paths = cost_field(agent._costs(view), view.cell, view.grid.resolution_m)
+    goals = np.array([c for c, _ in agent.candidates][:6])
+    xy, starts = agent.readings(view, paths, goals)
+    bits = agent.path_bits(view, xy, starts)
+    bounds = [*starts.tolist(), len(bits)]
+    per_path = [bits[a:b] for a, b in itertools.pairwise(bounds)]
+    if rank_by == "total":
+        expected = [g.sum() for g in per_path]
+    else:
+        expected = [
+            max(g[:m].sum() / max(m, 3) for m in range(min(3, len(g)), len(g) + 1))
+            for g in per_path
+        ]
+    np.testing.assert_allclose(agent.path_rates(view, paths, goals), expected, rtol=1e-12)
