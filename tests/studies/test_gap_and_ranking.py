@@ -33,6 +33,7 @@ def test_the_gap_bins_partition_the_unknown_free_cells_and_the_sources_the_bits(
     assert sum(walls) == left
     assert bins["in sight"] + bins["out of sight"] == left
     assert bins["room entered"] + bins["room never entered"] + bins["in no room"] == left
+    assert bins["room entered"] > 0 and bins["room never entered"] > 0  # 200 steps: some rooms
     assert sum(row["sources"].values()) == pytest.approx(row["bits"], rel=1e-9)
 
 
