@@ -52,3 +52,8 @@ def test_the_ranking_probe_scores_the_top_candidates_against_their_true_bits():
         for m in r.MODELS:
             assert np.isnan(row[m]) or -1.0 <= row[m] <= 1.0
             assert 0.0 <= row["regret"][m] <= row["truth_max"] - min(row["truth"]) + 1e-12
+    # the dry run's total ranks well: its choice loses less than a candidate of average truth
+    model = "dry run, predicted walls: total"
+    lost = np.mean([row["regret"][model] for row in agent.rows])
+    average = np.mean([row["truth_max"] - np.mean(row["truth"]) for row in agent.rows])
+    assert lost < average
