@@ -76,19 +76,7 @@ def main() -> None:
     )
     args = p.parse_args()
 
-    agents, params, label = [], json.loads(args.agent_params), {}
-    for name in args.agents.split(","):
-        if name in TUNED:
-            label_text, entry, kwargs = TUNED[name]
-            agents.append(entry)
-            params[entry] = kwargs
-            label[entry] = label_text
-        else:
-            agents.append(name)
-            label[name] = agent_label(name, is_privileged(name))
-            if params.get(name):  # a variant: name its settings
-                settings = ", ".join(f"{k}={v}" for k, v in params[name].items())
-                label[name] = f"{label[name]} ({settings})"
+    agents, params, label = resolve_agents(args.agents.split(","), json.loads(args.agent_params))
     if args.model and "regions-ppo" in agents:
         params.setdefault("regions-ppo", {})["path"] = args.model
     result = evaluate(
@@ -182,6 +170,27 @@ def main() -> None:
     if args.write_docs:
         page, block = args.write_docs.split(":")
         write_block(RESULTS / page, block, [f"`{command_line()}`:", "", *lines])
+
+
+def resolve_agents(
+    names: list[str], params: dict[str, dict]
+) -> tuple[list[str], dict[str, dict], dict[str, str]]:
+    """The agents to evaluate, their parameters and their table labels: a tuned heuristic by
+    its entry point, an oracle marked †, a variant with parameters labelled with them."""
+    agents, params, label = [], dict(params), {}
+    for name in names:
+        if name in TUNED:
+            label_text, entry, kwargs = TUNED[name]
+            agents.append(entry)
+            params[entry] = kwargs
+            label[entry] = label_text
+        else:
+            agents.append(name)
+            label[name] = agent_label(name, is_privileged(name))
+            if params.get(name):  # a variant: name its settings
+                settings = ", ".join(f"{k}={v}" for k, v in params[name].items())
+                label[name] = f"{label[name]} ({settings})"
+    return agents, params, label
 
 
 def curve_at(curve: list[list[float]], step: int) -> tuple[float, float]:

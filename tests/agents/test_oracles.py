@@ -356,3 +356,19 @@ def test_belief_paths_go_round_a_wall_the_belief_holds():
         path = oracle._driven_paths(view, start, true_paths).path(goal)
         rows[name] = max(grid.cell_to_world(np.asarray(path))[:, 1])
     assert rows["oracle-coverage"] < 1.5 and rows["oracle-belief-paths"] > 3.0
+
+
+def test_the_study_labels_oracles_and_variants_by_their_settings():
+    script = ROOT / "scripts/studies/regions_study.py"
+    spec = importlib.util.spec_from_file_location("study", script)
+    assert spec and spec.loader
+    study = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(study)
+    entry = "sfw_gym.rl.predict_explore:RolloutExploreAgent"
+    agents, params, label = study.resolve_agents(
+        ["frontier", "oracle-rollout", entry], {entry: {"horizon_steps": 60, "menu": "x"}}
+    )
+    assert agents == ["frontier", "oracle-rollout", entry]
+    assert label["frontier"] == "frontier" and label["oracle-rollout"] == "oracle-rollout †"
+    assert label[entry] == f"{entry} (horizon_steps=60, menu=x)"
+    assert params == {entry: {"horizon_steps": 60, "menu": "x"}}
