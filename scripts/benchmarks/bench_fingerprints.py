@@ -108,8 +108,8 @@ TRACES = (
 
 def figure(layouts: Path, columns: dict, path: Path, walks: int = 2) -> None:
     """A few tracked walks per floor over the layout image (0.1 m a pixel, origin bottom-left)."""
-    import imageio.v3 as iio
     import matplotlib
+    from PIL import Image
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -117,7 +117,7 @@ def figure(layouts: Path, columns: dict, path: Path, walks: int = 2) -> None:
     fig, axes = plt.subplots(1, 3, figsize=(18, 4.6))
     labels = np.asarray(columns["trajectory"])
     for ax, (floor, name) in zip(axes, WIFINE_FLOORS.items(), strict=True):
-        image = iio.imread(layouts / f"Floor_{name}_10cm.png")
+        image = np.asarray(Image.open(layouts / f"Floor_{name}_10cm.png"))
         height, width = image.shape[:2]
         ax.imshow(image, extent=(0, width / 10, 0, height / 10), alpha=0.35)
         on_floor = [

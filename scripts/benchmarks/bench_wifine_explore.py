@@ -22,8 +22,8 @@ import argparse
 import time
 from pathlib import Path
 
-import imageio.v3 as iio
 import numpy as np
+from PIL import Image
 
 from sfw_gym.datasets import WIFINE_FLOORS, write_wifine_maps
 from sfw_gym.evaluation import evaluate
@@ -36,9 +36,7 @@ ENV_ID = "SfW-Explore-v0"
 
 def stack_figures(paths: list[Path], out: Path) -> Path:
     """The figures one above the other on white, quantised to 64 colours (a small PNG)."""
-    from PIL import Image
-
-    images = [iio.imread(p)[..., :3] for p in paths]
+    images = [np.asarray(Image.open(p).convert("RGB")) for p in paths]
     width = max(im.shape[1] for im in images)
     rows = [
         np.pad(im, ((0, 0), (0, width - im.shape[1]), (0, 0)), constant_values=255) for im in images

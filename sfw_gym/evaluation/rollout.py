@@ -214,7 +214,10 @@ def _write_npz(path: Path, **arrays: Any) -> None:
 
 
 def _write_gif(path: Path, frames: list[np.ndarray], fps: int) -> None:
-    import imageio.v3 as iio
+    from PIL import Image
 
-    with atomic_path(path) as tmp:
-        iio.imwrite(tmp, np.stack(frames), extension=".gif", duration=1000 / fps, loop=0)
+    first, *rest = (Image.fromarray(frame) for frame in frames)
+    with atomic_path(path) as tmp:  # loop=0: played over and over, not once
+        first.save(
+            tmp, format="GIF", save_all=True, append_images=rest, duration=1000 / fps, loop=0
+        )

@@ -133,15 +133,18 @@ def _number(value: Any, what: str) -> float:
 
 def _read_gray(image: Path) -> np.ndarray:
     """The image as float grey levels 0-255 ([row, col], row 0 the top)."""
-    import imageio.v3 as iio
+    from PIL import Image
 
     if not image.is_file():
         raise FloorplanError(f"image {str(image)!r} not found")
-    try:
-        pixels = np.asarray(iio.imread(image, plugin="pillow"))  # PNG, PGM, ...: Pillow's formats
+    try:  # PNG, PGM, ...: Pillow's formats; a palette image as its colours
+        with Image.open(image) as img:
+            pixels = np.asarray(img.convert("RGBA") if img.mode in ("P", "PA") else img)
     except Exception as exc:  # any of Pillow's errors: an unreadable image
         first = (str(exc).splitlines() or [type(exc).__name__])[0]
         raise FloorplanError(f"cannot read image {str(image)!r}: {first}") from None
+    if pixels.dtype == np.int32 and pixels.min() >= 0 and pixels.max() <= 65535:
+        pixels = pixels.astype(np.uint16)  # 16-bit grey as older Pillow opens it (mode "I")
     if pixels.dtype == np.bool_:
         scale = 255.0
     elif pixels.dtype == np.uint8:

@@ -6,9 +6,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import gymnasium as gym
-import imageio.v3 as iio
 import numpy as np
 import pytest
+from PIL import Image
 
 import sfw_gym  # noqa: F401  (registration)
 from sfw_gym.core.errors import FloorplanError
@@ -49,7 +49,7 @@ def write_map(folder: Path, image: str | None = "map.png", name: str = "map.yaml
 
 @pytest.fixture
 def ros_map(tmp_path: Path) -> Path:
-    iio.imwrite(tmp_path / "map.png", IMAGE)
+    Image.fromarray(IMAGE).save(tmp_path / "map.png")
     return write_map(tmp_path)
 
 
@@ -70,7 +70,7 @@ def test_free_space_is_the_largest_free_region_on_the_pixel_edges(ros_map: Path)
 def test_pixels_touching_at_a_corner_keep_the_outline_simple(tmp_path: Path) -> None:
     image = np.full((4, 4), 255, np.uint8)
     image[1, 2] = image[2, 1] = 0  # two walls touching at one corner, as do the free (1, 1), (2, 2)
-    iio.imwrite(tmp_path / "map.png", image)
+    Image.fromarray(image).save(tmp_path / "map.png")
     plan = load_floorplan(write_map(tmp_path))
     assert plan.free_space.is_valid and len(plan.free_space.interiors) == 1
     # the two free pixels' corners there are cut by 1/8 px² each
@@ -81,7 +81,7 @@ def test_pixels_touching_at_a_corner_keep_the_outline_simple(tmp_path: Path) -> 
 
 
 def test_negate_makes_the_dark_pixels_free(tmp_path: Path) -> None:
-    iio.imwrite(tmp_path / "map.png", IMAGE)
+    Image.fromarray(IMAGE).save(tmp_path / "map.png")
     plan = load_floorplan(write_map(tmp_path, negate=1))
     dark = {(0, 3), (0, 4), (1, 3), (2, 3), (2, 4), (3, 0), (3, 1), (3, 2), (3, 3)}
     assert plan.area_m2 == pytest.approx(len(dark) * RES**2, abs=1e-12)
@@ -91,7 +91,7 @@ def test_negate_makes_the_dark_pixels_free(tmp_path: Path) -> None:
 
 
 def test_free_thresh_decides_the_unknown_pixel(tmp_path: Path) -> None:
-    iio.imwrite(tmp_path / "map.png", IMAGE)
+    Image.fromarray(IMAGE).save(tmp_path / "map.png")
     plan = load_floorplan(write_map(tmp_path, free_thresh=0.6, occupied_thresh=0.9))
     assert plan.area_m2 == pytest.approx(9 * RES**2, abs=1e-12)  # p = 0.498 < 0.6: free
     assert len(plan.free_space.interiors) == 0
@@ -99,9 +99,12 @@ def test_free_thresh_decides_the_unknown_pixel(tmp_path: Path) -> None:
 
 
 def test_colour_and_pgm_images_read_as_grey(tmp_path: Path) -> None:
-    iio.imwrite(tmp_path / "rgba.png", np.dstack([IMAGE, IMAGE, IMAGE, np.full_like(IMAGE, 7)]))
-    iio.imwrite(tmp_path / "map.pgm", IMAGE)  # map_saver's format
-    for image in ("rgba.png", "map.pgm"):
+    rgba = np.dstack([IMAGE, IMAGE, IMAGE, np.full_like(IMAGE, 7)])
+    Image.fromarray(rgba).save(tmp_path / "rgba.png")
+    Image.fromarray(IMAGE).save(tmp_path / "map.pgm")  # map_saver's format
+    Image.fromarray(IMAGE.astype(np.uint16) * 257).save(tmp_path / "grey16.png")  # 0-65535
+    Image.fromarray(rgba[..., :3]).quantize(4).save(tmp_path / "palette.png")  # a colour table
+    for image in ("rgba.png", "map.pgm", "grey16.png", "palette.png"):
         plan = load_floorplan(write_map(tmp_path, image=image))
         assert plan.area_m2 == pytest.approx(8 * RES**2, abs=1e-12), image
 
@@ -109,8 +112,8 @@ def test_colour_and_pgm_images_read_as_grey(tmp_path: Path) -> None:
 def test_image_paths_relative_to_the_yaml_or_absolute(tmp_path: Path) -> None:
     (tmp_path / "maps" / "img").mkdir(parents=True)
     (tmp_path / "elsewhere").mkdir()
-    iio.imwrite(tmp_path / "maps" / "img" / "floor.png", IMAGE)
-    iio.imwrite(tmp_path / "elsewhere" / "floor.png", IMAGE)
+    Image.fromarray(IMAGE).save(tmp_path / "maps" / "img" / "floor.png")
+    Image.fromarray(IMAGE).save(tmp_path / "elsewhere" / "floor.png")
     relative = write_map(tmp_path / "maps", image="img/floor.png")
     absolute = write_map(tmp_path / "maps", image=str(tmp_path / "elsewhere" / "floor.png"))
     renamed = write_map(tmp_path / "maps", image="img/floor.png", name="floor.YML")
@@ -141,8 +144,8 @@ def test_image_paths_relative_to_the_yaml_or_absolute(tmp_path: Path) -> None:
 def test_malformed_maps_get_one_line_naming_the_file(
     tmp_path: Path, keys: dict, message: str
 ) -> None:
-    iio.imwrite(tmp_path / "map.png", IMAGE)
-    iio.imwrite(tmp_path / "black.png", np.zeros_like(IMAGE))
+    Image.fromarray(IMAGE).save(tmp_path / "map.png")
+    Image.fromarray(np.zeros_like(IMAGE)).save(tmp_path / "black.png")
     (tmp_path / "garbage.png").write_bytes(b"not a png at all")
     image = keys.pop("image", "map.png")
     path = write_map(tmp_path, image=image, **keys)
@@ -168,7 +171,7 @@ def test_malformed_yaml_files(tmp_path: Path) -> None:
 def test_the_env_explores_a_ros_map(tmp_path: Path) -> None:
     room = np.zeros((30, 40), np.uint8)  # 4 x 3 m at 0.1 m: a room inside a wall of one pixel
     room[1:-1, 1:-1] = 254
-    iio.imwrite(tmp_path / "room.png", room)
+    Image.fromarray(room).save(tmp_path / "room.png")
     path = write_map(tmp_path, image="room.png", name="room.yaml", resolution=0.1)
     env = gym.make("SfW-ExploreSmall-v0")
     for source in (path, str(path)):
@@ -198,7 +201,7 @@ def test_wifine_floors_load_with_the_documented_frame(
     rows = pd.concat(pd.read_csv(f, usecols=["x", "y", "floorID"]) for f in files)
     assert (rows["floorID"] == floor_id).all()
     xy = rows[["x", "y"]].to_numpy()
-    height = iio.improps(image).shape[0] * 0.1
+    height = Image.open(image).height * 0.1
     inside = plan.is_free(xy).mean()
     flipped = plan.is_free(np.column_stack([xy[:, 0], height - xy[:, 1]])).mean()
     assert inside >= 0.5 and inside >= flipped + 0.15, (inside, flipped)
