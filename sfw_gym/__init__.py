@@ -8,7 +8,7 @@ from __future__ import annotations
 from sfw_gym.core.errors import ConfigError, FloorplanError, SfwGymError
 from sfw_gym.envs import ENV_IDS, register_envs
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 register_envs()
 
