@@ -2,7 +2,9 @@
 
 Every agent is built with keyword parameters (all optional), bound to an episode with
 ``agent.reset(env)`` and asked for actions with ``agent.act(obs)``; see :mod:`sfw_gym.agents.base`.
-``make_agent("frontier", **params)`` builds one by its command-line name.
+``make_agent("frontier", **params)`` builds one by its command-line name: a name of
+:data:`AGENTS`, one an installed package adds through the :data:`ENTRY_POINT_GROUP` entry points,
+or a ``"module:Class"`` (:func:`agent_class`, the one place every command resolves a name).
 """
 
 from __future__ import annotations
@@ -56,8 +58,49 @@ DEPRECATED_AGENTS: dict[str, str] = {
 }
 
 
+#: The entry-point group through which an installed package adds agents by name, for every
+#: command that takes one: in its pyproject.toml,
+#: ``[project.entry-points."sfw_gym.agents"]`` ``mine = "pkg.mod:MyAgent"``.
+ENTRY_POINT_GROUP = "sfw_gym.agents"
+
+
+def installed_agents() -> dict[str, str]:
+    """The agents installed packages add (:data:`ENTRY_POINT_GROUP`), name → ``"module:Class"``.
+    A name the package has already (:data:`AGENTS`, :data:`DEPRECATED_AGENTS`) stays the
+    built-in's, with a warning."""
+    from importlib.metadata import entry_points
+
+    found: dict[str, str] = {}
+    for point in entry_points(group=ENTRY_POINT_GROUP):
+        if point.name in AGENTS or point.name in DEPRECATED_AGENTS:
+            warnings.warn(
+                f"entry point {point.name} = {point.value!r} ({ENTRY_POINT_GROUP}) is ignored: "
+                f"{point.name!r} is a built-in agent's name; run yours as {point.value!r}",
+                stacklevel=2,
+            )
+            continue
+        found.setdefault(point.name, point.value)
+    return found
+
+
+def agent_names() -> list[str]:
+    """Every agent name the commands take: :data:`AGENTS`', then :func:`installed_agents`'
+    (deprecated names work, with a warning, but are not listed)."""
+    return [*AGENTS, *installed_agents()]
+
+
+def unknown_agents_error(names: list[str]) -> ConfigError:
+    """The one-line error for agent names that are none of :func:`agent_names`."""
+    which = f"agent {names[0]!r}" if len(names) == 1 else f"agent(s) {names}"
+    return ConfigError(
+        f"unknown {which}; known: {', '.join(agent_names())}; or a 'module:Class' of your own"
+    )
+
+
 def register_agent(name: str, entry_point: str) -> None:
-    """Make ``make_agent(name)`` (and ``sfw-gym evaluate --agents name``) build your agent."""
+    """Make ``make_agent(name)`` build your agent, in this process only (the evaluation's
+    worker processes and a command line reach it by ``"module:Class"`` or an installed
+    package's :data:`ENTRY_POINT_GROUP` entry point)."""
     if ":" not in entry_point:
         raise ConfigError(
             f"agent {name!r}: entry point must be 'module:Class', got {entry_point!r}"
@@ -66,14 +109,16 @@ def register_agent(name: str, entry_point: str) -> None:
 
 
 def known_agent(name: str) -> bool:
-    """Whether ``name`` is registered (or a deprecated name of a registered agent)."""
-    return name in AGENTS or name in DEPRECATED_AGENTS
+    """Whether ``name`` is registered, installed (:func:`installed_agents`) or a deprecated
+    name of a registered agent."""
+    return name in AGENTS or name in DEPRECATED_AGENTS or name in installed_agents()
 
 
 def agent_class(name: str) -> type[Agent]:
-    """The class registered as ``name``, or named by a ``"module:Class"`` entry point (which
-    also reaches the evaluation's worker processes, where a :func:`register_agent` call made in
-    the parent is unknown). A deprecated name warns and resolves to its new one."""
+    """The class registered as ``name``, installed as ``name`` (:func:`installed_agents`), or
+    named by a ``"module:Class"`` (both also reach the evaluation's worker processes, where a
+    :func:`register_agent` call made in the parent is unknown). A deprecated name warns and
+    resolves to its new one."""
     if name in DEPRECATED_AGENTS and name not in AGENTS:
         new = DEPRECATED_AGENTS[name]
         warnings.warn(
@@ -83,12 +128,12 @@ def agent_class(name: str) -> type[Agent]:
             stacklevel=3,
         )
         name = new
-    entry_point = AGENTS.get(name) or (name if ":" in name else None)
-    module, _, cls = (entry_point or "").partition(":")
+    installed = installed_agents()  # read here, so that a clash with a built-in warns
+    entry_point = AGENTS.get(name) or installed.get(name)
+    module, _, cls = (entry_point or (name if ":" in name else "")).partition(":")
     if not (module and cls):
-        raise ConfigError(
-            f"unknown agent {name!r}; known: {sorted(AGENTS)} or a 'module:Class' of your own"
-        )
+        raise unknown_agents_error([name])
+    entry_point = f"{module}:{cls}"
     try:
         found = getattr(importlib.import_module(module), cls)
     except ImportError as exc:
@@ -124,6 +169,7 @@ def make_agent(name: str, **params: Any) -> Agent:
 __all__ = [
     "AGENTS",
     "DEPRECATED_AGENTS",
+    "ENTRY_POINT_GROUP",
     "STOP_REASONS",
     "Agent",
     "CrossPassAgent",
@@ -134,8 +180,11 @@ __all__ = [
     "RobotView",
     "RobotViewHandle",
     "agent_class",
+    "agent_names",
+    "installed_agents",
     "is_privileged",
     "known_agent",
     "make_agent",
     "register_agent",
+    "unknown_agents_error",
 ]
