@@ -8,15 +8,14 @@ import gymnasium as gym
 
 ENTRY_POINT = "sfw_gym.envs.explore:SfWExploreEnv"
 
-#: Every registered id with its kwargs (also the parametrisation of the env test suite).
+#: Every registered id with its kwargs (also the parametrisation of the env test suite); what
+#: each one is: :data:`ENV_SUMMARIES`; its versions: :data:`ENV_HISTORY`.
 ENV_IDS: dict[str, dict[str, Any]] = {
     "SfW-Explore-v0": {},
-    # Explore the whole building: the step budget grows with the plan (steps per m² of free area).
     "SfW-ExploreFull-v0": {"steps_per_m2": 60.0, "max_steps": 30_000},
     "SfW-ExploreDiscrete-v0": {"action_type": "discrete"},
     "SfW-ExploreThick-v0": {"radio_preset": "thick"},
     "SfW-ExploreResidential-v0": {"radio_preset": "residential"},
-    # Small and quick, for tests and smoke runs: small plans, coarse grid, short episodes.
     "SfW-ExploreSmall-v0": {
         "generator": {"area_m2": 45.0},
         "resolution_m": 0.2,
@@ -24,40 +23,66 @@ ENV_IDS: dict[str, dict[str, Any]] = {
         "crop_px": 36,
         "max_steps": 300,
     },
-    # Candidate-goal actions: pick one of K goals of the navigation menu, the robot drives there.
     "SfW-ExploreGoals-v0": {},
-    # Region actions: pick one of K candidates as a region every 20 steps; the classical local
-    # steering drives towards it (≤ 150 decisions an episode; sfw_gym.envs.regions).
     "SfW-ExploreRegions-v0": {},
-    # Drifting odometry (5 % of each step's travel, 0.02 rad of heading per step: about 1 m of
-    # ATE over 1,500 frontier steps, scripts/studies/slam_study.py) and 16 background access
-    # points whose fingerprint Radio SLAM (sfw_gym.slam.radio_slam) can close loops with.
     "SfW-ExploreDrift-v0": {
         "robot": {"odometry_translation_std": 0.05, "odometry_heading_std_rad": 0.02},
         "n_background_aps": 16,
     },
-    # The same drift, mapped along Radio SLAM's trajectory: solved again every 100 steps, the
-    # map rebuilt along each correction (sfw_gym.slam.OnlineRadioSlam).
     "SfW-ExploreRadioSLAM-v0": {
         "robot": {"odometry_translation_std": 0.05, "odometry_heading_std_rad": 0.02},
         "n_background_aps": 16,
         "pose_source": "radio_slam",
     },
-    # A 2-D LiDAR on the robot (360 beams, 8 m), the same drift and APs, mapped along
-    # Radio+LiDAR SLAM's trajectory (the Radio SLAM paper's second system): the reference for
-    # how close WiFi-only mapping comes (sfw_gym.slam.radio_lidar).
     "SfW-ExploreLidar-v0": {
         "robot": {"odometry_translation_std": 0.05, "odometry_heading_std_rad": 0.02},
         "n_background_aps": 16,
         "lidar": {},
         "pose_source": "radio_lidar",
     },
-    # Find yourself on a known plan: a survey's GP gridmaps and WiFi Monte-Carlo localisation
-    # from an unknown start (sfw_gym.envs.localize), the same drift and APs.
     "SfW-Localize-v0": {
         "robot": {"odometry_translation_std": 0.05, "odometry_heading_std_rad": 0.02},
         "n_background_aps": 16,
     },
+}
+
+_DRIFT = (
+    "drifting odometry (5 % of each step's travel, 0.02 rad of heading per step: about 1 m of "
+    "ATE over 1,500 frontier steps, scripts/studies/slam_study.py) and 16 background access "
+    "points heard as a fingerprint"
+)
+#: What each id is, in a sentence or two (the first lines of its reference page).
+ENV_SUMMARIES: dict[str, str] = {
+    "SfW-Explore-v0": "The benchmark: continuous (linear, angular) actions, 10 dB per wall, "
+    "3,000 steps whatever the plan's size.",
+    "SfW-ExploreFull-v0": "Explore the whole building: the step budget grows with the plan, "
+    "60 steps per m² of free area (at most 30,000).",
+    "SfW-ExploreDiscrete-v0": "Discrete actions: forward, turn left, turn right.",
+    "SfW-ExploreThick-v0": "Thick walls: 15 dB per wall (the paper's building).",
+    "SfW-ExploreResidential-v0": "Per-material wall losses (the hard mode).",
+    "SfW-ExploreSmall-v0": "Small and quick, for tests and smoke runs: small plans, 0.2 m "
+    "cells, 300 steps.",
+    "SfW-ExploreGoals-v0": "Candidate-goal actions: pick one of K goals of the navigation "
+    "menu, the robot drives there.",
+    "SfW-ExploreRegions-v0": "Region actions: pick one of K candidates as a region every 20 "
+    "steps; the classical local steering drives towards it (≤ 150 decisions an episode).",
+    "SfW-ExploreDrift-v0": f"The robot maps where its odometry says it is: {_DRIFT}, whose "
+    "fingerprints Radio SLAM (sfw_gym.slam.radio_slam) can close loops with.",
+    "SfW-ExploreRadioSLAM-v0": f"{_DRIFT[0].upper()}{_DRIFT[1:]}, mapped along Radio SLAM's "
+    "trajectory: solved again every 100 steps, the map rebuilt along each correction "
+    "(sfw_gym.slam.OnlineRadioSlam).",
+    "SfW-ExploreLidar-v0": "A 2-D LiDAR on the robot (360 beams, 8 m), the same drift and "
+    "access points, mapped along Radio+LiDAR SLAM's trajectory (the Radio SLAM paper's second "
+    "system): the reference for how close WiFi-only mapping comes (sfw_gym.slam.radio_lidar).",
+    "SfW-Localize-v0": "Find yourself on a known plan: a survey's GP gridmaps and WiFi "
+    "Monte-Carlo localisation from an unknown start, with the same drift and access points.",
+}
+
+#: Each id's versions, oldest first: (version, what changed). The one place for them: the env
+#: reference pages print them and the changelog points here. A change that alters an id's
+#: behaviour or spaces registers the next version (``-v1``) and adds its entry.
+ENV_HISTORY: dict[str, tuple[tuple[str, str], ...]] = {
+    env_id: (("v0", "Initial version."),) for env_id in ENV_IDS
 }
 #: Ids whose env is not the explore env itself.
 ENTRY_POINTS: dict[str, str] = {

@@ -36,79 +36,96 @@ from sfw_gym.world.lidar import Lidar
 class SfWExploreEnv(gym.Env):
     """Active WiFi exploration: a robot maps walls from RSSI by sparse inverse k-visibility.
 
-    ## Description
-    A differential-drive disc robot (pymunk) drives through an indoor floorplan. It has no camera
-    and no LiDAR: each step it hears the RSSI of the WiFi routers (log-distance path loss, a loss
-    per wall crossed, correlated shadowing, noise) and feels whether it bumped into a wall. From
-    these and its odometry, a sparse inverse k-visibility mapper (Kim et al., arXiv:2408.07757)
-    estimates how many walls separate it from each router and updates an occupancy belief map
-    along the router–robot rays. The task: make that map complete and right, fast.
+    Description:
+        A differential-drive disc robot (pymunk) drives through an indoor floorplan. It has no
+        camera and no LiDAR: each step it hears the RSSI of the WiFi routers (log-distance path
+        loss, a loss per wall crossed, correlated shadowing, noise) and feels whether it bumped
+        into a wall. From these and its odometry, a sparse inverse k-visibility mapper (Kim et
+        al., arXiv:2408.07757) estimates how many walls separate it from each router and updates
+        an occupancy belief map along the router–robot rays. The task: make that map complete
+        and right, fast.
 
-    ## Action Space
-    ``action_type="continuous"``: ``Box(-1, 1, (2,), float32)`` = (linear, angular) velocity as
-    fractions of the robot's limits (0.5 m/s, 1.5 rad/s by default). Out-of-range values are
-    clipped to [-1, 1]; NaN or inf raise ``ValueError``.
-    ``action_type="discrete"``: ``Discrete(3)``: 0 forward, 1 turn left, 2 turn right (in place).
+    Action Space:
+        ``action_type="continuous"``: ``Box(-1, 1, (2,), float32)`` = (linear, angular) velocity
+        as fractions of the robot's limits (0.5 m/s, 1.5 rad/s by default). Out-of-range values
+        are clipped to [-1, 1]; NaN or inf raise ``ValueError``.
+        ``action_type="discrete"``: ``Discrete(3)``: 0 forward, 1 turn left, 2 turn right (in
+        place).
 
-    ## Observation Space
-    ``Dict`` accepted by stable-baselines3's ``MultiInputPolicy``:
+    Observation Space:
+        A ``Dict`` that stable-baselines3's ``MultiInputPolicy`` takes as is:
 
-    - ``map``: ``uint8 (3, M, M)``, M = ``map_px`` (64): the belief map fitted to the image (0 wall,
-      255 free, 127 unknown), the trajectory (128) with the robot (255), the routers (255);
-    - ``local``: ``uint8 (1, C, C)``, C = ``crop_px`` (48): the belief around the robot at full
-      resolution (north up);
-    - ``state``: ``float32 (2R + 6,)``: per router the normalised RSSI ((dBm + 100) / 80, 0 when not
-      heard) and a heard flag; bump; the pose estimate's x, y in [0, 1] over the map; sin and cos
-      of its heading; the fraction of the map the robot believes known.
+        - ``map``: ``uint8 (3, M, M)``, M = ``map_px``: the belief map fitted to the image (0
+          wall, 255 free, 127 unknown), the trajectory (128) with the robot (255), the routers
+          (255);
+        - ``local``: ``uint8 (1, C, C)``, C = ``crop_px``: the belief around the robot at full
+          resolution (north up);
+        - ``state``: ``float32 (2R + 6,)``: per router the normalised RSSI ((dBm + 100) / 80, 0
+          when not heard) and a heard flag; bump; the pose estimate's x, y in [0, 1] over the
+          map; sin and cos of its heading; the fraction of the map the robot believes known;
+        - with ``n_background_aps`` > 0: ``fingerprint`` (each access point's normalised RSSI)
+          and ``fingerprint_heard``; with a LiDAR: ``lidar`` (each beam's range ÷ its maximum).
 
-    ## Rewards
-    ``reward_scale`` × information gain of the map this step (bits; the entropy decrease of the
-    belief), minus ``collision_penalty`` on a bump. With the defaults (0.01 per bit, 0.1 m cells)
-    the reward is about the square metres of map resolved.
+    Rewards:
+        ``reward_scale`` × the information gain of the map this step (bits; the entropy
+        decrease of the belief), minus ``collision_penalty`` on a bump. With the defaults (0.01
+        per bit, 0.1 m cells) the reward is about the square metres of map resolved.
 
-    ## Starting State
-    A fresh procedural floorplan from the env's RNG each episode (or the ``floorplan`` kwarg or
-    option), ``n_routers`` routers placed where a person would (k-means centres of the free space),
-    the robot at a random free pose with clearance, the map unknown.
+    Starting State:
+        A fresh procedural floorplan from the env's RNG each episode (or the ``floorplan``
+        kwarg or option), ``n_routers`` routers placed where a person would (k-means centres of
+        the free space), the robot at a random free pose with clearance, the map unknown.
 
-    ## Episode End
-    Terminated when the ground-truth coverage (fraction of free cells the map has classified)
-    reaches ``coverage_target`` (0.95). Truncated by the env itself after the episode's step
-    budget, so that the final ``info["summary"]`` (episode metrics, steps to 50/90 % coverage) is
-    always there. ``SfW-Explore-v0``: ``max_steps`` = 3,000 steps (300 m of driving at full speed)
-    whatever the plan's size, the benchmark of how much a robot maps in a fixed time.
-    ``SfW-ExploreFull-v0``: ``steps_per_m2`` = 60 steps per m² of the plan's free area (capped by
-    ``max_steps`` = 30,000), room for a frontier explorer to map 90 % of any plan (see
-    docs/results/agents.md). The episode's budget is ``info["max_steps"]``.
-    ``gym.make(..., max_episode_steps=N)`` still works but truncates from outside, without it.
+    Episode End:
+        Terminated when the ground-truth coverage (fraction of free cells the map has
+        classified) reaches ``coverage_target``. Truncated by the env itself after the
+        episode's step budget (``info["max_steps"]``), so that the final ``info["summary"]``
+        (episode metrics, steps to 50/90 % coverage) is always there: ``max_steps`` whatever
+        the plan's size (the benchmark of how much a robot maps in a fixed time), or with
+        ``steps_per_m2`` a budget that grows with the plan's free area, capped by
+        ``max_steps``. ``gym.make(..., max_episode_steps=N)`` still works but truncates from
+        outside, without the summary.
 
-    ## Arguments
-    ``gym.make("SfW-Explore-v0", **kwargs)`` with, all JSON-serialisable: ``action_type``
-    ("continuous" | "discrete"), ``floorplan`` (None: procedural each episode; an int: that
-    generator seed every episode; a path: a HouseExpo or sfw_gym JSON file or a ROS map YAML; a
-    folder: one of its JSON files each episode), ``generator`` (dict of `generate_floorplan`
-    params), ``n_routers`` (2), ``radio_preset`` ("default" | "thick" | "residential"),
-    ``radio_band`` ("2.4" | "5"), ``radio`` / ``robot`` / ``mapper`` (dicts of RadioConfig /
-    RobotConfig / MapperConfig overrides), ``resolution_m`` (0.1), ``map_px`` (64), ``crop_px``
-    (48), ``coverage_target`` (0.95), ``collision_penalty`` (0.1), ``reward_scale`` (0.01),
-    ``max_steps`` (3000), ``steps_per_m2`` (None: the budget is ``max_steps``; a number: the budget
-    is ``min(max_steps, ceil(steps_per_m2 × free area))``), ``n_background_aps`` (0: access points
-    beyond the routers, half in the building and half in its neighbourhood, whose RSSI the robot
-    hears as a fingerprint: ``obs["fingerprint"]``, ``obs["fingerprint_heard"]`` and
-    ``info["fingerprint"]``; Radio SLAM's input), ``pose_source`` ("odometry": the robot maps where
-    its odometry says it is; "radio_slam": odometry corrected by radio loop closures between
-    background-AP fingerprints, solved every ``slam["solve_every"]`` steps, the map rebuilt along
-    each correction; "radio_lidar": Radio+LiDAR SLAM, the same with LiDAR scan matching; "true": the
-    true pose), ``slam`` (dict of `RadioSlamConfig` overrides; the odometry weights default to the
-    robot's noise model), ``lidar`` (None: no LiDAR, the default; a dict of `LidarConfig` overrides,
-    ``{}`` for the defaults: a simulated 2-D LiDAR, ``obs["lidar"]`` and ``info["lidar_ranges"]``),
-    ``render_mode`` (None | "rgb_array" | "human"), ``render_size`` ((960, 480): every frame is
-    ``width × height``, the plan letterboxed into it, so video writers work across plans; None: the
-    plan's own size). ``reset(options=…)``: ``floorplan`` (a Floorplan, a path or a generator seed),
-    ``routers`` (positions (R, 2) or a count ≤ n_routers), ``start_pose`` ((x, y, θ)).
+    Arguments:
+        action_type: "continuous" (wheel velocities) or "discrete" (forward, left, right).
+        floorplan: None: a procedural plan each episode; an int: that generator seed every
+            episode; a path: a HouseExpo or sfw_gym JSON file or a ROS map YAML; a folder: one
+            of its JSON files each episode.
+        generator: Overrides of the procedural plans' `GeneratorConfig` (dict).
+        n_routers: Routers the robot hears and maps from.
+        radio_preset: The walls' losses: "default", "thick" or "residential" (per material).
+        radio_band: "2.4" or "5" (GHz).
+        radio: Overrides of `RadioConfig` (dict).
+        robot: Overrides of `RobotConfig` (dict): size, speeds, odometry noise.
+        mapper: Overrides of `MapperConfig` (dict).
+        resolution_m: The map's cell size.
+        map_px: Side of the ``map`` observation image.
+        crop_px: Side of the ``local`` observation crop.
+        coverage_target: Coverage that ends the episode.
+        collision_penalty: Reward lost per bump.
+        reward_scale: Reward per bit of information gain.
+        max_steps: The step budget (its cap when ``steps_per_m2`` is set).
+        steps_per_m2: None: the budget is ``max_steps``; a number: ``min(max_steps,
+            ceil(steps_per_m2 × free area))``.
+        n_background_aps: Access points beyond the routers, half in the building and half in
+            its neighbourhood, whose RSSI the robot hears as a fingerprint
+            (``obs["fingerprint"]``, ``obs["fingerprint_heard"]``, ``info["fingerprint"]``):
+            Radio SLAM's input.
+        pose_source: Where the robot believes it is, and so where it maps: "odometry";
+            "radio_slam": odometry corrected by radio loop closures between background-AP
+            fingerprints, solved every ``slam["solve_every"]`` steps, the map rebuilt along each
+            correction; "radio_lidar": Radio+LiDAR SLAM, the same with LiDAR scan matching;
+            "true": the true pose.
+        slam: Overrides of `RadioSlamConfig` (dict); the odometry weights default to the
+            robot's noise model.
+        lidar: None: no LiDAR; a dict of `LidarConfig` overrides (``{}`` for the defaults): a
+            simulated 2-D LiDAR, ``obs["lidar"]`` and ``info["lidar_ranges"]``.
+        render_mode: None, "rgb_array" or "human".
+        render_size: (width, height) of every frame, the plan letterboxed into it, so video
+            writers work across plans; None: the plan's own size.
 
-    ## Version History
-    - v0: initial release.
+    ``reset(options=…)`` takes ``floorplan`` (a Floorplan, a path or a generator seed),
+    ``routers`` (positions (R, 2) or a count ≤ ``n_routers``) and ``start_pose`` ((x, y, θ)).
     """
 
     metadata: dict[str, Any] = {"render_modes": ["rgb_array", "human"], "render_fps": 10}  # noqa: RUF012

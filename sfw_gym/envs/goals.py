@@ -1,11 +1,5 @@
-"""Candidate-goal actions: each action picks one of K goals from the navigation menu
-(:func:`~sfw_gym.navigation.candidate_goals`) and the robot drives there.
-
-One decision spans several env steps. Its reward is what the decision bought, in bits: the map's
-information gain, minus a cost per metre driven and per step spent (a contact costs the steps it
-wastes, no separate fine), plus a bonus when the coverage target is reached; divided by
-``reward_scale_bits`` so that a good decision is worth about one.
-"""
+"""Candidate-goal actions: ``SfW-ExploreGoals-v0`` (:class:`SfWGoalsEnv`): each action picks
+one of K goals from the navigation menu and the robot drives there."""
 
 from __future__ import annotations
 
@@ -46,7 +40,8 @@ _SCALES = np.array([FEATURE_SCALES[name] for name in FEATURES])
 
 @dataclass(frozen=True)
 class GoalsConfig(Config):
-    """Decisions and their reward (bits; see the module doc)."""
+    """The menu's size (``max_candidates``), a decision's step limit and its reward (bits; see
+    :class:`SfWGoalsEnv`)."""
 
     prefix: ClassVar[str | None] = "goals"
     max_candidates: int = setting(16, ge=2, le=128, integer=True)
@@ -60,19 +55,39 @@ class GoalsConfig(Config):
 class SfWGoalsEnv(gym.Env):
     """``SfW-ExploreGoals-v0``: ``Discrete(K)`` actions over the candidate-goal menu.
 
-    The observation is the explore env's, plus ``candidates`` (``(K, F)`` features of
-    :data:`~sfw_gym.navigation.menu.FEATURES`, each divided by its
-    :data:`FEATURE_SCALES` entry; 0 for empty slots) and ``candidate_mask`` (1 where the goal is
-    reachable). :meth:`action_masks` gives the mask to sb3-contrib's ``MaskablePPO``.
+    Description:
+        Each action picks one of K goals from the navigation menu
+        (:func:`~sfw_gym.navigation.candidate_goals`: frontier goals with a path on the belief
+        map) and the robot drives there, so a policy learns *where* to explore. One decision
+        spans several steps of the explore env it wraps: the robot drives along the candidate's
+        path (pure pursuit) until the goal is reached, the target cell is resolved, a bump,
+        ``max_steps_per_goal`` steps, or the episode's end.
 
-    A decision drives along the candidate's path (pure pursuit) until the goal is reached, the
-    target cell is resolved, a bump, ``max_steps_per_goal`` steps, or the episode's end. A
-    masked action is no goal: the robot turns in place for one step (``info["invalid_action"]``).
+    Action Space:
+        ``Discrete(K)``, K = ``max_candidates``: a slot of the menu. A masked action is no goal:
+        the robot turns in place for one step (``info["invalid_action"]``);
+        :meth:`action_masks` gives the mask to sb3-contrib's ``MaskablePPO``.
+
+    Observation Space:
+        The explore env's, plus ``candidates`` (``(K, F)`` features of
+        :data:`~sfw_gym.navigation.menu.FEATURES`, each divided by its :data:`FEATURE_SCALES`
+        entry; 0 for empty slots) and ``candidate_mask`` (1 where the goal is reachable).
+
+    Rewards:
+        What the decision bought, in bits: the map's information gain, minus
+        ``cost_per_m_bits`` per metre driven and ``cost_per_step_bits`` per step spent (a
+        contact costs the steps it wastes, no separate fine), plus ``goal_bonus_bits`` when the
+        coverage target is reached; divided by ``reward_scale_bits`` so that a good decision is
+        worth about one.
+
+    Episode End:
+        As the explore env's (coverage target or step budget, counted in its steps); the
+        decision under way stops there.
 
     Args:
-        goals: :class:`GoalsConfig` fields (dict).
+        goals: Overrides of :class:`GoalsConfig` (dict): the menu's size and the reward.
         render_mode: As the explore env's.
-        **explore_kwargs: The explore env's kwargs.
+        **explore_kwargs: The explore env's keyword arguments.
     """
 
     metadata = SfWExploreEnv.metadata

@@ -1,14 +1,5 @@
-"""``SfW-Localize-v0``: find yourself on a known plan from WiFi fingerprints (Miyagusuku et al.).
-
-At every reset the env surveys the plan (a fingerprint of the background access points every
-``survey_spacing_m`` over the free space), fits a GP signal model to it and stores its Gaussian
-gridmaps; the robot then starts at a pose it does not know, and a WiFi Monte-Carlo localiser
-(:class:`~sfw_gym.localization.WifiMCL`) starts from its first fingerprint (Alg. 1). Each step
-the robot drives as in the explore env, the localiser takes the odometry increment and the new
-fingerprint. ``kidnap_step`` > 0 carries the robot to a random free pose at that step, unseen by
-its odometry. The reward is the reduction of the localisation error bound (the particles' RMS
-spread, metres).
-"""
+"""``SfW-Localize-v0`` (:class:`SfWLocalizeEnv`): find yourself on a known plan from WiFi
+fingerprints (Miyagusuku et al.)."""
 
 from __future__ import annotations
 
@@ -51,15 +42,36 @@ class LocalizeConfig(Config):
 
 
 class SfWLocalizeEnv(gym.Env):
-    """The explore env's observation plus ``belief`` (float32 (5,): the estimate's x, y scaled
-    to [0, 1] over the plan, the sine and cosine of its heading, its spread / 10 m clipped to 1);
-    ``info["loc_error_m"]`` (estimate to truth), ``info["loc_spread_m"]``,
-    ``info["loc_estimate"]``, ``info["kidnapped"]``.
+    """``SfW-Localize-v0``: WiFi Monte-Carlo localisation on a known plan, from an unknown start.
+
+    Description:
+        At every reset the env surveys the plan (a fingerprint of the background access points
+        every ``survey_spacing_m`` over the free space), fits a GP signal model to it and stores
+        its Gaussian gridmaps; the robot then starts at a pose it does not know, and a WiFi
+        Monte-Carlo localiser (:class:`~sfw_gym.localization.WifiMCL`) starts from its first
+        fingerprint (Alg. 1). Each step the robot drives as in the explore env; the localiser
+        takes the odometry increment and the new fingerprint. ``kidnap_step`` > 0 carries the
+        robot to a random free pose at that step, unseen by its odometry, to test recovery.
+
+    Observation Space:
+        The explore env's plus ``belief`` (float32 (5,): the estimate's x, y scaled to [0, 1]
+        over the plan, the sine and cosine of its heading, its spread / 10 m clipped to 1);
+        ``info["loc_error_m"]`` (estimate to truth), ``info["loc_spread_m"]``,
+        ``info["loc_estimate"]``, ``info["kidnapped"]``.
+
+    Rewards:
+        The fall of the localisation error bound (the particles' RMS spread, metres) this step.
+
+    Starting State:
+        The explore env's, with the survey's gridmaps built and the localiser's particles
+        spread over the plan by the first fingerprint.
 
     Args:
-        localize: :class:`LocalizeConfig` fields (dict).
+        localize: Overrides of :class:`LocalizeConfig` (dict): the survey, the signal model and
+            the localiser.
         render_mode: As the explore env's.
-        **explore_kwargs: The explore env's kwargs (``n_background_aps`` ≥ 1 needed).
+        **explore_kwargs: The explore env's keyword arguments (``n_background_aps`` ≥ 1
+            needed).
     """
 
     metadata = SfWExploreEnv.metadata

@@ -1,18 +1,5 @@
-"""Region actions: ``SfW-ExploreRegions-v0``, decisions that go somewhere.
-
-An action picks one of K candidates of the navigation menu (as ``SfW-ExploreGoals-v0``'s do), but
-the candidate is a *region*, not a goal: for ``decision_steps`` env steps the classical local
-steering drives towards it and collects what lies along the way
-(:class:`~sfw_gym.navigation.regions.RegionSteering`: explore_lite's choice among frontier
-clusters, each lowered by its distance from the chosen candidate's target). 20 steps a decision
-make ≤ 150 decisions in a 3,000-step episode, against ~1,600 one-to-two-step decisions of the
-goals env, so a policy's credit assignment spans an episode.
-
-The observation adds ``candidate_px`` (each candidate's target on the ``map`` image, (row, col)
-÷ ``map_px``), so a policy can read the whole map at each candidate; with ``privileged=True`` (for
-training only: an asymmetric critic) also ``true_map``, the ground-truth plan on the same image
-(0 wall, 255 free, 127 outside). The reward is the goals env's, per decision.
-"""
+"""Region actions: ``SfW-ExploreRegions-v0`` (:class:`SfWRegionsEnv`), decisions that go
+somewhere."""
 
 from __future__ import annotations
 
@@ -43,14 +30,33 @@ class RegionsConfig(GoalsConfig):
 class SfWRegionsEnv(SfWGoalsEnv):
     """``SfW-ExploreRegions-v0``: ``Discrete(K)`` region choices, ``decision_steps`` each.
 
-    A masked action chooses no region: the local steering runs unanchored for the decision
-    (``info["invalid_action"]``). :meth:`teacher_action` is explore_lite's choice on the menu.
+    Description:
+        An action picks one of K candidates of the navigation menu (as ``SfW-ExploreGoals-v0``'s
+        do), but the candidate is a *region*, not a goal: for ``decision_steps`` env steps the
+        classical local steering drives towards it and collects what lies along the way
+        (:class:`~sfw_gym.navigation.regions.RegionSteering`: explore_lite's choice among
+        frontier clusters, each lowered by its distance from the chosen candidate's target). 20
+        steps a decision make ≤ 150 decisions in a 3,000-step episode, against ~1,600
+        one-to-two-step decisions of the goals env, so a policy's credit assignment spans an
+        episode. :meth:`teacher_action` is explore_lite's choice on the menu.
+
+    Action Space:
+        ``Discrete(K)``, K = ``max_candidates``. A masked action chooses no region: the local
+        steering runs unanchored for the decision (``info["invalid_action"]``).
+
+    Observation Space:
+        The goals env's, plus ``candidate_px`` (each candidate's target on the ``map`` image,
+        (row, col) ÷ ``map_px``), so a policy can read the whole map at each candidate; with
+        ``privileged=True`` also ``true_map``, the ground-truth plan on the same image (0 wall,
+        255 free, 127 outside).
 
     Args:
-        regions: :class:`RegionsConfig` fields (dict).
-        privileged: Add the ground truth ``true_map`` to the observation (training only).
+        regions: Overrides of :class:`RegionsConfig` (dict): the goals env's settings plus the
+            decision's length and the steering's pull.
+        privileged: Add the ground truth ``true_map`` to the observation (for training only:
+            an asymmetric critic).
         render_mode: As the explore env's.
-        **explore_kwargs: The explore env's kwargs.
+        **explore_kwargs: The explore env's keyword arguments.
     """
 
     config_class: ClassVar[type[GoalsConfig]] = RegionsConfig
