@@ -78,3 +78,11 @@ def test_references_include_the_three_papers() -> None:
     titles = {" ".join(str(r["title"]).split()) for r in load_cff()["references"]}
     missing = [p for p in PAPERS if p not in titles]
     assert not missing, f"CITATION.cff's references lack {missing}"
+
+
+def test_the_citing_section_cites_this_version() -> None:
+    """docs/index.md's BibTeX entry for sfw_gym names the version CITATION.cff gives."""
+    index = (ROOT / "docs" / "index.md").read_text(encoding="utf-8")
+    entry = index[index.index("@software{sfw_gym,") :]
+    entry = entry[: entry.index("\n}")]
+    assert f"version = {{{sfw_gym.__version__}}}" in entry
