@@ -1,8 +1,9 @@
 """Learning: PPO and MaskablePPO training (stable-baselines3, sb3-contrib, rl-zoo
-hyperparameters), the policies, and the agents that act with a trained model (``PPOAgent``:
-candidate goals, the shipped learned explorer; ``RegionsPPOAgent``: a region every 20 steps;
-``WheelsPPOAgent``: PPO from scratch on the wheel commands; ``WaypointPPOAgent``: the earlier
-block-waypoint policy). The only layer that imports torch and
+hyperparameters), the policies, and the agents that act with a trained model
+(``RegionsPPOAgent``: a region every 20 steps, ``regions-ppo``, the default learned explorer and
+the demo's; ``PPOAgent``: a candidate goal per decision, ``goals-ppo``; ``WheelsPPOAgent``: PPO
+from scratch on the wheel commands, ``wheels-ppo``; ``WaypointPPOAgent``: the block-waypoint
+policy, ``waypoint-ppo``, which did not learn). The only layer that imports torch and
 stable-baselines3 (``pip install 'sfw-gym[rl]'``).
 """
 
