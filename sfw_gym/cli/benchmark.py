@@ -4,15 +4,18 @@ fixed splits; ``benchmark compare`` pairs two results files."""
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
 from sfw_gym.cli.options import (
+    EPISODE_ROUTERS_HELP,
     add_command,
     add_episode_runner_options,
     add_out_folder,
+    add_routers,
     add_seed,
+    agents_from_here,
     json_object,
+    optional_routers,
     positive_int,
     runner_settings,
 )
@@ -43,8 +46,11 @@ def add_options(parser: argparse.ArgumentParser) -> None:
     bench_run.add_argument("--agent-params", default=None, help="the agent's parameters as JSON")
     add_seed(bench_run, "the agent seed")
     bench_run.add_argument(
-        "--plans", default=None, help="a folder of plan files to add (by the split)"
+        "--plans",
+        default=None,
+        help="a folder of plan files, JSON or ROS map YAML, to add (by the split)",
     )
+    add_routers(bench_run, EPISODE_ROUTERS_HELP)
     bench_run.add_argument(
         "--episodes", type=positive_int, default=None, help="at most this many episodes per env"
     )
@@ -73,8 +79,7 @@ def run(args: argparse.Namespace) -> int:
         a, b = (benchmark.load_results(p) for p in args.results)
         print(benchmark.compare(a, b), end="")
         return 0
-    # an agent of one's own, importable from the current folder (as `python -m` would)
-    sys.path.insert(0, str(Path.cwd()))
+    agents_from_here()
     out = args.out or f"benchmark/{args.agent.replace(':', '.')}/{args.split}"
     benchmark.run_benchmark(
         args.agent,
@@ -84,6 +89,7 @@ def run(args: argparse.Namespace) -> int:
         agent_params=json_object("--agent-params", args.agent_params),
         agent_seed=args.seed,
         plans=args.plans,
+        routers=optional_routers(args.routers),
         episodes=args.episodes,
         **runner_settings(args),
     )

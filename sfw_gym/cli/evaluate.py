@@ -7,12 +7,16 @@ import argparse
 from pathlib import Path
 
 from sfw_gym.cli.options import (
+    EPISODE_ROUTERS_HELP,
     add_env,
     add_episode_runner_options,
     add_out_folder,
+    add_routers,
     add_seed,
+    agents_from_here,
     json_object,
     non_negative_int,
+    optional_routers,
     positive_int,
     runner_settings,
 )
@@ -22,11 +26,11 @@ HELP = "compare agents on the same floorplans and seeds (table, curves, paths)"
 
 
 def agents_help() -> str:
-    """``--agents``' help: the agent registry's names as they are now (deprecated names work,
-    with a warning, but are not listed)."""
-    from sfw_gym.agents import AGENTS
+    """``--agents``' help: every agent name as it is now, installed ones included
+    (:func:`~sfw_gym.agents.agent_names`)."""
+    from sfw_gym.agents import agent_names
 
-    return f"comma-separated agent names: {', '.join(AGENTS)}; or package.module:Class"
+    return f"comma-separated agent names: {', '.join(agent_names())}; or package.module:Class"
 
 
 def add_options(parser: argparse.ArgumentParser) -> None:
@@ -36,8 +40,10 @@ def add_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--floorplans",
         default=None,
-        help="folder of plan files (cycled) or one file (default: the env's procedural plans)",
+        help="folder of plan files, JSON or ROS map YAML (cycled), or one file (default: the "
+        "env's procedural plans)",
     )
+    add_routers(parser, EPISODE_ROUTERS_HELP)
     add_env(parser)
     parser.add_argument("--env-kwargs", default=None, help="extra gym.make kwargs as JSON")
     parser.add_argument(
@@ -62,6 +68,7 @@ def add_options(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from sfw_gym.evaluation import evaluate
 
+    agents_from_here()
     result = evaluate(
         [a.strip() for a in args.agents.split(",") if a.strip()],
         args.episodes,
@@ -69,6 +76,7 @@ def run(args: argparse.Namespace) -> int:
         out=args.out,
         env_id=args.env,
         floorplans=args.floorplans,
+        routers=optional_routers(args.routers),
         env_kwargs=json_object("--env-kwargs", args.env_kwargs),
         agent_params=json_object("--agent-params", args.agent_params),
         gif_episodes=args.gif_episodes if args.gif else 0,

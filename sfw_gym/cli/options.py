@@ -62,6 +62,36 @@ def parse_routers(text: str) -> np.ndarray | int:
     return arr
 
 
+#: ``--routers``' help where it places the routers of one plan (``world``, ``record``).
+ROUTERS_HELP = "a count, or positions 'x1,y1;x2,y2' (m) (default: the plan's own routers, else 2)"
+#: ``--routers``' help where it places every episode's (``evaluate``, ``benchmark run``).
+EPISODE_ROUTERS_HELP = (
+    "every episode's routers: a count, or positions 'x1,y1;x2,y2' (m) (default: a plan's own "
+    "routers, else the env's n_routers placed by k-means)"
+)
+
+
+def add_routers(parser: Options, help: str = ROUTERS_HELP) -> None:
+    """``--routers``: a count or positions in metres, read by :func:`optional_routers` (its
+    bad input a one-line error naming ``--routers``); the order of who places the routers is
+    :func:`~sfw_gym.world.floorplan.chosen_routers`'."""
+    parser.add_argument("--routers", default=None, help=help)
+
+
+def optional_routers(text: str | None) -> np.ndarray | int | None:
+    """:func:`parse_routers` of an optional ``--routers`` (None: not given)."""
+    return None if text is None else parse_routers(text)
+
+
+def agents_from_here() -> None:
+    """Let an agent's ``module:Class`` name a module of the current folder, as ``python -m``
+    would (the worker processes, spawned, inherit the path)."""
+    import sys
+
+    if str(Path.cwd()) not in sys.path:
+        sys.path.insert(0, str(Path.cwd()))
+
+
 def json_object(option: str, text: str | None) -> dict:
     """A command-line JSON object (empty when not given), or a one-line error naming ``option``."""
     import json

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from sfw_gym.cli.options import add_seed, parse_routers, positive_float
+from sfw_gym.cli.options import add_routers, add_seed, optional_routers, positive_float
 
 EXAMPLE = "sfw-gym record walk.csv --seed 3 --routers 2"
 HELP = "record an RSSI log (CSV, the SfW layout) from the simulator, the truth beside it"
@@ -15,7 +15,7 @@ def add_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("out", help="the CSV to write; .truth.npy and .truth.json go beside it")
     parser.add_argument("--floorplan", help="a floorplan file (default: a generated one)")
     add_seed(parser, "plan, routers, walk and radio")
-    parser.add_argument("--routers", default="2", help="a count, or positions 'x1,y1;x2,y2' (m)")
+    add_routers(parser)
     parser.add_argument(
         "--trajectory",
         choices=["walk", "survey"],
@@ -28,9 +28,10 @@ def add_options(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from sfw_gym.evaluation.logs import read_log_meta, record_log
     from sfw_gym.world import generate_floorplan, load_floorplan
+    from sfw_gym.world.floorplan import chosen_routers
 
     plan = load_floorplan(args.floorplan) if args.floorplan else generate_floorplan(args.seed)
-    routers = parse_routers(args.routers)
+    routers = chosen_routers(optional_routers(args.routers), plan, default=2)
     paths = record_log(
         plan, args.out, routers=routers, seed=args.seed, trajectory=args.trajectory,
         step_m=args.step,

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from sfw_gym.cli.options import add_env, non_negative_int, positive_int
+from sfw_gym.cli.options import add_env, agents_from_here, non_negative_int, positive_int
 
 EXAMPLE = "sfw-gym speed --steps 5000 --resets 50"
 HELP = "the env's throughput: steps/s and reset ms beside CartPole-v1 (alias: bench)"
@@ -36,6 +36,7 @@ def add_options(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from sfw_gym.bench import main_bench
 
+    agents_from_here()
     agents = [a for a in args.agents.split(",") if a] if args.agents else None
     return main_bench(
         args.env, args.steps, args.resets, args.memory_steps, agents, args.agent_episodes

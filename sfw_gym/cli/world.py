@@ -7,7 +7,7 @@ import time
 
 import numpy as np
 
-from sfw_gym.cli.options import add_seed, parse_routers, positive_float
+from sfw_gym.cli.options import add_routers, add_seed, optional_routers, positive_float
 
 EXAMPLE = "sfw-gym world --seed 3 --out world.png"
 HELP = "draw a floorplan, its routers, RSSI and true k-regions"
@@ -21,7 +21,7 @@ def add_options(parser: argparse.ArgumentParser) -> None:
     source.add_argument(
         "--floorplan", help="a floorplan file: HouseExpo or sfw_gym JSON, or a ROS map YAML"
     )
-    parser.add_argument("--routers", default="2", help="a count, or positions 'x1,y1;x2,y2'")
+    add_routers(parser)
     parser.add_argument("--preset", choices=PRESETS, default="default", help="radio preset")
     parser.add_argument("--band", choices=list(BANDS), default="2.4", help="GHz")
     parser.add_argument(
@@ -32,6 +32,7 @@ def add_options(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from sfw_gym.world import RadioConfig, RadioModel, load_floorplan, place_routers
+    from sfw_gym.world.floorplan import chosen_routers
     from sfw_gym.world.picture import draw_world
 
     start = time.perf_counter()
@@ -42,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
         from sfw_gym.world.generator import generate_floorplan
 
         plan = generate_floorplan(args.seed)
-    routers = parse_routers(args.routers)
+    routers = chosen_routers(optional_routers(args.routers), plan, default=2)
     if isinstance(routers, int):
         routers = place_routers(plan, routers, rng)
     radio = RadioModel(plan, routers, RadioConfig.preset(args.preset, band=args.band), rng)

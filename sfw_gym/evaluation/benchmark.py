@@ -74,12 +74,13 @@ def split_seeds(protocol: dict[str, Any], split: str) -> tuple[int, int]:
 
 
 def split_plan_files(protocol: dict[str, Any], folder: str | Path, split: str) -> list[Path]:
-    """The plan files (``*.json``) of ``folder`` that fall in ``split`` (by name hash)."""
+    """The plan files of ``folder`` (JSON plans and ROS map YAMLs:
+    :func:`~sfw_gym.evaluation.runner.plan_files`) that fall in ``split`` (by name hash)."""
+    from sfw_gym.evaluation.runner import plan_files
+
     _check_split(split)
     buckets = set(protocol["splits"]["plan_files"][split])
-    files = sorted(Path(folder).glob("*.json"))
-    if not files:
-        raise ConfigError(f"--plans {folder}: no .json floorplan files there")
+    files = [Path(f) for f in plan_files(folder, "--plans") if f]
     return [f for f in files if _bucket(f.name) in buckets]
 
 
@@ -108,6 +109,7 @@ def run_benchmark(
     agent_seed: int = 0,
     plans: str | Path | None = None,
     episodes: int | None = None,
+    routers: Any = None,
     workers: int = 1,
     backend: str = "local",
     address: str | None = None,
@@ -117,11 +119,19 @@ def run_benchmark(
     ``split``; writes ``OUT/results.json``, ``OUT/results.md`` and ``OUT/index.html`` (the same
     tables for a browser) and returns the results.
     ``episodes`` caps the episodes per env (a quick look; recorded in the results);
+    ``routers`` places every episode's routers (positions ``[[x, y], ...]`` or a count; None:
+    a plan's own, else the env's k-means placement: :func:`~sfw_gym.evaluation.runner.
+    episode_routers`);
     ``workers``, ``backend`` and ``address`` as :func:`~sfw_gym.evaluation.evaluate`'s."""
     from sfw_gym import __version__
     from sfw_gym.agents import is_privileged
     from sfw_gym.evaluation.rollout import EpisodeSpec
-    from sfw_gym.evaluation.runner import run_specs
+    from sfw_gym.evaluation.runner import (
+        check_routers,
+        episode_routers,
+        routers_json,
+        run_specs,
+    )
 
     proto = load_protocol(protocol)
     first, last = split_seeds(proto, split)
@@ -136,6 +146,9 @@ def run_benchmark(
             files += [str(p) for p in split_plan_files(proto, plans, split)]
         if len(files) > last - first + 1:
             raise ConfigError(f"protocol: {len(files)} episodes exceed the {split} split's seeds")
+        used = episode_routers(routers_json(routers), files)
+        if routers is not None:
+            check_routers(env["id"], env.get("kwargs"), used, first)
         for i, plan in enumerate(files):
             specs.append(
                 EpisodeSpec(
@@ -145,6 +158,7 @@ def run_benchmark(
                     agent_seed=agent_seed_for(first + i, agent_seed),
                     env_id=env["id"],
                     floorplan=plan,
+                    routers=used[plan],
                     env_kwargs=dict(env.get("kwargs") or {}),
                     agent_params=dict(agent_params or {}),
                     npz_path=None,
@@ -157,7 +171,7 @@ def run_benchmark(
         "agent_params": json.loads(json.dumps(agent_params or {})),
         "split": split,
         "plans": None if plans is None else str(plans),
-    }
+    } | ({} if routers is None else {"routers": routers_json(routers)})
     require_same_run(out, run, "benchmark")
     start = time.perf_counter()
     records = run_specs(specs, out, executor)
@@ -175,7 +189,7 @@ def run_benchmark(
         "plans": None if plans is None else Path(plans).name,
         "episodes": [_episode_row(r, proto) for r in records],
         "timing": {"wall_s": time.perf_counter() - start, "workers": workers},
-    }
+    } | ({} if routers is None else {"routers": routers_json(routers)})
     results["summary"] = summarize_results(results, proto)
     write_text_atomic(out / "results.json", json.dumps(results, indent=1, sort_keys=True) + "\n")
     write_report(out / "results.md", results_markdown(results))  # and index.html

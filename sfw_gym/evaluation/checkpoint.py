@@ -68,17 +68,19 @@ def evaluation_manifest(
     floorplans: str | Path | None,
     env_kwargs: dict[str, Any] | None,
     agent_params: dict[str, dict[str, Any]] | None,
+    routers: list[list[float]] | int | None = None,
 ) -> dict[str, Any]:
     """An evaluation's ``config.json``: what its episodes ran with. Resuming in a folder whose
-    recorded episodes ran with another env, plans, env kwargs or agent parameters is refused
-    (their records would be reused as if they were this run's); more agents or episodes extend
-    it."""
+    recorded episodes ran with another env, plans, routers, env kwargs or agent parameters is
+    refused (their records would be reused as if they were this run's); more agents or episodes
+    extend it."""
     given = json.loads(
         json.dumps(
             {
                 "env_id": env_id,
                 "floorplans": str(floorplans) if floorplans else None,
                 "env_kwargs": env_kwargs or {},
+                "routers": routers,
                 "agent_params": {name: (agent_params or {}).get(name, {}) for name in agents},
             }
         )
@@ -93,7 +95,7 @@ def evaluation_manifest(
                 f"{path}: unreadable run manifest ({exc}); use another --out"
             ) from None
     ran = {r["agent"] for r in records}
-    for key in ("env_id", "floorplans", "env_kwargs"):
+    for key in ("env_id", "floorplans", "routers", "env_kwargs"):
         if previous and previous.get(key) != given[key]:
             raise ConfigError(
                 f"{out}: its {len(records)} recorded episodes ran with {key} "

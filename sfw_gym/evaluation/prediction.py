@@ -95,7 +95,8 @@ def _run(vec: Any, n: int, queue: list[SnapshotEpisode], out: Path, make_agent, 
         if not queue:
             return
         ep = queue.pop(0)
-        obs, _ = reset_sub_env(vec, i, ep.seed, ep.floorplan)
+        plan = {"floorplan": ep.floorplan} if ep.floorplan else None
+        obs, _ = reset_sub_env(vec, i, ep.seed, plan)
         agent = make_agent(ep.agent)
         agent.reset(vec.envs[i], seed=ep.seed)
         view = unwrap_sfw(vec.envs[i]).robot_view()

@@ -35,6 +35,8 @@ class EpisodeSpec:
         seed: ``env.reset`` seed (``seed + i``); also the agent's seed.
         env_id: Gymnasium id.
         floorplan: Plan file passed as ``reset(options={"floorplan": ...})``, or None.
+        routers: Router positions ``[[x, y], ...]`` (metres) or a count, passed as
+            ``reset(options={"routers": ...})``; None: the env's own (k-means) placement.
         env_kwargs: Extra ``gym.make`` kwargs.
         agent_params: Agent constructor parameters.
         curve_every: Record ``[step, coverage, map IoU, path length m, entropy bits]`` every
@@ -51,6 +53,7 @@ class EpisodeSpec:
     seed: int
     env_id: str = "SfW-Explore-v0"
     floorplan: str | None = None
+    routers: list[list[float]] | int | None = None
     env_kwargs: dict[str, Any] = field(default_factory=dict)
     agent_params: dict[str, Any] = field(default_factory=dict)
     curve_every: int = 10
@@ -68,7 +71,18 @@ class EpisodeSpec:
     def key(self) -> str:
         """Identity in the checkpoint (an episode with the same key is not run again)."""
         key = f"{self.agent}|{self.episode}|{self.seed}|{self.env_id}|{self.floorplan}"
-        return key if self.agent_seed is None else f"{key}|{self.agent_seed}"
+        key = key if self.agent_seed is None else f"{key}|{self.agent_seed}"
+        return key if self.routers is None else f"{key}|routers={self.routers}"
+
+    @property
+    def reset_options(self) -> dict[str, Any]:
+        """The episode's ``reset`` options: its plan file and routers, where given."""
+        options: dict[str, Any] = {}
+        if self.floorplan:
+            options["floorplan"] = self.floorplan
+        if self.routers is not None:
+            options["routers"] = self.routers
+        return options
 
 
 # ---------------------------------------------------------------------------------- one episode
@@ -147,6 +161,7 @@ class EpisodeRecord:
             "env_id": spec.env_id,
             "floorplan": truth.floorplan.name,
             "floorplan_file": spec.floorplan,
+            "routers": np.asarray(truth.radio.routers).tolist(),
             "area_m2": float(truth.floorplan.area_m2),
             "steps": self.steps,
             "terminated": bool(terminated),
@@ -182,8 +197,7 @@ def run_episode(spec: EpisodeSpec) -> dict[str, Any]:
     start = time.perf_counter()
     render = "rgb_array" if spec.gif_path else None
     env = gym.make(spec.env_id, render_mode=render, **spec.env_kwargs)
-    options = {"floorplan": spec.floorplan} if spec.floorplan else None
-    obs, info = env.reset(seed=spec.seed, options=options)
+    obs, info = env.reset(seed=spec.seed, options=spec.reset_options or None)
     episode = EpisodeRecord(spec, info, start)
     agent = make_agent(spec.agent, **spec.agent_params)
     agent.reset(env, seed=spec.agent_reset_seed)

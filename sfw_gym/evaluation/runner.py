@@ -56,9 +56,12 @@ __all__ = [
     "BACKENDS",
     "CHECKPOINT",
     "EpisodeSpec",
+    "check_routers",
+    "episode_routers",
     "evaluate",
     "load_checkpoint",
     "plan_files",
+    "routers_json",
     "run_episode",
     "run_specs",
     "zone_band_unknown",
@@ -94,18 +97,64 @@ def run_specs(
     return [by_key[s.key] for s in specs]
 
 
-def plan_files(floorplans: str | Path | None) -> list[str | None]:
-    """The plan files episodes cycle through: a folder's ``*.json`` files, one file, or
-    ``[None]`` (the env's procedural plans)."""
+def plan_files(floorplans: str | Path | None, option: str = "--floorplans") -> list[str | None]:
+    """The plan files episodes cycle through: a folder's plan files (JSON plans and ROS map
+    YAMLs: :func:`~sfw_gym.world.floorplan.floorplan_files`), one file, or ``[None]`` (the
+    env's procedural plans); a folder with none is an error that names it."""
+    from sfw_gym.world.floorplan import PLAN_SUFFIXES, floorplan_files
+
     if floorplans is None:
         return [None]
-    folder = Path(floorplans)
-    if folder.is_file():
-        return [str(folder)]
-    files = sorted(folder.glob("*.json")) if folder.is_dir() else []
+    files = floorplan_files(floorplans)
     if not files:
-        raise ConfigError(f"--floorplans {floorplans}: no .json floorplan files there")
+        raise ConfigError(
+            f"{option} {floorplans}: no floorplan files there ({', '.join(PLAN_SUFFIXES)})"
+        )
     return [str(p) for p in files]
+
+
+def episode_routers(
+    routers: list[list[float]] | int | None, plans: Sequence[str | None]
+) -> dict[str | None, list[list[float]] | int | None]:
+    """Each plan file's routers for its episodes (:func:`~sfw_gym.world.floorplan.
+    chosen_routers`: ``routers``, else the plan's own, else None, the env's k-means placement).
+    Loads each plan once, so a malformed one fails here."""
+    from sfw_gym.world import load_floorplan
+    from sfw_gym.world.floorplan import chosen_routers
+
+    return {
+        plan: chosen_routers(routers, load_floorplan(plan) if plan else None)
+        for plan in dict.fromkeys(plans)
+    }
+
+
+def routers_json(routers: Any) -> list[list[float]] | int | None:
+    """``routers`` as JSON keeps it: a count, a list of ``[x, y]``, or None."""
+    if routers is None or isinstance(routers, int):
+        return routers
+    return [[float(x), float(y)] for x, y in routers]
+
+
+def check_routers(
+    env_id: str,
+    env_kwargs: dict[str, Any] | None,
+    used: dict[str | None, Any],
+    seed: int,
+) -> None:
+    """Reset the env once on each plan with its routers: ``--routers``' one-line error (a
+    router in a plan's wall, more than the env's ``n_routers``) before any episode runs."""
+    import gymnasium as gym
+
+    env = gym.make(env_id, **(env_kwargs or {}))
+    try:
+        for plan, routers in used.items():
+            options = {"routers": routers} | ({"floorplan": plan} if plan else {})
+            try:
+                env.reset(seed=seed, options=options)
+            except ConfigError as exc:
+                raise ConfigError(f"--routers: {exc}") from None
+    finally:
+        env.close()
 
 
 def evaluate(
@@ -118,6 +167,7 @@ def evaluate(
     floorplans: str | Path | None = None,
     env_kwargs: dict[str, Any] | None = None,
     agent_params: dict[str, dict[str, Any]] | None = None,
+    routers: Any = None,
     workers: int = 2,
     gif_episodes: int = 0,
     curve_every: int = 10,
@@ -135,10 +185,13 @@ def evaluate(
         seed: Seed of episode 0.
         out: Output folder (created; holds the checkpoint that a rerun resumes from).
         env_id: Gymnasium id.
-        floorplans: A folder of plan files (episode ``i`` uses file ``i mod n``) or one file;
-            None: the env's procedural plans.
+        floorplans: A folder of plan files, JSON or ROS map YAML (episode ``i`` uses file
+            ``i mod n``), or one file; None: the env's procedural plans.
         env_kwargs: Extra ``gym.make`` kwargs (JSON-serialisable).
         agent_params: Per agent name, constructor parameters.
+        routers: Every episode's routers, positions ``[[x, y], ...]`` (metres) or a count;
+            None: each plan's own routers where it stores them, else the env's k-means
+            placement (:func:`episode_routers`).
         workers: Worker processes (1: run in this process).
         gif_episodes: Write GIFs of the first this many episodes of every agent.
         curve_every: Curve sampling interval, steps.
@@ -158,17 +211,14 @@ def evaluate(
     """
     import gymnasium as gym
 
-    from sfw_gym.agents import AGENTS, agent_class, known_agent, make_agent
+    from sfw_gym.agents import agent_class, known_agent, make_agent, unknown_agents_error
 
     agents = list(dict.fromkeys(agents))
     if not agents:
         raise ConfigError("--agents: give at least one agent")
     unknown = [a for a in agents if not known_agent(a) and ":" not in a]
     if unknown:
-        raise ConfigError(
-            f"--agents: unknown agent(s) {unknown}; known: {sorted(AGENTS)} or a "
-            "'module:Class' of your own"
-        )
+        raise ConfigError(f"--agents: {unknown_agents_error(unknown)}")
     for name in agents:
         agent_class(name)  # an entry point of one's own must import, in this process too
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
@@ -194,6 +244,9 @@ def evaluate(
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     plans = plan_files(floorplans)
+    used = episode_routers(routers_json(routers), plans[:episodes])
+    if routers is not None:  # fail early on routers the env refuses (in a wall, too many)
+        check_routers(env_id, env_kwargs, used, seed)
     specs = [  # episode-major: every agent's episode 0 first
         EpisodeSpec(
             agent=name,
@@ -201,6 +254,7 @@ def evaluate(
             seed=seed + i,
             env_id=env_id,
             floorplan=plans[i % len(plans)],
+            routers=used[plans[i % len(plans)]],
             env_kwargs=dict(env_kwargs or {}),
             agent_params=dict((agent_params or {}).get(name, {})),
             curve_every=curve_every,
@@ -212,8 +266,9 @@ def evaluate(
     ]
     records = load_checkpoint(out / CHECKPOINT)
     manifest = evaluation_manifest(
-        out, records, agents, episodes, seed, env_id, floorplans, env_kwargs, agent_params
-    )
+        out, records, agents, episodes, seed, env_id, floorplans, env_kwargs, agent_params,
+        routers_json(routers),
+    )  # fmt: skip
     write_text_atomic(out / "config.json", json.dumps(manifest, indent=2) + "\n")
     mine = run_specs(specs, out, executor, vector_envs)
     rows = summarize(mine, agents)

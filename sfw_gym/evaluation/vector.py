@@ -111,7 +111,7 @@ def run_vector(
                 return
             index, spec = queue.popleft()
             begin = time.perf_counter()
-            obs, infos = reset_sub_env(vec, i, spec.seed, spec.floorplan)
+            obs, infos = reset_sub_env(vec, i, spec.seed, spec.reset_options)
             episode = EpisodeRecord(spec, SubEnvInfo(infos, i), begin)
             agent = make_agent(spec.agent, **spec.agent_params)
             agent.reset(vec.envs[i], seed=spec.agent_reset_seed)
@@ -143,19 +143,17 @@ def run_vector(
 
 
 def reset_sub_env(
-    vec: Any, i: int, seed: int, floorplan: str | None = None
+    vec: Any, i: int, seed: int, options: dict[str, Any] | None = None
 ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
     """Reset sub-env ``i`` of a native vector env alone (``reset_mask``, clearing its pending
-    autoreset) with ``seed`` and, if given, a plan file; the others go on as they were."""
+    autoreset) with ``seed`` and its ``options`` (a plan file, routers: :attr:`EpisodeSpec.
+    reset_options`); the others go on as they were."""
     n = vec.num_envs
     mask = np.zeros(n, np.bool_)
     mask[i] = True
     seeds: list[int | None] = [None] * n
     seeds[i] = seed
-    options: dict[str, Any] = {"reset_mask": mask}
-    if floorplan:
-        options["floorplan"] = floorplan
-    return vec.reset(seed=seeds, options=options)
+    return vec.reset(seed=seeds, options={**(options or {}), "reset_mask": mask})
 
 
 def _standing_action(space: gym.Space) -> Any:

@@ -38,6 +38,8 @@ MAX_FILE_BYTES = 50_000_000
 _PARALLEL_MIN_SEGMENTS = 2048
 FORMAT_NAME = "sfw_gym.floorplan"
 FORMAT_VERSION = 1
+#: The files a folder of plans holds: JSON plans (sfw_gym, HouseExpo) and ROS map YAMLs.
+PLAN_SUFFIXES = (".json", *ROS_MAP_SUFFIXES)
 
 
 @dataclass(frozen=True)
@@ -63,6 +65,9 @@ class Floorplan:
             holes; each ring without its closing vertex).
         name: an identifier (file id or generator seed).
         rooms: labelled room boxes (metadata).
+        routers: the routers' positions ``((x, y), ...)``, metres, each in the free space; empty:
+            none stored (the env places its own). The evaluation's order: ``--routers``, then
+            these, then the env's k-means placement.
     """
 
     free_space: Polygon
@@ -70,6 +75,7 @@ class Floorplan:
     edge_materials: tuple[str, ...]
     name: str = "floorplan"
     rooms: tuple[Room, ...] = ()
+    routers: tuple[tuple[float, float], ...] = ()
     edges: np.ndarray = field(init=False, repr=False)
     edge_material_index: np.ndarray = field(init=False, repr=False)
 
@@ -93,6 +99,14 @@ class Floorplan:
                 f"known: {list(MATERIALS)}"
             )
         index = np.array([MATERIALS.index(m) for m in self.edge_materials], dtype=np.int64)
+        routers = tuple((float(x), float(y)) for x, y in self.routers)
+        for i, (x, y) in enumerate(routers):
+            if not (math.isfinite(x) and math.isfinite(y) and self.is_free(np.array([x, y]))):
+                raise FloorplanError(
+                    f"floorplan {self.name!r}: router {i} at ({x:g}, {y:g}) is not in the free "
+                    "space"
+                )
+        object.__setattr__(self, "routers", routers)
         edges.setflags(write=False)
         index.setflags(write=False)
         object.__setattr__(self, "edges", edges)
@@ -213,7 +227,7 @@ class Floorplan:
             "footprint": _ring_coords(self.footprint.exterior),
             "edge_materials": list(self.edge_materials),
             "rooms": [{"label": r.label, "box": list(r.box)} for r in self.rooms],
-        }
+        } | ({"routers": [list(r) for r in self.routers]} if self.routers else {})
 
     def save(self, path: str | os.PathLike[str]) -> Path:
         """Write the plan as sfw_gym JSON, atomically (temp file + rename). Returns the path."""
@@ -334,6 +348,9 @@ def _from_sfw_dict(data: Mapping[str, Any]) -> Floorplan:
     materials = data["edge_materials"]
     if not isinstance(materials, list) or not all(isinstance(m, str) for m in materials):
         raise FloorplanError("'edge_materials' must be a list of material names")
+    routers = data.get("routers", [])
+    if not isinstance(routers, list):
+        raise FloorplanError("'routers' must be a list of [x, y] positions")
     rooms = []
     for i, room in enumerate(data.get("rooms", [])):
         if not isinstance(room, Mapping) or "label" not in room or "box" not in room:
@@ -347,11 +364,37 @@ def _from_sfw_dict(data: Mapping[str, Any]) -> Floorplan:
         tuple(materials),
         name=str(data.get("name", "floorplan")),
         rooms=tuple(rooms),
+        routers=tuple(_xy(_parse_numbers(r, f"routers[{i}]", 2)) for i, r in enumerate(routers)),
     )
+
+
+def chosen_routers(given: Any, plan: Floorplan | None, default: Any = None) -> Any:
+    """The routers an episode on ``plan`` uses: ``given`` (a command's ``--routers``: positions
+    or a count) where given, else the plan's own (:attr:`Floorplan.routers`, as ``[[x, y], ...]``),
+    else ``default`` (a count, or None: the env's ``n_routers``, both placed by k-means)."""
+    if given is not None:
+        return given
+    if plan is not None and plan.routers:
+        return [list(r) for r in plan.routers]
+    return default
+
+
+def floorplan_files(folder: str | os.PathLike[str]) -> list[Path]:
+    """A folder's plan files (:data:`PLAN_SUFFIXES`), sorted by name; a file: itself. Whether
+    each loads is :func:`load_floorplan`'s to say."""
+    path = Path(folder)
+    if path.is_file():
+        return [path]
+    found = path.iterdir() if path.is_dir() else iter(())
+    return sorted(p for p in found if p.suffix.lower() in PLAN_SUFFIXES and p.is_file())
 
 
 def _box(v: list[float]) -> tuple[float, float, float, float]:
     return v[0], v[1], v[2], v[3]
+
+
+def _xy(v: list[float]) -> tuple[float, float]:
+    return v[0], v[1]
 
 
 def _parse_numbers(values: Any, what: str, n: int) -> list[float]:

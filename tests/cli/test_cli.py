@@ -8,6 +8,7 @@ usage lines may come first), never a traceback.
 
 from __future__ import annotations
 
+import json
 import re
 import shutil
 import subprocess
@@ -166,10 +167,18 @@ CASES = [
     ),
     bad(
         [*EVALUATE, "--agents", "random,nope"],
-        r"--agents: unknown agent\(s\) \['nope'\]",
+        r"--agents: unknown agent 'nope'; known: frontier, .*; or a 'module:Class' of your own",
         id="evaluate-agent-unknown",
     ),
     bad([*EVALUATE, "--agents", ","], r"--agents: give at least one", id="evaluate-agents-none"),
+    bad(
+        [*EVALUATE, "--routers", "1,2;3"], r"--routers: .*'1,2;3'", id="evaluate-routers-malformed"
+    ),
+    bad(
+        ["benchmark", "run", "--agent", "random", "--routers", "0", "--out", "{tmp}/b"],
+        r"--routers: .*'0'",
+        id="benchmark-routers-0",
+    ),
     bad(
         [*EVALUATE, "--env", "Nope-v0"],
         r"--env Nope-v0: .*doesn't exist",
@@ -217,7 +226,7 @@ CASES = [
     ),
     bad(
         [*EVALUATE, "--floorplans", "{tmp}/missing"],
-        r"--floorplans .*missing: no \.json",
+        r"--floorplans .*missing: no floorplan files there \(\.json, \.yaml, \.yml\)",
         id="evaluate-floorplans-missing",
     ),
     bad(
@@ -349,6 +358,19 @@ def test_world_is_reproducible_from_its_seed(inputs, capsys):
     assert first == run_cli(argv, capsys).splitlines()[0]
     assert first != run_cli([*argv[:2], "6", *argv[3:]], capsys).splitlines()[0]
     assert first.count("[") == 4  # three router positions in a list
+
+
+def test_world_draws_the_plan_s_own_routers_unless_told_others(inputs, capsys):
+    from sfw_gym.world import load_floorplan
+
+    square = load_floorplan({"verts": [[0, 0], [6, 0], [6, 4], [0, 4]]})
+    hall = square.to_dict() | {"routers": [[1, 1], [5, 3]]}  # a plan with its routers
+    Path(inputs, "hall.json").write_text(json.dumps(hall))
+    argv = ["world", "--floorplan", "hall.json", "--out", "w.png", "--resolution", "0.5"]
+    assert "routers at [[1.0, 1.0], [5.0, 3.0]]" in run_cli(argv, capsys)
+    assert "routers at [[2.0, 2.0]]" in run_cli([*argv, "--routers", "2,2"], capsys)
+    line = run_cli([*argv, "--routers", "1"], capsys).splitlines()[0]
+    assert line.count("[") == 2  # one router, placed by k-means
 
 
 def test_map_reports_which_columns_feed_which_router(inputs, capsys):

@@ -14,11 +14,13 @@ from pathlib import Path
 
 import pytest
 
-from sfw_gym.agents import AGENTS, DEPRECATED_AGENTS
+from sfw_gym.agents import AGENTS, DEPRECATED_AGENTS, agent_names
 from sfw_gym.cli import build_parser, main, version
 from sfw_gym.cli.options import shown_default, shows_default
 from sfw_gym.cli.train import describe
 
+#: ``--routers``' help on evaluate and benchmark run, its default (in words) left out.
+EPISODE_ROUTERS = "every episode's routers: a count, or positions 'x1,y1;x2,y2' (m)"
 BEFORE = json.loads((Path(__file__).parent / "data" / "help_before.json").read_text("utf-8"))
 
 #: The intended differences, per command: (text before, text now), both whitespace-normalised
@@ -46,6 +48,23 @@ CORRECTIONS: dict[str, list[tuple[str, str]]] = {
             f"comma-separated agent names: {', '.join(AGENTS)}; or package.module:Class",
         ),
         ("--agents frontier,ppo,greedy", "--agents frontier,regions-ppo,greedy"),
+        # issue 52: fixed routers for every episode, and ROS maps in a folder of plans
+        (
+            "[--floorplans FLOORPLANS] [--env ENV]",
+            "[--floorplans FLOORPLANS] [--routers ROUTERS] [--env ENV]",
+        ),
+        (
+            "--floorplans FLOORPLANS folder of plan files (cycled) or one file --env ENV",
+            "--floorplans FLOORPLANS folder of plan files, JSON or ROS map YAML (cycled), or one "
+            f"file --routers ROUTERS {EPISODE_ROUTERS} --env ENV",
+        ),
+    ],
+    # issue 52: world and record share one --routers (in metres)
+    "sfw-gym world": [
+        (
+            "--routers ROUTERS a count, or positions 'x1,y1;x2,y2' --preset",
+            "--routers ROUTERS a count, or positions 'x1,y1;x2,y2' (m) --preset",
+        )
     ],
     "sfw-gym speed": [("(e.g. frontier,ppo)", "(e.g. frontier,regions-ppo)")],
     "sfw-gym bench": [("(e.g. frontier,ppo)", "(e.g. frontier,regions-ppo)")],
@@ -59,6 +78,16 @@ CORRECTIONS: dict[str, list[tuple[str, str]]] = {
         (
             "--out OUT default benchmark/AGENT/SPLIT (resumes)",
             "--out OUT output folder (resumes from it)",
+        ),
+        # issue 52: as evaluate's
+        (
+            "[--plans PLANS] [--episodes EPISODES]",
+            "[--plans PLANS] [--routers ROUTERS] [--episodes EPISODES]",
+        ),
+        (
+            "--plans PLANS a folder of plan files to add (by the split) --episodes",
+            "--plans PLANS a folder of plan files, JSON or ROS map YAML, to add (by the split) "
+            f"--routers ROUTERS {EPISODE_ROUTERS} --episodes",
         ),
     ],
     "sfw-gym fingerprints evaluate": [
@@ -201,6 +230,6 @@ def test_evaluate_lists_exactly_the_registrys_agents(monkeypatch):
     text = normalised(every_help(monkeypatch)["sfw-gym evaluate"])
     listed = re.search(r"comma-separated agent names: ([^;]*);", text)
     assert listed, text
-    assert listed.group(1).split(", ") == list(AGENTS)
+    assert listed.group(1).split(", ") == agent_names()  # AGENTS, then installed ones
     for old in DEPRECATED_AGENTS:  # still accepted (with a warning), not advertised
         assert not re.search(rf"[\s,:]{re.escape(old)}[\s,;)]", text), old

@@ -167,10 +167,32 @@ def run_page(page: Path, workspace: Path, monkeypatch: pytest.MonkeyPatch) -> in
     return ran
 
 
+def episode_records(folder: Path) -> list[dict]:
+    """An evaluation folder's episode records, by episode."""
+    lines = (folder / "episodes.jsonl").read_text(encoding="utf-8").splitlines()
+    return sorted(map(json.loads, lines), key=lambda r: r["episode"])
+
+
+def own_building_did_what_it_says(workspace: Path) -> None:
+    """The own-building page's evaluations ran with the routers and plans the page names."""
+    hall = episode_records(workspace / "runs" / "hall")
+    assert hall and all(r["routers"] == [[2.0, 2.0], [10.0, 6.0]] for r in hall)
+    assert {r["floorplan_file"] for r in hall} == {"hall.json"}
+    plans = episode_records(workspace / "runs" / "plans")
+    assert plans[0]["floorplan_file"] == "plans/hall.json"  # the folder's first plan
+    assert json.loads((workspace / "runs" / "plans" / "config.json").read_text())["routers"] is None
+
+
+#: What a page's commands must have done, checked after they ran, by page.
+PAGE_CHECKS = {"docs/guide/own-building.md": own_building_did_what_it_says}
+
+
 @pytest.mark.episode
 @pytest.mark.parametrize("page", runnable_pages(), ids=rel)
 def test_every_command_of_the_page_runs(page, tmp_path, monkeypatch):
-    assert run_page(page, workspace_for(tmp_path), monkeypatch) > 0
+    workspace = workspace_for(tmp_path)
+    assert run_page(page, workspace, monkeypatch) > 0
+    PAGE_CHECKS.get(rel(page), lambda _: None)(workspace)
 
 
 def test_smoke_makes_commands_smaller_and_keeps_the_rest(tmp_path):

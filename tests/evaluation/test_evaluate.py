@@ -195,7 +195,7 @@ def test_bad_arguments_are_clear_errors(tmp_path):
         ev.evaluate(["frontier", "nope"], 1, out=tmp_path, **TINY)
     with pytest.raises(ConfigError, match="episodes"):
         ev.evaluate(["frontier"], 0, out=tmp_path, **TINY)
-    with pytest.raises(ConfigError, match=r"no \.json"):
+    with pytest.raises(ConfigError, match=r"no floorplan files there"):
         ev.evaluate(["frontier"], 1, out=tmp_path, floorplans=tmp_path, **TINY)
     with pytest.raises(ConfigError, match="potential_scale"):
         ev.evaluate(

@@ -230,3 +230,58 @@ def test_saved_files_get_the_usual_permissions(tmp_path, two_rooms):
     mask = os.umask(0)
     os.umask(mask)
     assert stat.S_IMODE(path.stat().st_mode) == 0o666 & ~mask
+
+
+# ------------------------------------------------------------------------- routers and folders
+def _hall() -> Floorplan:
+    return floorplan_from_polygon(Polygon([(0, 0), (12, 0), (12, 8), (0, 8)]), name="hall")
+
+
+def test_a_plan_s_routers_round_trip_and_a_plan_without_has_no_key(tmp_path):
+    hall = _hall()
+    assert hall.routers == () and "routers" not in hall.to_dict()
+    data = hall.to_dict() | {"routers": [[3, 3], [9, 5.5]]}
+    (tmp_path / "r.json").write_text(json.dumps(data))
+    plan = load_floorplan(tmp_path / "r.json")
+    assert plan.routers == ((3.0, 3.0), (9.0, 5.5))
+    again = load_floorplan(plan.save(tmp_path / "again.json"))
+    assert again.routers == plan.routers and again.to_dict() == plan.to_dict()
+
+
+@pytest.mark.parametrize(
+    ("routers", "message"),
+    [
+        ([[3, 3], [13, 5]], r"router 1 at \(13, 5\) is not in the free space"),
+        ([[3, 3, 1]], r"routers\[0\] must be a list of 2 numbers"),
+        ("3,3", "'routers' must be a list"),
+        ([["a", 3]], r"routers\[0\] must hold numbers"),
+    ],
+)
+def test_bad_routers_in_a_plan_are_refused_naming_the_file(tmp_path, routers, message):
+    (tmp_path / "r.json").write_text(json.dumps(_hall().to_dict() | {"routers": routers}))
+    with pytest.raises(FloorplanError, match=rf"r\.json: .*{message}"):
+        load_floorplan(tmp_path / "r.json")
+
+
+def test_floorplan_files_are_json_plans_and_ros_map_yamls_sorted(tmp_path):
+    from sfw_gym.world.floorplan import floorplan_files
+
+    for name in ("b.json", "a.yaml", "c.YML", "a.pgm", "notes.txt"):
+        (tmp_path / name).write_text("")
+    (tmp_path / "sub.json").mkdir()
+    assert [p.name for p in floorplan_files(tmp_path)] == ["a.yaml", "b.json", "c.YML"]
+    assert floorplan_files(tmp_path / "b.json") == [tmp_path / "b.json"]
+    assert floorplan_files(tmp_path / "missing") == []
+
+
+def test_chosen_routers_given_then_the_plan_s_then_the_default():
+    from sfw_gym.world.floorplan import chosen_routers
+
+    stored = Floorplan(
+        _hall().free_space, _hall().footprint, _hall().edge_materials, routers=((3, 3),)
+    )
+    assert chosen_routers([[1, 1]], stored, 2) == [[1, 1]]
+    assert chosen_routers(1, stored, 2) == 1
+    assert chosen_routers(None, stored, 2) == [[3.0, 3.0]]
+    assert chosen_routers(None, _hall(), 2) == 2
+    assert chosen_routers(None, None) is None
