@@ -25,6 +25,7 @@ from sfw_gym.world import (
     place_background_aps,
     place_routers,
 )
+from sfw_gym.world.floorplan import chosen_routers
 
 #: Start poses keep this much more than the robot's radius from every wall.
 START_CLEARANCE_MARGIN_M = 0.05
@@ -93,8 +94,10 @@ def build_scene(
     n_background_aps: int = 0,
 ) -> EpisodeScene:
     """Assemble an episode; every random choice comes from ``rng`` (the background access
-    points' last, so that without them every other draw is as before)."""
+    points' last, so that without them every other draw is as before). ``routers`` None: the
+    plan's own (:attr:`Floorplan.routers`), else ``max_routers`` placed by k-means."""
     plan = resolve_floorplan(floorplan, generator_params)
+    routers = chosen_routers(routers, plan, max_routers)
     truth, origin = plan.rasterize(resolution_m)
     if isinstance(routers, int | np.integer) and not isinstance(routers, bool):
         if not 1 <= routers <= max_routers:

@@ -30,6 +30,7 @@ from sfw_gym.mapping import GridSpec, SparseInverseKVisibility
 from sfw_gym.navigation.view import RobotView
 from sfw_gym.slam import OnlineRadioLidarSlam, OnlineRadioSlam
 from sfw_gym.world import Floorplan, Pose
+from sfw_gym.world.floorplan import PLAN_SUFFIXES, floorplan_files
 from sfw_gym.world.lidar import Lidar
 
 
@@ -73,8 +74,9 @@ class SfWExploreEnv(gym.Env):
 
     Starting State:
         A fresh procedural floorplan from the env's RNG each episode (or the ``floorplan``
-        kwarg or option), ``n_routers`` routers placed where a person would (k-means centres of
-        the free space), the robot at a random free pose with clearance, the map unknown.
+        kwarg or option), the plan's own routers if it has them, else ``n_routers`` routers
+        placed where a person would (k-means centres of the free space), the robot at a random
+        free pose with clearance, the map unknown.
 
     Episode End:
         Terminated when the ground-truth coverage (fraction of free cells the map has
@@ -125,7 +127,8 @@ class SfWExploreEnv(gym.Env):
             writers work across plans; None: the plan's own size.
 
     ``reset(options=…)`` takes ``floorplan`` (a Floorplan, a path or a generator seed),
-    ``routers`` (positions (R, 2) or a count ≤ ``n_routers``) and ``start_pose`` ((x, y, θ)).
+    ``routers`` (positions (R, 2) or a count ≤ ``n_routers``, over the plan's own) and
+    ``start_pose`` ((x, y, θ)).
     """
 
     metadata: dict[str, Any] = {"render_modes": ["rgb_array", "human"], "render_fps": 10}  # noqa: RUF012
@@ -219,7 +222,7 @@ class SfWExploreEnv(gym.Env):
         explore = config.explore
         self.scene = build_scene(
             plan,
-            routers=options.get("routers", explore.n_routers),
+            routers=options.get("routers"),  # None: the plan's own, else n_routers by k-means
             max_routers=explore.n_routers,
             start_pose=options.get("start_pose"),
             radio_config=config.radio,
@@ -582,9 +585,10 @@ def _frame_size(size: Any) -> tuple[int, int] | None:
 
 def _folder_plans(source: Any) -> list[Path]:
     if isinstance(source, str | Path) and Path(source).is_dir():
-        plans = sorted(Path(source).glob("*.json"))
+        plans = floorplan_files(source)
         if not plans:
-            raise ConfigError(f"floorplan folder {source} holds no .json file")
+            suffixes = ", ".join(PLAN_SUFFIXES)
+            raise ConfigError(f"floorplan folder {source} holds no plan file ({suffixes})")
         return plans
     return []
 

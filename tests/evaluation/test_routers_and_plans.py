@@ -161,3 +161,22 @@ def yaml_protocol(path: Path) -> Path:
     protocol["splits"]["plan_files"] = {"train": [], "validation": [], "test": list(range(10))}
     path.write_text(yaml.safe_dump(protocol))
     return path
+
+
+def test_the_env_itself_takes_a_plan_s_routers_and_a_folder_s_ros_maps(tmp_path):
+    plans = write_plans(tmp_path / "plans")
+    env = gym.make(SMALL, floorplan=str(plans))
+    seen = set()
+    for seed in range(12):  # a folder: each episode one of its plans, the ROS map among them
+        env.reset(seed=seed)
+        scene = unwrap_sfw(env).ground_truth()
+        seen.add(scene.floorplan.name)
+        routers = np.asarray(scene.radio.routers).tolist()
+        assert (routers == STORED) == (scene.floorplan.name == "hall-r"), scene.floorplan.name
+    assert seen == {"hall", "hall-r", "office"}
+    env.reset(seed=0, options={"floorplan": str(plans / "hall_r.json"), "routers": [[6.0, 4.0]]})
+    assert np.asarray(unwrap_sfw(env).ground_truth().radio.routers).tolist() == [[6.0, 4.0]]
+    env.close()
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ConfigError, match=r"floorplan folder .*empty holds no plan file"):
+        gym.make(SMALL, floorplan=str(tmp_path / "empty"))
