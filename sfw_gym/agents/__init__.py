@@ -49,8 +49,8 @@ AGENTS: dict[str, str] = {
     "oracle-frontier-targets": "sfw_gym.agents.coverage_oracle:FrontierTargetsOracle",
     "oracle-belief-gain": "sfw_gym.agents.coverage_oracle:BeliefGainOracle",
 }
-#: Names of an earlier release, kept for one more: each warns (FutureWarning) and builds the
-#: agent it names now.
+#: Names deprecated in 0.2.0, removed in 0.3.0 (CHANGELOG.md): each warns (FutureWarning) and
+#: builds the agent it names now.
 DEPRECATED_AGENTS: dict[str, str] = {
     "ppo": "regions-ppo",
     "ppo-goals": "goals-ppo",
@@ -122,8 +122,7 @@ def agent_class(name: str) -> type[Agent]:
     if name in DEPRECATED_AGENTS and name not in AGENTS:
         new = DEPRECATED_AGENTS[name]
         warnings.warn(
-            f"agent name {name!r} is deprecated: use {new!r} (the old name goes in the next "
-            "release)",
+            f"agent name {name!r} is deprecated: use {new!r} (the old name goes in sfw_gym 0.3)",
             FutureWarning,
             stacklevel=3,
         )

@@ -242,7 +242,7 @@ class Agent(ABC):
     def params(self) -> dict[str, Any]:
         """The parameters (for logs and result files): :attr:`settings` as a dict, plus the
         constructor parameters of an agent written with its own ``__init__`` instead of a
-        settings class (as agents were before issue 32), read from its attributes."""
+        settings class (as agents were before 0.2.0), read from its attributes."""
         out = self.settings.to_dict()
         for klass in type(self).__mro__:
             init = klass.__dict__.get("__init__")

@@ -1,5 +1,5 @@
 """Exploration on a predicted map: information gain where the map predictor expects it, per metre
-of path planned through what it expects (issue 46; MapEx's recipe for a WiFi mapper).
+of path planned through what it expects (MapEx's recipe for a WiFi mapper).
 
 :class:`PredictiveExplorer` is :class:`~sfw_gym.agents.greedy.GreedyInfoGainAgent` with its two
 guesses about the unseen made by a map predictor

@@ -1,4 +1,4 @@
-"""Candidates ranked by the bits their paths really buy (issue 51).
+"""Candidates ranked by the bits their paths really buy.
 
 :class:`RolloutExplorer` is :class:`~sfw_gym.agents.predict_explore.PredictiveExplorer` with one
 change: of its menu (frontier cells and cells beyond the frontier that the predictor calls

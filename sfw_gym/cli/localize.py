@@ -29,7 +29,7 @@ def add_options(parser: argparse.ArgumentParser) -> None:
     add_episode_runner_options(parser)
     parser.add_argument(
         "--out",
-        "--json",  # its name before issue 32, kept as an alias
+        "--json",  # its name before 0.2.0, kept as an alias
         dest="out",
         type=folder,
         default="localize",

@@ -44,12 +44,13 @@ class Policy(NamedTuple):
 WHEELS_DECISIONS_PER_S = 377.0
 #: By env id (and ``env`` for any other env, with no wrapper in its hyperparameters).
 POLICIES = {
-    # 30,000 decisions in ~35 min, 9 of them cloning (the shipped SfW-ExploreRegions-v0_1)
+    # 30,000 decisions in 1,228 s, 555 s of cloning before them (the shipped
+    # SfW-ExploreRegions-v0_1's config.yml: wall_time_s, total_wall_time_s)
     "SfW-ExploreRegions-v0": Policy(
         "the region policy of regions-ppo, the default learned agent",
         "one region decision (up to 20 env steps)",
-        30_000 / (26 * 60),
-        9 * 60,
+        30_000 / 1228,
+        555.0,
         30_000,
     ),
     # 200,192 decisions in 1,373 s, cloning included (SfW-ExploreGoals-v0_1's run)

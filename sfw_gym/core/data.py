@@ -23,7 +23,7 @@ def data_path(*parts: str) -> Path:
     return Path(str(resources.files("sfw_gym").joinpath("data", *parts)))
 
 
-#: The earlier waypoint policy (``sfw-gym train ppo`` with the waypoint block of issue 6).
+#: The earlier waypoint policy (``sfw-gym train ppo`` with its waypoint hyperparameters).
 DEFAULT_WAYPOINT_MODEL_DIR = data_path("agents", "ppo", "SfW-Explore-v0_1")
 #: The shipped PPO on the wheels (``sfw-gym train ppo --env SfW-Explore-v0``, from scratch):
 #: rl-zoo's latest ``ppo`` run of ``SfW-Explore-v0``, so ``rl_zoo3.enjoy`` replays it.

@@ -1,4 +1,4 @@
-"""The mapper's update, run dry: the bits a path of hypothetical readings would buy (issue 51).
+"""The mapper's update, run dry: the bits a path of hypothetical readings would buy.
 
 :class:`DryRun` snapshots a :class:`~sfw_gym.mapping.sparse.SparseInverseKVisibility` and runs
 its update, step by step along candidate paths, on scratch copies of the belief: the same

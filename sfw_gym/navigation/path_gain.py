@@ -1,4 +1,4 @@
-"""What a path buys (issue 51): the readings a robot would take along the first steps of a
+"""What a path buys: the readings a robot would take along the first steps of a
 planned path, the k a map gives each, and the best-prefix rate that ranks them.
 
 - :func:`readings_along`: one reading per control step, turns in place charged in steps (the

@@ -1,7 +1,7 @@
 """Where a training run keeps its model and its hyperparameters: rl-baselines3-zoo's layout,
 which ``sfw-gym train`` writes and ``python -m rl_zoo3.enjoy`` reads::
 
-    OUT/<env-id>.zip            the final model (``model.zip`` in runs from before issue 32)
+    OUT/<env-id>.zip            the final model (``model.zip`` in runs from before 0.2.0)
     OUT/<env-id>/config.yml     the env id's block of the hyperparameter file, as rl-zoo keeps it
     OUT/<env-id>/args.yml       the run's arguments (algo, env, env_kwargs, seed, ...)
     OUT/config.yml              sfw-gym's record of the run (with the ``sfw_gym`` block's keys,
