@@ -41,8 +41,9 @@ What it does
 score = killed / (mutants − equivalent); "timeout" and "no tests" mutants count against it.
 
 mutmut notes: it copies the package and tests into ``mutants/`` (git-ignored) and imports from
-there; decorated functions are not mutated (the numba ``@njit`` kernels: they are checked against
-the dense oracle and hand-computed cases instead); ``conftest.HOUSEEXPO_DIR`` resolves to
+there; decorated functions are not mutated, but for the numba ``@njit`` kernels: the runs set
+``NUMBA_DISABLE_JIT=1``, under which ``njit`` returns the Python function, and mutmut is told to
+mutate functions whose only decorators are ``njit`` (see ``_BOOTSTRAP``); ``conftest.HOUSEEXPO_DIR`` resolves to
 ``mutants/../shared`` = ``<repo>/shared``, which does not exist, so the three HouseExpo tests of
 test_floorplan.py skip under mutmut (no group here relies on them). Two mutmut 3.8 quirks this
 script works around: a file copied unmutated by a run of other groups (or other ``--files``) is
@@ -87,17 +88,29 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
         [
             "sfw_gym/mapping/sparse.py",
             "sfw_gym/mapping/k_estimation.py",
+            "sfw_gym/mapping/kmeans1d.py",
             "sfw_gym/mapping/grid.py",
             "sfw_gym/mapping/raycast.py",
+            "sfw_gym/mapping/dry_run.py",
         ],
         [
             "tests/mapping/test_sparse_mapper.py",
+            "tests/mapping/test_mapper_rules.py",
             "tests/mapping/test_k_estimation.py",
             "tests/mapping/test_grid.py",
             "tests/mapping/test_dense_mapper.py",
+            "tests/mapping/test_dry_run.py",
         ],
     ),
-    "radio": (["sfw_gym/world/radio.py"], ["tests/world/test_radio.py"]),
+    # the radio model and the wall geometry its attenuation counts walls with
+    "radio": (
+        [
+            "sfw_gym/world/radio.py",
+            "sfw_gym/world/wall_crossing.py",
+            "sfw_gym/world/wall_index.py",
+        ],
+        ["tests/world/test_radio.py", "tests/world/test_wall_index.py"],
+    ),
     # the navigation unit tests, the region env's (the one user of regions.py) and the agents'
     # unit tests (frontier's approach cells, greedy's choice, cross-pass's dominance bands); the
     # whole-episode agent tests are left out (seconds per mutant)
@@ -155,9 +168,29 @@ COLUMNS = ["mutants", "killed", "survived", "timeout", "no tests", "other", "equ
 
 # Runs mutmut in a child interpreter with two config fields overridden. mutmut's fork server and
 # workers are os.fork()ed from it, so they inherit the patched configuration.
+#
+# The numba kernels are mutated too: mutmut skips decorated functions (a decorator may not survive
+# being applied to its trampoline and mutant copies), but ``@njit(...)`` returns the function
+# itself when NUMBA_DISABLE_JIT=1, which the child runs with, so a kernel is plain Python there.
 _BOOTSTRAP = """
 import json, sys
+import libcst as cst
 import mutmut.configuration as configuration
+import mutmut.mutation.file_mutation as file_mutation
+
+def _is_njit(decorator):
+    target = decorator.decorator
+    target = target.func if isinstance(target, cst.Call) else target
+    return isinstance(target, cst.Name) and target.value == "njit"
+
+_skip = file_mutation.MutationVisitor._skip_node_and_children
+
+def _skip_but_kernels(self, node):
+    if isinstance(node, cst.FunctionDef) and node.decorators and all(map(_is_njit, node.decorators)):
+        return _skip(self, node.with_changes(decorators=[]))  # as if undecorated
+    return _skip(self, node)
+
+file_mutation.MutationVisitor._skip_node_and_children = _skip_but_kernels
 only_mutate, tests, args = json.loads(sys.argv[1])
 cfg = configuration.config()
 cfg.only_mutate = only_mutate
@@ -206,7 +239,8 @@ def run_mutmut(
     args = ["--max-children", str(max_children), *globs]
     payload = json.dumps([files, tests, args])
     start = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-c", _BOOTSTRAP, payload], cwd=ROOT, check=False)
+    env = os.environ | {"NUMBA_DISABLE_JIT": "1"}  # the kernels as Python, so mutmut reaches them
+    proc = subprocess.run([sys.executable, "-c", _BOOTSTRAP, payload], cwd=ROOT, env=env, check=False)
     wall = time.perf_counter() - start
     if check and proc.returncode not in (0, None):
         sys.exit(f"mutmut run failed with exit code {proc.returncode}")
