@@ -43,16 +43,16 @@ score = killed / (mutants − equivalent); "timeout" and "no tests" mutants coun
 mutmut notes: it copies the package and tests into ``mutants/`` (git-ignored) and imports from
 there; decorated functions are not mutated, but for the numba ``@njit`` kernels: the runs set
 ``NUMBA_DISABLE_JIT=1``, under which ``njit`` returns the Python function, and mutmut is told to
-mutate functions whose only decorators are ``njit`` (see ``_BOOTSTRAP``); ``conftest.HOUSEEXPO_DIR`` resolves to
-``mutants/../shared`` = ``<repo>/shared``, which does not exist, so the three HouseExpo tests of
-test_floorplan.py skip under mutmut (no group here relies on them). Two mutmut 3.8 quirks this
-script works around: a file copied unmutated by a run of other groups (or other ``--files``) is
-newer than its source, and mutmut then never mutates it again (the script deletes such copies
-before a run of that file; mutmut keeps the verdicts of its unchanged functions); and mutmut
-reuses its stats when the test selection is unchanged, so functions of a newly mutated file get
-"no tests" (the script deletes ``mutants/mutmut-stats.json`` before each run, so mutmut also
-never sees a change of the test selection: verdicts in mutants/ stay until a run names them).
-The numbers of every group stay in ``docs/results/data/mutation_results.json``.
+mutate functions whose only decorators are ``njit`` (see ``_BOOTSTRAP``);
+``conftest.HOUSEEXPO_DIR`` resolves to ``mutants/../shared`` = ``<repo>/shared``, which does not
+exist, so the three HouseExpo tests of test_floorplan.py skip under mutmut (no group here relies on
+them). Two mutmut 3.8 quirks this script works around: a file copied unmutated by a run of other
+groups (or other ``--files``) is newer than its source, and mutmut then never mutates it again (the
+script deletes such copies before a run of that file; mutmut keeps the verdicts of its unchanged
+functions); and mutmut reuses its stats when the test selection is unchanged, so functions of a
+newly mutated file get "no tests" (the script deletes ``mutants/mutmut-stats.json`` before each
+run, so mutmut also never sees a change of the test selection: verdicts in mutants/ stay until a
+run names them). The numbers of every group stay in ``docs/results/data/mutation_results.json``.
 
 ``--files`` runs some modules of a group (the rest keep their stored numbers), e.g. a full run of
 the fast modules and ``--sample`` of the slow ones of the same group, as for ``evaluation``.
@@ -186,7 +186,8 @@ def _is_njit(decorator):
 _skip = file_mutation.MutationVisitor._skip_node_and_children
 
 def _skip_but_kernels(self, node):
-    if isinstance(node, cst.FunctionDef) and node.decorators and all(map(_is_njit, node.decorators)):
+    kernel = isinstance(node, cst.FunctionDef) and node.decorators
+    if kernel and all(map(_is_njit, node.decorators)):
         return _skip(self, node.with_changes(decorators=[]))  # as if undecorated
     return _skip(self, node)
 
@@ -240,7 +241,8 @@ def run_mutmut(
     payload = json.dumps([files, tests, args])
     start = time.perf_counter()
     env = os.environ | {"NUMBA_DISABLE_JIT": "1"}  # the kernels as Python, so mutmut reaches them
-    proc = subprocess.run([sys.executable, "-c", _BOOTSTRAP, payload], cwd=ROOT, env=env, check=False)
+    cmd = [sys.executable, "-c", _BOOTSTRAP, payload]
+    proc = subprocess.run(cmd, cwd=ROOT, env=env, check=False)
     wall = time.perf_counter() - start
     if check and proc.returncode not in (0, None):
         sys.exit(f"mutmut run failed with exit code {proc.returncode}")
