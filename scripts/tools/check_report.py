@@ -6,7 +6,8 @@ demo's). Needs Playwright (the ``test`` extra) and a Chromium: ``--chromium`` or
 ``chromium``, ``chromium-browser``, ``google-chrome`` on the PATH.
 
     sfw-gym demo --out runs/demo
-    python scripts/tools/check_report.py runs/demo/index.html --screenshot shot.png
+    python scripts/tools/check_report.py runs/demo/index.html \
+        --screenshot docs/figures/demo_report.png   # the docs' first page shows it
 """
 
 from __future__ import annotations

@@ -490,16 +490,22 @@ def test_estimator_with_either_backend_gives_the_same_k_values(monkeypatch):
 
 # -- the compiled refit (one call per refit) against the Python path it replaced ----------------
 def test_mean_var_are_numpys_to_the_bit():
-    # numpy's pairwise sums: 8 accumulators up to 128 values, halves (multiples of 8) above
+    # numpy's pairwise sums: 8 accumulators up to 128 values, halves (multiples of 8) above; the
+    # variance as numpy >= 2.3 sums it (older numpy's can differ in the last bit)
     from sfw_gym.mapping.kmeans1d import mean_var
 
+    numpy_2_3 = tuple(int(p) for p in np.__version__.split(".")[:2]) >= (2, 3)
     rng = np.random.default_rng(7)
     sizes = [*range(1, 300), 511, 512, 513, 1000, 4095, 4096, 4097, 9999, 70001]
     for n in sizes:
         x = rng.normal(-60.0, 12.0, n)
         for data in (x, np.round(x)):
             mean, var = mean_var(data)
-            assert mean == data.mean() and var == data.var(), n
+            assert mean == data.mean(), n
+            if numpy_2_3:
+                assert var == data.var(), n
+            else:
+                assert var == pytest.approx(data.var(), rel=4 * np.finfo(float).eps), n
 
 
 def old_fit_levels(x, max_k, gap, frac):
