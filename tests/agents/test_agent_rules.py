@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -203,6 +205,133 @@ def test_sweep_goal_is_the_reachable_unvisited_cell_farthest_from_the_path():
     assert agent.stop_reason == "no_frontiers"
     assert agent.goal is not None and agent.goal.kind == "sweep"
     assert agent.goal.cell[1] >= 35  # the far end of the corridor
+
+
+# ------------------------------------------------------------------------------ frontier's rules
+class BumpingEnv(FakeEnv):
+    """:class:`FakeEnv` whose view reports a bump while ``bump`` is set."""
+
+    bump = False
+
+    def robot_view(self):
+        return dataclasses.replace(super().robot_view(), bumped=self.bump)
+
+
+def open_room() -> np.ndarray:
+    """A known free 16 x 16-cell room in unknown space: frontiers all round."""
+    b = np.full((20, 20), U, np.uint8)
+    b[2:18, 2:18] = F
+    return b
+
+
+def bumped_step(agent, env, forward: bool = True):
+    """One act on a view that reports a bump, the last command having been ``forward``
+    (full speed ahead) or a turn on the spot."""
+    env.bump = True
+    agent.last_command = (1.0, 0.0) if forward else (0.0, 1.0)
+    action = agent.act(None)
+    env.bump = False
+    env.step(action)
+    return action
+
+
+def test_a_bump_driving_forward_marks_the_one_cell_disk_just_ahead_and_nothing_else():
+    """Hand-derived: the robot (radius 0.17 m) at (1.01, 1.05) facing +x touches half a cell
+    beyond its rim, at x = 1.01 + 0.17 + 0.05 = 1.23 m: cell (10, 12) (its rim, 1.18 m, is in
+    column 11), marked with its 4 neighbours. A bump while turning on the spot, or while the
+    robot still moved at least half the commanded 0.1 m (sliding along a wall), marks
+    nothing."""
+    env = BumpingEnv(open_room(), pose=(1.01, 1.05, 0.0), frozen=True)
+    agent = FrontierAgent(backoff_steps=0)
+    agent.reset(env, seed=0)
+    env.step(agent.act(None))
+    bumped_step(agent, env, forward=False)
+    assert not agent.bumps.any() and agent.n_bumps == 0
+    bumped_step(agent, env, forward=True)
+    cross = [(9, 12), (10, 11), (10, 12), (10, 13), (11, 12)]
+    assert sorted(map(tuple, np.argwhere(agent.bumps).tolist())) == cross
+    assert agent.n_bumps == 1
+    sliding = BumpingEnv(open_room(), pose=(1.05, 1.05, 0.0))  # it moves 0.1 m a step
+    agent = FrontierAgent(backoff_steps=0)
+    agent.reset(sliding, seed=0)
+    sliding.step(np.array([1.0, 0.0]))  # moved 0.1 m since the agent's last view
+    bumped_step(agent, sliding, forward=True)
+    assert not agent.bumps.any() and agent.n_bumps == 0
+
+
+@pytest.mark.parametrize("backoff_steps", [0, 1, 3])
+def test_after_a_bump_it_reverses_for_exactly_backoff_steps_steps(backoff_steps):
+    """The step that sees the bump and the next ``backoff_steps - 1`` are full reverse
+    ``(-1, 0)``; then it drives again (never reverse: pure pursuit goes forward or turns)."""
+    env = BumpingEnv(open_room(), pose=(1.05, 1.05, 0.0), frozen=True)
+    agent = FrontierAgent(backoff_steps=backoff_steps)
+    agent.reset(env, seed=0)
+    env.step(agent.act(None))
+    actions = [bumped_step(agent, env).tolist()]
+    for _ in range(5):
+        actions.append(agent.act(None).tolist())
+        env.step(actions[-1])
+    reverse = [a == [-1.0, 0.0] for a in actions]
+    assert reverse == [True] * backoff_steps + [False] * (6 - backoff_steps), actions
+
+
+def test_a_goal_is_blacklisted_at_its_max_bumps_per_goal_th_bump_for_blacklist_ttl_steps():
+    """``max_bumps_per_goal=3``: after bumps 1 and 2 on the way to a goal it is kept (nothing
+    blacklisted); the 3rd, at act call k, blacklists the cells within ``blacklist_radius_m``
+    (2.5 cells) of its target until step k + ``blacklist_ttl_steps``: for exactly that many
+    steps."""
+    ttl = 7
+    env = BumpingEnv(open_room(), pose=(1.05, 1.05, 0.0), frozen=True)
+    agent = FrontierAgent(
+        backoff_steps=0, max_bumps_per_goal=3, blacklist_ttl_steps=ttl, blacklist_radius_m=0.25
+    )
+    agent.reset(env, seed=0)
+    env.step(agent.act(None))
+    bumped_step(agent, env)  # the contact cell marked: the goals from now on avoid it
+    target = agent.goal.target
+    assert agent.goal.bumps == 0 and not agent.blacklisted.any()
+    for n in (1, 2):  # the frozen robot bumps the same cell again and again
+        bumped_step(agent, env)
+        assert agent.goal is not None and agent.goal.target == target  # the same goal
+        assert agent.goal.bumps == n and not agent.blacklisted.any()
+    k = agent.steps
+    bumped_step(agent, env)  # act call k: the 3rd bump
+    assert agent.n_blacklisted == 1 and agent.goal.target != target
+    disk = np.zeros(agent.blacklisted.shape, bool)
+    rr, cc = np.ogrid[:20, :20]
+    disk[(rr - target[0]) ** 2 + (cc - target[1]) ** 2 <= 2.5**2] = True
+    np.testing.assert_array_equal(agent.finder.failed_until > 0, disk)
+    assert (agent.finder.failed_until[disk] == k + ttl).all()
+    blacklisted = [bool(agent.blacklisted[target])]  # after act call k
+    while agent.steps < k + ttl + 2:
+        env.step(agent.act(None))  # act call agent.steps
+        blacklisted.append(bool(agent.blacklisted[target]))
+    # after calls k .. k + ttl - 1: blacklisted (ttl steps); after call k + ttl: free again
+    assert blacklisted == [True] * ttl + [False] * 2
+
+
+def row_of_cells(free: slice, n: int = 30) -> np.ndarray:
+    """A one-cell-high map: ``free`` columns known free, the rest unknown."""
+    b = np.full((1, n), U, np.uint8)
+    b[0, free] = F
+    return b
+
+
+@pytest.mark.parametrize(("turn_cost", "chosen"), [(0.0, (0, 25)), (0.2, (0, 25)), (0.25, (0, 4))])
+def test_turn_cost_adds_turn_cost_times_the_turn_to_a_clusters_path(turn_cost, chosen):
+    """One row, free over columns 5-24; the robot at column 18 facing -x. Two one-cell frontiers:
+    (0, 4) ahead (turn 0), reached from column 5: 1.3 m; (0, 25) behind (turn π), reached from
+    column 24: 0.6 m. Utility = 1.0 · 0.1 − 3.0 · (path + turn_cost · turn): the one behind wins
+    until turn_cost · π > 0.7 m, i.e. turn_cost > 0.223."""
+    env = FakeEnv(row_of_cells(slice(5, 25)), pose=(1.85, 0.05, np.pi), routers=((1.5, 0.05),))
+    agent = FrontierAgent(
+        turn_cost_m_per_rad=turn_cost, min_frontier_size_m=0.0, min_unknown_region_m2=0.0
+    )
+    agent.reset(env, seed=0)
+    agent.act(None)
+    expected = {(0, 4): 0.1 - 3.0 * 1.3, (0, 25): 0.1 - 3.0 * (0.6 + turn_cost * np.pi)}
+    assert dict(agent.candidates) == pytest.approx(expected, abs=1e-9)
+    assert agent.goal.target == chosen
 
 
 # ------------------------------------------------------------------------------ cross-pass loop

@@ -15,6 +15,7 @@ from sfw_gym.agents.predict_explore import PredictiveExplorer
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.navigation.planning import cost_field
 from sfw_gym.navigation.prediction import UNKNOWN, PredictedMap
+from tests.agents.test_agents import FakeEnv
 
 SMALL = "SfW-ExploreSmall-v0"
 
@@ -121,3 +122,79 @@ def test_a_step_predicts_once_however_often_its_planning_asks():
     n = agent.n_predictions
     assert agent.prediction(view) is first and agent.n_predictions == n
     assert agent.prediction(env.unwrapped.robot_view()) is not first  # a new view: anew
+
+
+class GivenPrediction:
+    """A predictor that returns fixed ``p_free`` and ``spread`` (``p_wall`` 0) on unknown cells."""
+
+    def __init__(self, p_free: np.ndarray, spread: np.ndarray) -> None:
+        self.p_free, self.spread = p_free, spread
+
+    def predict_codes(self, codes, proximity):
+        return PredictedMap.with_belief(codes, self.p_free, 0 * self.p_free, self.spread)
+
+
+def reference_scores(unknown, p_free, spread, robot_col, router_col, frontier_cols):
+    """The documented score on a one-row map with unit cell costs, walked cell by cell: expected
+    bits ``p_free(c) · (1 − spread(c)) · (footprint + Σ_ray reach · bits)`` (1 bit an unknown
+    cell; the footprint is c − 1 .. c + 1; the ray runs from beyond the robot's radius, 2 cells,
+    to the router's cell, reach the running product of p_free, 1 on free cells) over metres of
+    path (to the cell beside a frontier target, whose footprint covers it; to a beyond cell
+    itself) + 0.3 m per radian of turn (0 ahead, π behind) + the 1 m offset."""
+    n = len(unknown)
+    p = np.where(unknown, p_free, 1.0)
+    scores = {}
+    for c in [*frontier_cols, *np.flatnonzero(unknown & (p_free >= 0.5))]:
+        c = int(c)
+        if c in scores:
+            continue
+        bits = sum(int(unknown[k]) for k in (c - 1, c, c + 1) if 0 <= k < n)
+        step = 1 if router_col > c else -1
+        reach = 1.0
+        for k in range(c + 2 * step, router_col + step, step):
+            reach *= p[k]
+            if reach < 1e-3:
+                break
+            bits += reach * unknown[k]
+        gain = p_free[c] * (1.0 - spread[c]) * bits
+        towards_robot = 1 if robot_col > c else -1
+        goal_col = c + towards_robot if c in frontier_cols else c  # a frontier: the cell beside
+        metres = abs(goal_col - robot_col) * 0.1
+        turn = 0.0 if c > robot_col else np.pi
+        scores[(0, c)] = gain / (metres + 0.3 * turn + 1.0)
+    return scores
+
+
+def test_the_chosen_candidate_has_the_best_score_computed_by_hand():
+    """One row of 30 cells, free over columns 8-19, the robot at column 14 facing +x, its router
+    at column 13; a fixed random prediction on the unknown cells (one hopeless cell, p_free 0,
+    that ends the rays through it; one below ``min_p_free``). Candidates: the two frontier cells
+    and every unknown cell predicted free enough (stride 1). Each score and the choice are
+    checked against :func:`reference_scores`, not the agent's own scoring."""
+    rng = np.random.default_rng(7)
+    unknown = np.ones(30, bool)
+    unknown[8:20] = False
+    p_free = rng.uniform(0.55, 0.95, 30)
+    p_free[3], p_free[26] = 0.0, 0.4
+    spread = rng.uniform(0.0, 0.3, 30)
+    belief = np.where(unknown, 127, 255).astype(np.uint8)[None]
+    env = FakeEnv(belief, pose=(1.45, 0.05, 0.0), routers=((1.35, 0.05),))
+    agent = PredictiveExplorer(
+        beyond_stride_cells=1,
+        min_frontier_size_m=0.0,
+        min_unknown_region_m2=0.0,
+        turn_cost_m_per_rad=0.3,
+        distance_offset_m=1.0,
+        spread_penalty=1.0,
+    )
+    agent.reset(env, seed=0)
+    agent.predictor = GivenPrediction(
+        np.where(unknown, p_free, 0.0).astype(np.float32)[None],
+        np.where(unknown, spread, 0.0).astype(np.float32)[None],
+    )
+    agent.act(None)
+    expected = reference_scores(unknown, p_free, spread, 14, 13, (7, 20))
+    assert sorted(dict(agent.candidates)) == sorted(expected)
+    assert dict(agent.candidates) == pytest.approx(expected, rel=1e-6)  # float32 predictions
+    best = max(expected, key=expected.get)
+    assert agent.goal.target == best, (best, expected)

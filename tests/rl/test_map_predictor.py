@@ -213,3 +213,43 @@ def test_predictor_loss_is_a_weighted_cross_entropy_by_its_limits():
     ignored = logits.clone()
     ignored[0, :, :, 1, 0] = torch.tensor([-50.0, 50.0, 0.0])  # wrong for any label: IGNOREd
     assert float(predictor_loss(ignored, labels, inputs, 0.0)) < 1e-6
+
+
+class CellwiseNet(torch.nn.Module):
+    """A stand-in for the network: per cell, head ``k`` gives the logits
+    ``((k + 1) · proximity, 0, 0)`` (free, wall, outside), so that a cell's output is its own
+    input's; it keeps the input it was given."""
+
+    heads = 2
+
+    def forward(self, x):
+        self.seen = x.clone()
+        prox = x[:, INPUT_CHANNELS.index("router_proximity")]
+        logits = torch.zeros(x.shape[0], self.heads, 3, *x.shape[2:])
+        for k in range(self.heads):
+            logits[:, k, 0] = (k + 1) * prox
+        return logits
+
+
+@pytest.mark.parametrize("shape", [(11, 19), (16, 24)])
+def test_the_prediction_is_the_heads_softmax_cell_by_cell_with_the_padding_cut_off(shape):
+    """An 11 x 19 map is padded to 16 x 24 (multiples of 8, zeros at the bottom and right); a
+    16 x 24 map is not. With proximity ``ln m`` at a cell, head 0 gives ``(m, 1, 1) / (m + 2)``
+    and head 1 ``(m², 1, 1) / (m² + 2)``: ``p_free`` and ``p_wall`` are the two heads' means,
+    ``spread`` half the difference of their ``p_free`` (the standard deviation of two). Each
+    cell has its own m, so a shifted or transposed crop would not match."""
+    h, w = shape
+    m = 1.0 + np.arange(h * w, dtype=np.float64).reshape(h, w) / 50.0
+    codes = np.full(shape, UNKNOWN, np.uint8)
+    predictor = LearnedMapPredictor.__new__(LearnedMapPredictor)
+    predictor.net, predictor.threads = CellwiseNet(), 1
+    p = predictor.predict_codes(codes, np.log(m).astype(np.float32))
+    free0, free1 = m / (m + 2), m**2 / (m**2 + 2)
+    wall0, wall1 = 1 / (m + 2), 1 / (m**2 + 2)
+    np.testing.assert_allclose(p.p_free, (free0 + free1) / 2, rtol=1e-5)
+    np.testing.assert_allclose(p.p_wall, (wall0 + wall1) / 2, rtol=1e-5)
+    np.testing.assert_allclose(p.spread, np.abs(free1 - free0) / 2, rtol=1e-4, atol=1e-7)
+    seen = predictor.net.seen[0].numpy()
+    assert seen.shape[1:] == (16, 24)  # the next multiples of 8
+    inside = seen[INPUT_CHANNELS.index("inside")]
+    assert inside[:h, :w].all() and not seen[:, h:].any() and not seen[:, :, w:].any()
