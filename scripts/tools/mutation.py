@@ -164,6 +164,12 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
     ),
 }
 
+#: mutmut's ``timeout_constant`` for groups whose tests have no slow fixtures (pyproject's 30 s
+#: is for the agents' whole-episode module fixtures). A mutant's wall limit is
+#: ``(estimated test time + constant) * 15``: with 30 s, every kernel mutant that loops forever
+#: (e.g. an index step mutated to 0) held a worker for 7.5 min or more.
+TIMEOUT_CONSTANT_S = {"mapper": 5.0, "radio": 5.0, "navigation": 5.0}
+
 COLUMNS = ["mutants", "killed", "survived", "timeout", "no tests", "other", "equivalent"]
 
 # Runs mutmut in a child interpreter with two config fields overridden. mutmut's fork server and
@@ -192,10 +198,12 @@ def _skip_but_kernels(self, node):
     return _skip(self, node)
 
 file_mutation.MutationVisitor._skip_node_and_children = _skip_but_kernels
-only_mutate, tests, args = json.loads(sys.argv[1])
+only_mutate, tests, args, timeout_constant = json.loads(sys.argv[1])
 cfg = configuration.config()
 cfg.only_mutate = only_mutate
 cfg.pytest_add_cli_args_test_selection = tests
+if timeout_constant is not None:
+    cfg.timeout_constant = timeout_constant
 from mutmut.__main__ import cli
 cli(["run", *args])
 """
@@ -229,6 +237,7 @@ def run_mutmut(
     max_children: int,
     names: list[str] | None = None,
     check: bool = True,
+    timeout_constant: float | None = None,
 ) -> float:
     """Run mutmut on ``files`` (every mutant, or only ``names``); return the wall time."""
     forget_unmutated_copies(files)
@@ -238,7 +247,7 @@ def run_mutmut(
     (ROOT / "mutants" / "mutmut-stats.json").unlink(missing_ok=True)
     globs = names if names else [module_name(f) + ".*" for f in files]
     args = ["--max-children", str(max_children), *globs]
-    payload = json.dumps([files, tests, args])
+    payload = json.dumps([files, tests, args, timeout_constant])
     start = time.perf_counter()
     env = os.environ | {"NUMBA_DISABLE_JIT": "1"}  # the kernels as Python, so mutmut reaches them
     cmd = [sys.executable, "-c", _BOOTSTRAP, payload]
@@ -465,6 +474,8 @@ def main(argv: list[str] | None = None) -> int:
         tests = [t for g in args.modules for t in GROUPS[g][1]]
         # a listed test file that does not exist (yet) would make pytest, and so mutmut, fail
         tests = [t for t in tests if not t.endswith(".py") or (ROOT / t).exists()]
+        constants = [TIMEOUT_CONSTANT_S.get(g) for g in args.modules]
+        timeout = None if None in constants else max(constants)
         names = None
         if args.survivors:
             names = [
@@ -478,7 +489,7 @@ def main(argv: list[str] | None = None) -> int:
             names = sample_mutants(files, args.sample, tests, args.max_children)
             print(f"running a sample of {len(names)} mutants")
         if names is None or names:
-            wall = run_mutmut(files, tests, args.max_children, names)
+            wall = run_mutmut(files, tests, args.max_children, names, timeout_constant=timeout)
 
     modules = " ".join(args.modules)
     command = f"`nice -n 10 .venv/bin/python scripts/tools/mutation.py --modules {modules}"

@@ -137,20 +137,34 @@ def free_cells_on_row_10(m: SparseInverseKVisibility, cols) -> None:
     assert (belief_classes(m.occupancy_u8)[0][10, list(cols)]).all()
 
 
-def test_one_wall_goes_in_the_longest_run_of_cells_not_known_free():
-    """a (k = 0) at cell 20, b (k = 1) at cell 50, radius 0.1 m; cells 30 and 34 known free
-    (a's footprint also frees cell 21): runs 22..29, 31..33 and 35..49. The wall lies in the
-    longest, 35..49: [max(1.8 + 0.1, 3.25), min(4.8 - 0.1, 4.75)] = [3.25, 4.7] m."""
+@pytest.mark.parametrize(
+    ("free", "run", "interval", "peak"),
+    [
+        # runs 21..29, 31..33, 35..49: the longest comes last; its interval
+        # [max(1.8 + 0.1, 3.25), min(4.8 - 0.1, 4.75)], middle 3.975 m
+        ((30, 34), (35, 49), (3.25, 4.7), (41, 42)),
+        # runs 21..37, 39..41, 43..49: the longest comes first; the short run 39..41 is nearer
+        # the interval's middle, 3.3 m (its centre 3.8 m, the longest's 2.7 m): it must not win.
+        # The wall: [max(1.9, 1.85), min(4.7, 3.55)], middle 2.725 m (cell 29's centre 2.7 m)
+        ((38, 42), (21, 37), (1.9, 3.55), (29,)),
+    ],
+)
+def test_one_wall_goes_in_the_longest_run_of_cells_not_known_free(free, run, interval, peak):
+    """a (k = 0) at cell 20, b (k = 1) at cell 50, radius 0.1 m; two cells known free: the
+    wall lies in the longest run of the others, between its cells' outer edges (cut to
+    [1.9, 4.7] m by the radius). Cells 21 and 22 hold -0.4 from the helpers' rays (unknown);
+    cells 49 and 51 are b's footprint."""
     m = mapper(robot_radius_m=0.1, trajectory_gap_max_m=0.0)
     a, b = at(20), at(50)
     m.update(a, rssi_k(a, 0))
-    free_cells_on_row_10(m, (30, 34))
+    free_cells_on_row_10(m, free)
     m.update(b, rssi_k(b, 1))
     lo = m.log_odds[10].astype(np.float64)
-    assert int(np.argmax(lo)) in (41, 42)  # the middle, 3.975 m, is between their centres
-    for c in range(35, 49):
-        assert lo[c] == pytest.approx(eq6(s_of(c), 3.25, 4.7), rel=1e-4), c
-    assert (lo[22:30] <= 0).all()  # a run of 8 cells, shorter: no wall there
+    assert int(np.argmax(lo)) in peak
+    for c in range(max(run[0], 23), min(run[1], 48) + 1):
+        assert lo[c] == pytest.approx(eq6(s_of(c), *interval), rel=1e-4), c
+    others = [c for c in range(22, 50) if not run[0] <= c <= run[1] and c not in free]
+    assert (lo[others] <= 1e-3).all()  # no wall outside the run (Eq. 6's tail at most)
 
 
 def test_equal_runs_the_one_nearest_the_middle_wins():
@@ -318,3 +332,72 @@ def test_a_short_buffer_receives_its_length_of_cells_and_nothing_beyond():
 def test_a_segment_from_outside_that_ends_on_the_grid_s_edge_lists_no_cell():
     assert reference_traversal(-1.0, 0.5, 0.0, 0.5)[0] == []
     assert traverse(-1.0, 0.5, 0.0, 0.5)[0] == []
+
+
+# -- more of the mapper's rules -----------------------------------------------------------------
+def test_two_walls_go_between_the_first_and_last_cells_not_known_free():
+    """a (k = 0) at cell 16, b (k = 2) at cell 50, radius 0.21 m. a's footprint frees cells
+    14..18 of row 10; four visits at (c + 0.05, 1.25) free cells 46..49 (0.2 m away; their rays
+    leave row 10 before cell 15). The walls lie in [max(1.4 + 0.21, 1.65), min(4.8 - 0.21,
+    4.35)] = [1.65, 4.35] m, cut in two halves of 1.35 m with a peak at the middle of each."""
+    m = mapper(robot_radius_m=0.21, trajectory_gap_max_m=0.0)
+    a, b = at(16), at(50)
+    m.update(a, rssi_k(a, 0))
+    for c in (46, 47, 48, 49):
+        p = (c / 10 + 0.05, 1.25)
+        m.update(p, rssi_k(p, 0))
+    assert belief_classes(m.occupancy_u8)[0][10, [17, 18, 46, 47, 48, 49]].all()
+    m.update(b, rssi_k(b, 2))
+    lo = m.log_odds[10].astype(np.float64)
+    s_a, sub = 1.65, (4.35 - 1.65) / 2
+    sigma, amp = max(S_MIN, S_FRAC * sub), (PEAK - 0.5) * min(1.0, L_REF / sub)
+    for c in range(19, 46):
+        s = s_of(c)
+        centre = s_a + (min(max(math.floor((s - s_a) / sub), 0), 1) + 0.5) * sub
+        excess = amp * math.exp(-((s - centre) ** 2) / (2 * sigma**2))
+        assert lo[c] == pytest.approx(logit(0.5 + excess) if excess >= 1e-3 else 0.0, rel=1e-4)
+    assert int(np.argmax(lo[19:32])) + 19 in (25, 26)  # the first peak, 2.325 m
+    assert int(np.argmax(lo[32:46])) + 32 in (38, 39)  # the second, 3.675 m
+
+
+def test_a_bump_marks_a_contact_cell_in_the_first_column():
+    """Robot at x = 0.15 m (column 1), radius 0.05 m, heading west: the contact cell lies
+    radius + resolution / 2 = 0.1 m ahead, at x = 0.05 m: column 0, marked with +3."""
+    m = mapper(robot_radius_m=0.05)
+    m.update((0.15, 1.05), [-100.0], bumped=True, heading_rad=math.pi)
+    assert m.log_odds[10, 0] == pytest.approx(3.0)
+    assert (m.log_odds[10, 1:] <= 0).all()
+
+
+def test_the_footprint_at_the_grid_s_far_corner_is_clipped_to_the_grid():
+    """Robot at the centre of the last cell (19, 59), radius 0.17 m: the footprint is the cells
+    of the grid whose centres lie within 0.17 m: (19, 59), (18, 59), (19, 58), (18, 58)."""
+    m = mapper(robot_radius_m=0.17)
+    m.update((5.95, 1.95), [-100.0])
+    marked = {tuple(c) for c in np.argwhere(m.log_odds != 0).tolist()}
+    assert marked == {(19, 59), (18, 59), (19, 58), (18, 58)}
+    assert m.log_odds[19, 59] == pytest.approx(-1.0)
+
+
+def test_small_sum_is_numpy_s_sum_to_the_bit():
+    """kmeans1d's compiled sums equal numpy's pairwise summation bit for bit (numpy is the
+    reference, not the code under test), for every length that takes another path."""
+    from sfw_gym.mapping.kmeans1d import _pairwise_sum, _small_sum
+
+    rng = np.random.default_rng(5)
+    for n in [*range(1, 40), 64, 127, 128, 129, 300, 1031]:
+        a = rng.normal(0.0, 1e3, n) * 10.0 ** rng.integers(-8, 8, n)
+        if n <= 128:
+            assert _small_sum(a) == a.sum(), n
+        assert _pairwise_sum(a) == a.sum(), n
+
+
+def test_dry_run_messages_name_the_method():
+    from sfw_gym.core.errors import ConfigError
+    from sfw_gym.mapping.dry_run import DryRun
+
+    dry = DryRun.of_mapper(mapper())
+    with pytest.raises(
+        ConfigError, match=r"^DryRun\.path_gains: every position must lie inside the grid$"
+    ):
+        dry.path_gains(np.array([(99.0, 1.0)]), [0], [0])
