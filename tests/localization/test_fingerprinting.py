@@ -64,6 +64,19 @@ def train() -> Fingerprints:
     return survey()
 
 
+# Fitting the gridmaps takes seconds: each survey's fit is made once per module (and worker) and
+# only read by the tests.
+@pytest.fixture(scope="module")
+def gridmaps(train: Fingerprints):
+    return make_localizer("gridmaps").fit(train)
+
+
+@pytest.fixture(scope="module")
+def noisy_gridmaps():
+    """The gridmaps of a survey with 6 dB of noise per reading, as noisy as :func:`noisy_walk`."""
+    return make_localizer("gridmaps").fit(survey(noise_db=6.0))
+
+
 def test_1nn_at_a_training_place_answers_that_place(train: Fingerprints) -> None:
     rows = np.arange(0, len(train), 37)
     p = make_localizer("1nn").fit(train).predict(train.subset(rows))
@@ -74,7 +87,7 @@ def test_1nn_at_a_training_place_answers_that_place(train: Fingerprints) -> None
 
 @pytest.mark.parametrize("method", METHODS)
 def test_every_method_finds_building_floor_and_place_between_survey_points(
-    train: Fingerprints, method: str
+    train: Fingerprints, gridmaps, method: str
 ) -> None:
     rng = np.random.default_rng(3)
     xy = rng.uniform([2, 2], [18, 10], (40, 2))
@@ -82,7 +95,8 @@ def test_every_method_finds_building_floor_and_place_between_survey_points(
     xy = xy + 100 * building[:, None]
     rssi = np.concatenate([radio(xy[[i]], floor[i], building[i]) for i in range(40)])
     test = Fingerprints(xy, rssi, train.access_points, floor=floor, building=building)
-    p = make_localizer(method).fit(train).predict(test)
+    localizer = gridmaps if method == "gridmaps" else make_localizer(method).fit(train)
+    p = localizer.predict(test)
     np.testing.assert_array_equal(p.building, building)
     np.testing.assert_array_equal(p.floor, floor)
     # within the survey's 1 m spacing on average (1-NN: within half a diagonal of a point)
@@ -133,10 +147,10 @@ def noisy_walk(seed: int) -> tuple[Fingerprints, np.ndarray]:
 
 
 @pytest.mark.parametrize("method", ["sorensen", "gridmaps"])
-def test_tracking_a_noisy_walk_beats_locating_each_scan(method: str) -> None:
-    train = survey(noise_db=6.0)  # as noisy as the walk: the gridmaps learn one scan's scatter
-    localizer = make_localizer(method).fit(train)
-    maps = make_localizer("gridmaps").fit(train) if method != "gridmaps" else localizer
+def test_tracking_a_noisy_walk_beats_locating_each_scan(method: str, noisy_gridmaps) -> None:
+    # a survey as noisy as the walk: the gridmaps learn one scan's scatter
+    maps = noisy_gridmaps
+    localizer = maps if method == "gridmaps" else make_localizer(method).fit(survey(noise_db=6.0))
     per_scan, tracked = [], []
     for seed in range(3):
         walk, increments = noisy_walk(seed)
@@ -156,17 +170,17 @@ def test_tracking_a_noisy_walk_beats_locating_each_scan(method: str) -> None:
     assert np.mean(np.concatenate(tracked)) < 0.8 * np.mean(np.concatenate(per_scan))
 
 
-def test_odometry_must_match_the_walk(train: Fingerprints) -> None:
-    maps = make_localizer("gridmaps").fit(train).floors[0]
+def test_odometry_must_match_the_walk(train: Fingerprints, gridmaps) -> None:
+    maps = gridmaps.floors[0]
     with pytest.raises(ConfigError, match=r"a walk of 3 scans needs \(2, 3\) odometry"):
         track_walk(maps, train.rssi_dbm[:3], np.zeros((3, 3)))
 
 
-def test_particles_that_cross_a_wall_die_or_keep_the_stated_weight(train: Fingerprints) -> None:
+def test_particles_that_cross_a_wall_die_or_keep_the_stated_weight(gridmaps) -> None:
     # two rooms split by a wall at x = 5 with a doorway at y > 4: particles at y = 2 moving
     # 2 m in +x from x = 4 cross it, those at x = 1 do not
     plan = floorplan_from_polygon(two_rooms_polygon())
-    maps = make_localizer("gridmaps").fit(train).floors[0]
+    maps = gridmaps.floors[0]
     for wall_weight, expected in ((0.0, 0.0), (0.25, 0.25)):
         mcl = WifiMCL(maps.gridmaps, MclConfig(particles=2, translation_noise=0, rotation_noise=0))
         mcl.particles = np.array([[4.0, 2.0, 0.0], [1.0, 2.0, 0.0]])
@@ -198,20 +212,19 @@ def test_scan_likelihood_counts_each_heard_ap_once_with_the_scan_scatter() -> No
     np.testing.assert_allclose(log_l, [expected])
 
 
-def test_gridmaps_learn_one_scans_scatter_about_the_map() -> None:
+def test_gridmaps_learn_one_scans_scatter_about_the_map(gridmaps, noisy_gridmaps) -> None:
     """6 dB of noise per reading is (6 / 100)² = 0.0036 in normalised units; none: ~0."""
-    noisy = make_localizer("gridmaps").fit(survey(noise_db=6.0))
-    clean = make_localizer("gridmaps").fit(survey())
+    noisy, clean = noisy_gridmaps, gridmaps
     for floor in noisy.floors.values():
         assert floor.scan_variance == pytest.approx(0.0036, rel=0.15)
     for floor in clean.floors.values():
         assert floor.scan_variance < 0.0005
 
 
-def test_the_scan_sensor_model_weighs_the_particles(train: Fingerprints) -> None:
+def test_the_scan_sensor_model_weighs_the_particles(noisy_gridmaps) -> None:
     """MclConfig(sensor="scan") weighs by scan_log_likelihood; tracking's config inflates the
     floor's scan variance by SCAN_VARIANCE_INFLATION."""
-    floor = make_localizer("gridmaps").fit(survey(noise_db=6.0)).floors[0]
+    floor = noisy_gridmaps.floors[0]
     config = tracking_config(floor, particles=2)
     assert config.scan_variance == floor.scan_variance * SCAN_VARIANCE_INFLATION
     mcl = WifiMCL(floor.gridmaps, replace(config, resample_ess=1e-9, slow_rate=0, fast_rate=0))
