@@ -55,24 +55,30 @@ def test_evaluate_writes_metrics_and_predictions(files, capsys) -> None:
     assert "w3nn: 40 scans, mean error" in capsys.readouterr().out
 
 
+def _track(files, out: Path) -> pd.DataFrame:
+    argv = ["fingerprints", "evaluate", "--train", str(files["train"]), "--test"]
+    argv += [str(files["test"]), "--track", "--particles", "500", "--out", str(out)]
+    assert main(argv) == 0
+    return pd.read_csv(out / "predictions.csv")
+
+
 def test_track_orders_each_walk_by_time_and_reports_per_scan_beside(files) -> None:
     out = files["root"] / "tracked"
-    argv = ["fingerprints", "evaluate", "--train", str(files["train"]), "--test"]
-    argv += [str(files["test"]), "--track", "--particles", "500"]
-    assert main([*argv, "--out", str(out)]) == 0
+    rows = _track(files, out)
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["tracked_walks"] == 2 and metrics["sensor_model"] == "kernel"
     assert metrics["odometry"].startswith("synthetic")
     assert metrics["per_scan_mean_error_m"] > 0 and not metrics["with_floorplan"]
-    rows = pd.read_csv(out / "predictions.csv")
     assert {"per_scan_x", "per_scan_error_m"} <= set(rows)
     # the tracked walk is better than its scans alone once it has settled
     late = rows.groupby("trajectory").apply(lambda g: g.sort_values("t").iloc[5:])
     assert late["error_m"].mean() < late["per_scan_error_m"].mean()
-    again = files["root"] / "again"
-    assert main([*argv, "--out", str(again)]) == 0
-    same = pd.read_csv(again / "predictions.csv")
-    pd.testing.assert_frame_equal(rows, same)  # seeded: the same figures again
+
+
+@pytest.mark.slow
+def test_tracking_is_seeded_the_same_figures_again(files) -> None:
+    first, again = _track(files, files["root"] / "first"), _track(files, files["root"] / "again")
+    pd.testing.assert_frame_equal(first, again)
 
 
 def test_track_with_a_floorplan(files, tmp_path: Path) -> None:
