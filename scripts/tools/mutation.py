@@ -14,6 +14,13 @@ groups take ~0.1 s per mutant); ``--survivors`` after adding tests: under 1 min.
 and cli groups run integration tests (episodes, PPO, the CLI) per mutant: expect seconds per
 mutant, i.e. hours for a group; run one group at a time and use ``--survivors`` afterwards.
 Stats collection (one run of the groups' test files with mutmut's trampolines) comes first.
+Since the kernels are mutated (2026-11-29, JIT disabled: every test of these groups runs its
+kernels as Python), the kernel groups are far slower: mapper 4,010 mutants (about 0.1-0.5 per
+second; its stats collection alone about 8 min, the compiled-vs-Python k-means tests dominate),
+radio 1,318, navigation several thousand; hence ``--sample`` for them (mapper 30 per module:
+24 min wall, radio 20 per module: 3 min; raycast.py in full, 276 mutants: 9.7 min). A kernel
+mutant that loops forever is stopped after ``(estimate + timeout_constant) * 15`` s
+(``TIMEOUT_CONSTANT_S``).
 Issue 39 (2026-11-27, load 5-7 from other work): evaluation, 180 sampled mutants of its 9 slow
 modules, 26 min; navigation with the agents' unit tests, 10-35 mutants/min (a full run of the
 four issue-39 modules, 2,358 mutants, would have taken over an hour, hence ``--sample``).
@@ -242,13 +249,17 @@ def run_mutmut(
     names: list[str] | None = None,
     check: bool = True,
     timeout_constant: float | None = None,
+    fresh_stats: bool = True,
 ) -> float:
     """Run mutmut on ``files`` (every mutant, or only ``names``); return the wall time."""
     forget_unmutated_copies(files)
     # Fresh stats: mutmut reuses its stats file when the test selection is unchanged, and then
     # knows no tests for functions of a file that was not mutated when the stats were taken
-    # (every mutant of it would be "no tests"). Collecting them again costs one test run.
-    (ROOT / "mutants" / "mutmut-stats.json").unlink(missing_ok=True)
+    # (every mutant of it would be "no tests"). Collecting them again costs one test run
+    # (minutes for the kernel groups): not done right after ``sample_mutants`` generated the
+    # mutants, since that run collected them for the same files and tests.
+    if fresh_stats:
+        (ROOT / "mutants" / "mutmut-stats.json").unlink(missing_ok=True)
     globs = names if names else [module_name(f) + ".*" for f in files]
     args = ["--max-children", str(max_children), *globs]
     payload = json.dumps([files, tests, args, timeout_constant])
@@ -262,10 +273,15 @@ def run_mutmut(
     return wall
 
 
-def sample_mutants(files: list[str], n: int, tests: list[str], max_children: int) -> list[str]:
-    """``n`` mutant names per file, drawn with seed 0 (mutmut generates them first if needed)."""
-    if not all(statuses(f) for f in files):
-        # generate only: mutmut then stops, with an error, as no mutant has that name
+def sample_mutants(
+    files: list[str], n: int, tests: list[str], max_children: int
+) -> tuple[list[str], bool]:
+    """``n`` mutant names per file, drawn with seed 0 (mutmut generates them first if needed),
+    and whether mutmut ran to generate them (its stats are then current)."""
+    generated = not all(statuses(f) for f in files)
+    if generated:
+        # generate only: mutmut then stops, with an error, as no mutant has that name (after
+        # collecting its stats)
         run_mutmut(files, tests, max_children, names=["none.such.mutant"], check=False)
     rng = random.Random(0)
     names: list[str] = []
@@ -280,7 +296,7 @@ def sample_mutants(files: list[str], n: int, tests: list[str], max_children: int
             if name not in chosen:
                 data["exit_code_by_key"][name] = None
         meta.write_text(json.dumps(data))
-    return names
+    return names, generated
 
 
 def statuses(path: str) -> dict[str, str]:
@@ -481,7 +497,7 @@ def main(argv: list[str] | None = None) -> int:
         tests = [t for t in tests if not t.endswith(".py") or (ROOT / t).exists()]
         constants = [TIMEOUT_CONSTANT_S.get(g) for g in args.modules]
         timeout = None if None in constants else max(constants)
-        names = None
+        names, generated, t_sample = None, False, 0.0
         if args.survivors:
             names = [
                 name
@@ -491,10 +507,14 @@ def main(argv: list[str] | None = None) -> int:
             ]
             print(f"re-running {len(names)} mutants that were not killed")
         elif args.sample:
-            names = sample_mutants(files, args.sample, tests, args.max_children)
+            t_sample = time.perf_counter()  # generating the mutants is part of the run's time
+            names, generated = sample_mutants(files, args.sample, tests, args.max_children)
+            t_sample = time.perf_counter() - t_sample
             print(f"running a sample of {len(names)} mutants")
         if names is None or names:
-            wall = run_mutmut(files, tests, args.max_children, names, timeout_constant=timeout)
+            wall = t_sample + run_mutmut(
+                files, tests, args.max_children, names, timeout, fresh_stats=not generated
+            )
 
     modules = " ".join(args.modules)
     command = f"`nice -n 10 .venv/bin/python scripts/tools/mutation.py --modules {modules}"

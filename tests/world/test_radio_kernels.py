@@ -71,3 +71,18 @@ def test_the_parallel_kernel_equals_the_serial_one_over_several_chunks():
     # a face's loss, or 0 for a segment with both ends in the block (no face crossed)
     assert set(losses[through].tolist()) <= {0.0, 4.0, 5.0, 6.0, 7.0}
     assert (losses[~through] == 0.0).all()
+
+
+def test_an_edge_is_indexed_in_exactly_the_buckets_its_arc_meets():
+    """Seen from the origin, buckets are arcs of pi / 8 (0.393 rad): an edge spanning angles
+    0.01..0.02 rad lies in bucket 0 only; one spanning 0.35..0.45 rad in buckets 0 and 1."""
+    from sfw_gym.world.wall_index import _bucket_span
+
+    edges = np.array(
+        [
+            [10.0, 10.0 * np.tan(0.01), 10.0, 10.0 * np.tan(0.02)],
+            [10.0, 10.0 * np.tan(0.35), 10.0, 10.0 * np.tan(0.45)],
+        ]
+    )
+    assert _bucket_span(edges, 0, 0.0, 0.0, 8) == (0, 1)
+    assert _bucket_span(edges, 1, 0.0, 0.0, 8) == (0, 2)
