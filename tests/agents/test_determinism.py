@@ -58,11 +58,16 @@ def variants() -> list[tuple[str, dict[str, Any], str]]:
 
 
 VARIANTS = variants()
-#: The parametrisation: the quick loop keeps each agent's default on continuous actions.
-VARIANT_PARAMS = [
-    pytest.param(v, marks=() if not v[1] and v[2] == "continuous" else pytest.mark.episode)
-    for v in VARIANTS
-]
+
+
+def quick(variant: tuple[str, dict[str, Any], str]) -> bool:
+    """The quick loop keeps each robot agent's default on continuous actions; the privileged
+    oracles (study tools, several seconds an episode) run in the full suite only."""
+    name, params, action_type = variant
+    return not params and action_type == "continuous" and not agent_class(name).privileged
+
+
+VARIANT_PARAMS = [pytest.param(v, marks=() if quick(v) else pytest.mark.episode) for v in VARIANTS]
 
 
 def variant_id(variant: tuple[str, dict[str, Any], str]) -> str:
