@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import importlib.util
+import sys
 from pathlib import Path
+from types import ModuleType
 
 import pytest
 from shapely.geometry import Polygon
@@ -13,6 +16,18 @@ SHARED_DIR = Path(__file__).resolve().parents[1].parent / "shared"
 HOUSEEXPO_DIR = SHARED_DIR / "floorplans" / "houseexpo"
 #: The real WiFi datasets (../shared/datasets/README.md); tests that need them skip without them.
 DATASETS_DIR = SHARED_DIR / "datasets"
+SCRIPTS_DIR = Path(__file__).resolve().parents[1] / "scripts"
+
+
+def script_module(relative: str) -> ModuleType:
+    """The script ``scripts/<relative>`` imported as a module (registered in ``sys.modules``
+    under its stem, as dataclasses need)."""
+    path = SCRIPTS_DIR / relative
+    spec = importlib.util.spec_from_file_location(path.stem, path)
+    assert spec and spec.loader, path
+    module = sys.modules[path.stem] = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

@@ -4,7 +4,6 @@ covering a small plan within its budget."""
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 from types import ModuleType, SimpleNamespace
 
@@ -31,6 +30,7 @@ from sfw_gym.evaluation.report import PRIVILEGED_NOTE, results_markdown
 from sfw_gym.navigation.planning import cost_field, wall_distance_m
 from sfw_gym.world.floorplan import Floorplan
 from tests.agents.test_agents import _reachable
+from tests.conftest import script_module
 
 ROOT = Path(__file__).resolve().parents[2]
 ORACLES = sorted(n for n in AGENTS if agent_class(n).privileged)
@@ -81,11 +81,7 @@ def test_no_default_runs_an_oracle():
     assert not any(is_privileged(a) for a in DEMO_AGENTS)
     evaluate = build_parser().parse_args(["evaluate"])
     assert not any(is_privileged(a) for a in evaluate.agents.split(","))
-    script = ROOT / "scripts/benchmarks/benchmark_shipped.py"
-    spec = importlib.util.spec_from_file_location("shipped", script)
-    assert spec and spec.loader
-    shipped = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(shipped)
+    shipped = script_module("benchmarks/benchmark_shipped.py")
     assert set(shipped.shipped_agents()) == {n for n in AGENTS if n not in ORACLES}
 
 
@@ -140,11 +136,7 @@ def test_an_evaluation_and_a_benchmark_record_and_mark_an_oracle(tmp_path):
 
 
 def test_coverage_and_bits_per_metre_at_a_budget_read_the_last_sample_at_or_before_it():
-    script = ROOT / "scripts/studies/regions_study.py"
-    spec = importlib.util.spec_from_file_location("study", script)
-    assert spec and spec.loader
-    study = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(study)
+    study = script_module("studies/regions_study.py")
     curve = [
         [0, 0.0, 0.0, 0.0, 100.0],
         [10, 0.2, 0.0, 1.0, 90.0],
@@ -359,11 +351,7 @@ def test_belief_paths_go_round_a_wall_the_belief_holds():
 
 
 def test_the_study_labels_oracles_and_variants_by_their_settings():
-    script = ROOT / "scripts/studies/regions_study.py"
-    spec = importlib.util.spec_from_file_location("study", script)
-    assert spec and spec.loader
-    study = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(study)
+    study = script_module("studies/regions_study.py")
     entry = "sfw_gym.rl.predict_explore:RolloutExploreAgent"
     agents, params, label = study.resolve_agents(
         ["frontier", "oracle-rollout", entry], {entry: {"horizon_steps": 60, "menu": "x"}}

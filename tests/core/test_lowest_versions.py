@@ -3,16 +3,11 @@ floors written in pyproject.toml (extras followed through self-references, torch
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import pytest
 
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "tools" / "lowest_versions.py"
-spec = importlib.util.spec_from_file_location("lowest_versions", SCRIPT)
-assert spec and spec.loader
-lowest_versions = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(lowest_versions)
+from tests.conftest import script_module
+
+lowest_versions = script_module("tools/lowest_versions.py")
 
 PYPROJECT = """
 [project]

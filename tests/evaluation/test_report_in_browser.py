@@ -4,19 +4,14 @@ and the checker itself sees a broken page as broken. Skips, saying why, without 
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 from pathlib import Path
 
 import pytest
 
 from sfw_gym import evaluation as ev
+from tests.conftest import SCRIPTS_DIR, script_module
 
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "tools" / "check_report.py"
-spec = importlib.util.spec_from_file_location("check_report", SCRIPT)
-assert spec and spec.loader
-check_report = sys.modules["check_report"] = importlib.util.module_from_spec(spec)  # dataclasses
-spec.loader.exec_module(check_report)
+check_report = script_module("tools/check_report.py")
 
 CHROMIUM = check_report.find_chromium()
 pytestmark = [
@@ -61,7 +56,7 @@ def test_demo_report_loads_in_a_browser(tmp_path, monkeypatch):
 
 def test_the_checker_sees_a_missing_image_and_a_console_error(tmp_path):
     (tmp_path / "ok.png").write_bytes(
-        (SCRIPT.parents[2] / "docs/figures/lidar_maps.png").read_bytes()
+        (SCRIPTS_DIR.parent / "docs/figures/lidar_maps.png").read_bytes()
     )
     (tmp_path / "index.html").write_text(
         '<html><body><img src="ok.png"><img src="missing.png">'
