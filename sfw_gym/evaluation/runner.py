@@ -116,16 +116,16 @@ def plan_files(floorplans: str | Path | None, option: str = "--floorplans") -> l
 def episode_routers(
     routers: list[list[float]] | int | None, plans: Sequence[str | None]
 ) -> dict[str | None, list[list[float]] | int | None]:
-    """Each plan file's routers for its episodes (:func:`~sfw_gym.world.floorplan.
-    chosen_routers`: ``routers``, else the plan's own, else None, the env's k-means placement).
-    Loads each plan once, so a malformed one fails here."""
+    """Each plan file's ``routers`` reset option: ``routers`` for all (None: the env's choice,
+    a plan's own routers, else its k-means placement: :func:`~sfw_gym.envs.episode.
+    build_scene`). Loads each plan once, so a malformed one fails before any episode."""
     from sfw_gym.world import load_floorplan
-    from sfw_gym.world.floorplan import chosen_routers
 
-    return {
-        plan: chosen_routers(routers, load_floorplan(plan) if plan else None)
-        for plan in dict.fromkeys(plans)
-    }
+    files = list(dict.fromkeys(plans))
+    for plan in files:
+        if plan:
+            load_floorplan(plan)
+    return dict.fromkeys(files, routers)
 
 
 def routers_json(routers: Any) -> list[list[float]] | int | None:
