@@ -354,11 +354,16 @@ def _dijkstra_8(cost, r0, c0, cum, pred, limit, scale):  # pragma: no cover (com
 
 @njit(cache=True)
 def _trace_back(pred, goal):  # pragma: no cover (compiled)
+    """The cells from the search's start to ``goal`` along the predecessors ``pred`` (-1 at
+    the start); a chain longer than the grid (a cycle: a corrupted search) is an error, not a
+    hang."""
     n = 1
     i = goal
     while pred[i] >= 0:
         i = pred[i]
         n += 1
+        if n > len(pred):
+            raise ValueError("the path's predecessor chain has a cycle")
     out = np.empty(n, np.int64)
     i = goal
     for k in range(n - 1, -1, -1):

@@ -343,3 +343,45 @@ def test_a_cluster_whose_turn_carries_it_past_the_bound_is_not_exact():
     assert not proven_on_bounded_paths(menu, utility)
     feats[1, columns["heading_change_rad"]] = 0.0  # in front: its cost 0.9 is exact, and worse
     assert proven_on_bounded_paths(menu, explore_lite_utilities(menu))
+
+
+def test_the_approach_at_some_targets_is_the_whole_map_approach_there():
+    view = view_of(corridor(), xy=(0.25, 0.65))
+    finder = GoalFinder()
+    finder.reset(view)
+    paths = cost_field(finder.costs(view), view.cell, RES)
+    cells = np.array([[6, 33], [1, 40], [12, 20], [0, 0], [13, 59]])
+    whole = finder.approach(paths)
+    np.testing.assert_array_equal(finder.approach_at(paths, cells), whole[cells[:, 0], cells[:, 1]])
+
+
+@pytest.mark.parametrize(
+    ("area_m2", "res"), [(0.5, 0.1), (0.35, 0.1), (1.0, 0.05), (0.3, 0.25), (10.0, 2.0)]
+)
+def test_a_pocket_is_an_unknown_region_of_fewer_cells_than_the_minimum_area_takes(area_m2, res):
+    """The fewest cells n whose area n·res² reaches ``min_unknown_region_m2`` (coarse cells of
+    more than 1 m² included); 0, no pockets, when the setting is 0."""
+    n = GoalFinder(CandidateSettings(min_unknown_region_m2=area_m2))._pocket_cells(res)
+    assert n * res * res >= area_m2 > (n - 1) * res * res
+    assert GoalFinder(CandidateSettings(min_unknown_region_m2=0.0))._pocket_cells(res) == 0
+
+
+def test_a_limited_menu_keeps_the_information_gain_points_with_the_most_bits_per_metre():
+    """With ``max_candidates``, the information-gain points are ranked by their expected bits
+    ÷ (path + 1 m) even when the menu is not asked for the bits as a feature."""
+    view = view_of(corridor(), xy=(0.25, 0.65))
+    finder = GoalFinder()
+    finder.reset(view)
+    paths = cost_field(finder.costs(view), view.cell, RES)
+    every = finder.find(
+        view, paths, sources=("info_gain",), features=("expected_gain_bits", "path_cost_m")
+    )
+    assert len(every) > 3
+    rate = every.feature("expected_gain_bits") / (every.feature("path_cost_m") + 1.0)
+    best = np.lexsort((np.arange(len(every)), -rate, ~every.valid))[:3]
+    limited = finder.find(
+        view, paths, max_candidates=3, sources=("info_gain",), features=("path_cost_m",)
+    )
+    assert sorted(map(tuple, limited.target_rc.tolist())) == sorted(
+        map(tuple, every.target_rc[best].tolist())
+    )

@@ -60,6 +60,9 @@ def test_best_prefix_rate_by_hand():
     assert best_prefix_rate(gains, np.array([0, 6]), min_steps=3)[1] == pytest.approx(2 / 3)
     assert best_prefix_rate(gains, np.array([0, 6]), min_steps=4)[0] == pytest.approx(1.5)
     np.testing.assert_allclose(path_totals(gains, np.array([0, 6, 8])), [6.0, 2.0, 0.0])
+    # an empty path between two others rates 0, and the paths after it are still rated
+    rate = best_prefix_rate(gains, np.array([0, 6, 6]), min_steps=1)
+    assert rate.tolist() == pytest.approx([2.0, 0.0, 1.0])
 
 
 def test_best_prefix_rate_does_not_favour_long_paths():

@@ -479,3 +479,14 @@ def test_a_bounded_search_sees_expensive_cells_at_its_edge():
     part = cost_field(cost, (30, 30), 0.1, max_cost_m=1.0)
     known = np.isfinite(part.cumulative)
     assert np.array_equal(part.cumulative[known], full.cumulative[known])
+
+
+def test_a_path_is_traced_back_along_the_predecessors_and_a_cycle_is_an_error():
+    from sfw_gym.navigation.planning import _trace_back
+
+    pred = np.array([-1, 0, 1, 2, 1], np.int64)  # 0 is the start; 4 branches off 1
+    assert _trace_back(pred, 3).tolist() == [0, 1, 2, 3]
+    assert _trace_back(pred, 4).tolist() == [0, 1, 4]
+    assert _trace_back(pred, 0).tolist() == [0]
+    with pytest.raises(ValueError, match="cycle"):
+        _trace_back(np.array([1, 0], np.int64), 0)  # a corrupted search: 0 -> 1 -> 0 -> ...

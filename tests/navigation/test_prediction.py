@@ -137,3 +137,11 @@ def test_a_ray_stops_at_the_grid_s_edge_and_says_whether_it_reached_its_target()
     wall[0, 3] = True
     cells, reached = ray_cells(0, 0, np.array([4.5, 0.5]), 0.4, origin, 1.0, wall, buf)
     assert not reached and cells[:, 1].tolist() == [1, 1, 2, 2]  # stops before the wall
+    assert cells.shape == (4, 2)  # (row, col) pairs, from the buffer as from a fresh array
+    # the buffer holds the longest ray of its grid: corner to corner, sampled every half cell
+    shape = (7, 12)
+    corner = np.array([shape[1] - 0.5, shape[0] - 0.5])
+    longest, _ = ray_cells(
+        0, 0, corner, 0.0, origin, 1.0, np.zeros(shape, bool), np.empty((0, 2), np.int64)
+    )
+    assert ray_buffer(shape).shape[1] == 2 and len(ray_buffer(shape)) >= len(longest)
