@@ -1,11 +1,11 @@
 """Every agent name a page hands a command is one the package registers today.
 
 The pages' commands (code blocks and inline code) name agents with ``--agents a,b,c``,
-``--agent x``, ``evaluate --agent-params '{"x": ...}'`` and ``make_agent("x")``; each name must be in
-:data:`sfw_gym.agents.AGENTS`, a ``module:Class`` entry point, a name the same page declares as an
-entry point of the ``sfw_gym.agents`` group (the own-agent example), or a tuned entry of the
-study script the command runs. A deprecated name (``ppo``) fails: pages speak of today's names.
-The lab notebook (``docs/results/history.md``) keeps the names each section was recorded with.
+``--agent x``, ``evaluate --agent-params '{"x": ...}'`` and ``make_agent("x")``; each name
+must be in :data:`sfw_gym.agents.AGENTS`, a ``module:Class`` entry point, a name the same page
+declares as an entry point of the ``sfw_gym.agents`` group (the own-agent example), or a tuned
+entry of the study script the command runs. A deprecated name (``ppo``) fails: pages speak of
+today's names. The lab notebook (``docs/results/history.md``) keeps the names each section was recorded with.
 """
 
 from __future__ import annotations
@@ -51,7 +51,11 @@ def command_names(command: str, variables: dict[str, str]) -> list[tuple[str, se
         argv = shlex.split(command, comments=True)
     except ValueError:
         return []
-    argv = [re.sub(r"\$\{?(\w+)\}?", lambda m: variables.get(m.group(1), m.group(0)), a) for a in argv]
+
+    def expand(m: re.Match[str]) -> str:
+        return variables.get(m.group(1), m.group(0))
+
+    argv = [re.sub(r"\$\{?(\w+)\}?", expand, a) for a in argv]
     if not argv:
         return []
     extra = set().union(*(study_names(a) for a in argv if a.endswith(".py")))
@@ -117,7 +121,8 @@ def test_the_scan_finds_names_and_catches_a_stale_one(tmp_path: Path) -> None:
         "Run `sfw-gym evaluate --agents frontier,ppo`.\n\n"
         "```bash\nA=frontier,nonesuch\n"
         "sfw-gym evaluate --agents $A --agent-params '{\"greedy\": {}}'\n"
-        "sfw-gym benchmark run --agent pkg.mod:Cls --agent-params '{\"turn_steps\": 1}'\nsfw-gym benchmark run --agent mine\n```\n\n"
+        "sfw-gym benchmark run --agent pkg.mod:Cls --agent-params '{\"turn_steps\": 1}'\n"
+        "sfw-gym benchmark run --agent mine\n```\n\n"
         '```toml\n[project.entry-points."sfw_gym.agents"]\nmine = "my_agent:MyAgent"\n```\n',
         encoding="utf-8",
     )
