@@ -5,7 +5,8 @@ The pages' commands (code blocks and inline code) name agents with ``--agents a,
 must be in :data:`sfw_gym.agents.AGENTS`, a ``module:Class`` entry point, a name the same page
 declares as an entry point of the ``sfw_gym.agents`` group (the own-agent example), or a tuned
 entry of the study script the command runs. A deprecated name (``ppo``) fails: pages speak of
-today's names. The lab notebook (``docs/results/history.md``) keeps the names each section was recorded with.
+today's names. The lab notebook (``docs/results/history.md``) keeps the names each section was
+recorded with.
 """
 
 from __future__ import annotations
