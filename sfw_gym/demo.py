@@ -15,9 +15,6 @@ from pathlib import Path
 from typing import Any
 
 from sfw_gym.core.data import scenario
-from sfw_gym.evaluation import evaluate
-from sfw_gym.evaluation.metric_table import METRICS
-from sfw_gym.evaluation.report import report_markdown, write_report
 
 DEMO_AGENTS = ("frontier", "cross-pass", "regions-ppo")
 DEMO_ENV = "SfW-Explore-v0"  # the shipped policy's env
@@ -42,6 +39,10 @@ def run_demo(
     ``model``: a ``sfw-gym train ppo_mask`` folder (or a ``.zip`` in it) instead of the shipped
     policy.
     """
+    # here, not at the top: the command line reads this module's defaults to build its parser
+    from sfw_gym.evaluation import evaluate
+    from sfw_gym.evaluation.report import write_report
+
     out = Path(out)
     start = time.perf_counter()
     result = evaluate(
@@ -65,6 +66,9 @@ def run_demo(
 def _index_markdown(
     out: Path, result: dict[str, Any], seed: int, wall_s: float, policy: str
 ) -> str:
+    from sfw_gym.evaluation.metric_table import METRICS
+    from sfw_gym.evaluation.report import report_markdown
+
     records = result["records"]
     episodes = sorted({r["episode"] for r in records})
     plans = {r["episode"]: (r["floorplan"], r["area_m2"]) for r in records}

@@ -74,6 +74,18 @@ def test_making_and_stepping_an_env_imports_no_torch():
     subprocess.run([sys.executable, "-c", code], check=True, cwd=REPO)
 
 
+def test_the_command_line_builds_its_parser_without_the_heavy_libraries():
+    """``sfw-gym --help`` and a usage error answer at once: building the parser imports
+    no scikit-learn, torch or evaluation stack (each subcommand imports what it runs)."""
+    code = (
+        "import sys; from sfw_gym.cli import build_parser; build_parser(); "
+        "print(sorted({'sklearn', 'torch', 'stable_baselines3', 'sfw_gym.evaluation'} "
+        "& set(sys.modules)))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], check=True, cwd=REPO, capture_output=True)
+    assert out.stdout.decode().strip() == "[]"
+
+
 def test_every_data_file_the_package_reads_is_in_the_wheel():
     patterns = tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["setuptools"][
         "package-data"

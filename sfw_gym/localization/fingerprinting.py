@@ -31,7 +31,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.spatial import cKDTree
-from sklearn.neighbors import NearestNeighbors
 
 from sfw_gym.core.errors import ConfigError
 from sfw_gym.datasets import Fingerprints
@@ -97,6 +96,8 @@ class KnnLocalizer:
         self.key = _labels(train)
         self.k_used = min(self.k, len(train))
         if self.metric == "euclidean":
+            from sklearn.neighbors import NearestNeighbors  # importing scikit-learn takes a second
+
             self.index = NearestNeighbors(n_neighbors=self.k_used, algorithm="brute").fit(self.x)
         else:  # Bray–Curtis through what the scan heard (see _sorensen_neighbours)
             self.sums = self.x.sum(1)

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 import shapely
-from sklearn.cluster import KMeans
 
 from sfw_gym.core.constants import BULK_VERTICES
 from sfw_gym.core.errors import ConfigError
@@ -50,6 +49,8 @@ def place_routers(floorplan: Floorplan, n: int, rng: np.random.Generator) -> np.
             break
     if len(candidates) < n:
         raise ConfigError(f"floorplan {floorplan.name!r} has no open spot for a router")
+    from sklearn.cluster import KMeans  # here: importing scikit-learn takes a second
+
     seed = int(rng.integers(2**31))
     with single_threaded_openmp():
         centres = KMeans(n_clusters=n, n_init=1, random_state=seed).fit(candidates).cluster_centers_
