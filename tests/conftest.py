@@ -3,9 +3,17 @@
 from __future__ import annotations
 
 import importlib.util
+import os
 import sys
 from pathlib import Path
 from types import ModuleType
+
+if "PYTEST_XDIST_WORKER" in os.environ:
+    # ``-n auto`` runs a worker per core: OpenMP and BLAS pools of a thread per core in every
+    # worker would oversubscribe the cores (torch's threads spin while they wait). Set before
+    # numpy and torch load; numba keeps its threads, so its parallel kernels still run threaded.
+    for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(_var, "1")
 
 import pytest
 from shapely.geometry import Polygon

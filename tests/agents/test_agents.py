@@ -5,6 +5,7 @@ from __future__ import annotations
 import gc
 import pickle
 import time
+from collections import deque
 from typing import Any
 
 import gymnasium as gym
@@ -242,11 +243,14 @@ class OnlyRobotView:
         raise AssertionError(f"agent reached env.{name}: only robot_view() is allowed")
 
 
-def _reachable(obj: Any, stop: tuple[type, ...]) -> list[Any]:
-    """Objects reachable from ``obj`` through attributes and containers (not through ``stop``)."""
-    seen, out, todo = set(), [], [obj]
-    while todo:
-        o = todo.pop()
+def _reachable(obj: Any, stop: tuple[type, ...], until: tuple[Any, ...] = ()) -> list[Any]:
+    """Objects reachable from ``obj`` through attributes and containers (not through ``stop``),
+    nearest first; with ``until``, the walk ends once it has reached all of those (a walk past
+    a function's globals would go on through every loaded module)."""
+    seen, out, todo = set(), [], deque([obj])
+    wanted = {id(o) for o in until}
+    while todo and not (wanted and wanted <= seen):
+        o = todo.popleft()
         if id(o) in seen or isinstance(o, type):
             continue
         seen.add(id(o))

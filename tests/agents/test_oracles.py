@@ -72,7 +72,8 @@ def test_an_oracle_holds_the_ground_truth_that_robot_agents_may_not(name):
     agent.reset(env, seed=3)
     for _ in range(3):
         obs, *_ = env.step(agent.act(obs))
-    held = {id(o) for o in _reachable(agent, stop=(ModuleType,))}
+    truth = (env.unwrapped, env.unwrapped.scene.floorplan)
+    held = {id(o) for o in _reachable(agent, stop=(ModuleType,), until=truth)}
     assert id(env.unwrapped) in held
     assert id(env.unwrapped.scene.floorplan) in held
 

@@ -3,9 +3,12 @@ test in the quick loop (``--strict-markers``)."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -24,3 +27,11 @@ def test_a_misspelt_marker_is_an_error_and_a_registered_one_is_not(tmp_path):
     assert "ERROR collecting test_misspelt.py" in out
     assert "'episdoe' not found in `markers`" in out
     assert "1 passed, 1 error" in out  # the registered marker's test ran and passed
+
+
+def test_an_xdist_worker_runs_one_openmp_and_blas_thread():
+    """``-n auto`` fills the cores with workers: each worker's OpenMP and BLAS pools are one
+    thread unless the caller set otherwise (tests/conftest.py)."""
+    if "PYTEST_XDIST_WORKER" not in os.environ:
+        pytest.skip("not in an xdist worker")
+    assert all(os.environ.get(v) for v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS"))

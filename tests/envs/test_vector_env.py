@@ -112,8 +112,11 @@ def _same(a, b) -> None:
             _same(a[key], b[key])
         else:
             assert a[key].dtype == b[key].dtype and a[key].shape == b[key].shape, key
-            for x, y in zip(a[key], b[key], strict=True):
-                np.testing.assert_array_equal(x, y)
+            if a[key].dtype != object:
+                np.testing.assert_array_equal(a[key], b[key], err_msg=key)
+                continue
+            for x, y in zip(a[key], b[key], strict=True):  # arrays of arrays, one by one
+                np.testing.assert_array_equal(x, y, err_msg=key)
 
 
 def test_infos_are_batched_as_gymnasiums_vector_envs_batch_them():
