@@ -122,6 +122,17 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
             "tests/world/test_radio_kernels.py",
         ],
     ),
+    # the robot's motion (its compiled free-space substeps) and the LiDAR's beams
+    "world": (
+        ["sfw_gym/world/robot.py", "sfw_gym/world/lidar.py"],
+        [
+            "-m",
+            "not slow",
+            "tests/world/test_robot.py",
+            "tests/world/test_lidar.py",
+            "tests/world/test_plan_limits.py",
+        ],
+    ),
     # the navigation unit tests, the region env's (the one user of regions.py) and the agents'
     # unit tests (frontier's approach cells, greedy's choice, cross-pass's dominance bands)
     "navigation": (
@@ -183,7 +194,7 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
 #: is for the agents' whole-episode module fixtures). A mutant's wall limit is
 #: ``(estimated test time + constant) * 15``: with 30 s, every kernel mutant that loops forever
 #: (e.g. an index step mutated to 0) held a worker for 7.5 min or more.
-TIMEOUT_CONSTANT_S = {"mapper": 5.0, "radio": 5.0, "navigation": 5.0}
+TIMEOUT_CONSTANT_S = {"mapper": 5.0, "radio": 5.0, "world": 5.0, "navigation": 5.0}
 
 COLUMNS = ["mutants", "killed", "survived", "timeout", "no tests", "other", "equivalent"]
 

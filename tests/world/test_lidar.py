@@ -221,3 +221,33 @@ def test_bad_poses_and_ranges_are_named():
         sensor.scan((math.nan, 0.0, 0.0), rng)
     with pytest.raises(ConfigError, match=r"ranges must have shape \(4,\), got \(3,\)"):
         sensor.points((0, 0, 0), np.ones(3))
+
+
+def test_a_scan_draws_from_the_generator_only_what_its_noise_and_dropout_need():
+    """No noise and no dropout: the generator is left as it was (the env's other draws keep
+    their stream); noise only: exactly one normal per beam."""
+    rng = np.random.default_rng(5)
+    before = rng.bit_generator.state
+    lidar(dropout=0.0).scan((0.0, 0.0, 0.0), rng)
+    assert rng.bit_generator.state == before
+    noisy, reference = np.random.default_rng(5), np.random.default_rng(5)
+    lidar(range_noise_std_m=0.01, dropout=0.0, beams=16).scan((0.0, 0.0, 0.0), noisy)
+    reference.normal(0.0, 0.01, 16)
+    assert noisy.bit_generator.state == reference.bit_generator.state
+
+
+def test_a_zero_length_face_is_skipped_and_the_faces_after_it_still_count():
+    from sfw_gym.world.lidar import _cast
+
+    edges = np.array([[1.0, 1.0, 1.0, 1.0], [2.0, -1.0, 2.0, 1.0]])  # a point, then a wall
+    angles = np.array([0.0])
+    out = np.empty(1)
+    _cast(edges, 0.0, 0.0, 0.0, np.cos(angles), np.sin(angles), 0.0, 2 * math.pi, 8.0, out)
+    assert out.tolist() == [2.0]
+
+
+def test_a_beam_grazing_a_corner_hits_the_face_just_past_its_start():
+    """2 nm above the floor's face, a beam along it meets the far wall 5e-10 of its length
+    from the corner: a hit inside the face, not round-off."""
+    r = scan(lidar(beams=4), (0.0, -2.0 + 2e-9, 0.0))  # beam 2 points along +x
+    assert r[2] == pytest.approx(2.0, abs=1e-12)

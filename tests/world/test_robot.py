@@ -245,6 +245,15 @@ def test_thin_wall_is_never_crossed(thickness, headings):
         assert bumps > 900
 
 
+def test_a_reset_clears_the_bump_flag_to_false():
+    robot = make(BOX, pose=(3.5, 2.0, 0.0))
+    for _ in range(10):
+        robot.step(V_MAX, 0.0)
+    assert robot.bumped is True
+    robot.reset((2.0, 2.0, 0.0))
+    assert robot.bumped is False  # a bool, as step results carry it
+
+
 def test_bump_flag_clears_after_leaving_the_wall():
     robot = make(BOX, pose=(3.5, 2.0, 0.0))
     for _ in range(10):
@@ -473,3 +482,17 @@ def test_bad_rng_and_config_raise():
     with pytest.raises(ConfigError, match="config"):
         Robot(BOX, {"radius_m": 0.2}, (2, 2, 0), None)  # type: ignore[arg-type]
     assert Robot(BOX, None, (2, 2, 0), None).config == RobotConfig()  # noise-free: rng optional
+
+
+@pytest.mark.parametrize(("n_walls", "bulk"), [(2048, False), (2049, True)])
+def test_only_a_plan_of_more_than_bulk_vertices_walls_keeps_just_the_near_walls(n_walls, bulk):
+    """``BULK_VERTICES`` walls (2,048) still go into pymunk all at once; one more and pymunk
+    holds only the walls near the robot."""
+    from sfw_gym.core.constants import BULK_VERTICES
+
+    assert n_walls - BULK_VERTICES in (0, 1)
+    x = np.linspace(-20.0, 20.0, n_walls + 1)
+    walls = np.column_stack([x[:-1], np.full(n_walls, 3.0), x[1:], np.full(n_walls, 3.0)])
+    robot = Robot(walls, RobotConfig(), (0.0, 0.0, 0.0))
+    assert (robot._active_walls is not None) == bulk
+    assert robot.step(V_MAX, 0.0).pose[0] > 0.0  # it drives either way
