@@ -99,6 +99,9 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
             "sfw_gym/mapping/grid.py",
             "sfw_gym/mapping/raycast.py",
             "sfw_gym/mapping/dry_run.py",
+            "sfw_gym/mapping/dense.py",
+            "sfw_gym/mapping/reference.py",
+            "sfw_gym/mapping/lidar_map.py",
         ],
         [
             "tests/mapping/test_sparse_mapper.py",
@@ -107,6 +110,8 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
             "tests/mapping/test_grid.py",
             "tests/mapping/test_dense_mapper.py",
             "tests/mapping/test_dry_run.py",
+            "tests/mapping/test_reference.py",
+            "tests/mapping/test_lidar_map.py",
         ],
     ),
     # the radio model and the wall geometry its attenuation counts walls with

@@ -44,11 +44,9 @@ def _add_line(img, r0, c0, r1, c1, delta):
     sc = 1 if c1 > c0 else -1
     err = dc - dr
     r, c = r0, c0
-    while True:
+    for _ in range(max(dr, dc) + 1):  # the line's cells: one per step along its longer axis
         if 0 <= r < h and 0 <= c < w:
             img[r, c] = min(255, max(0, img[r, c] + delta))
-        if r == r1 and c == c1:
-            break
         e2 = 2 * err
         if e2 > -dr:
             err -= dr

@@ -69,7 +69,7 @@ def test_two_walls_and_two_routers():
 
 def test_bad_input():
     k = np.zeros(GRID.shape, np.int64)
-    with pytest.raises(ConfigError, match="k_grid"):
+    with pytest.raises(ConfigError, match=rf"k_grid must .* got \({k.shape[0]}, 5\) for 1 router"):
         dense_inverse_k_visibility(GRID, ROUTER, k[:, :5])
     with pytest.raises(ConfigError, match="integer"):
         dense_inverse_k_visibility(GRID, ROUTER, k.astype(float))

@@ -49,6 +49,11 @@ def test_a_beam_leaving_the_grid_frees_what_lies_inside():
     assert lo[1].tolist() == [F] * 6 and not lo[[0, 2]].any()
 
 
+def test_a_hit_just_past_the_grid_s_far_edge_marks_nothing():
+    lo = one_scan([0.0], [5.6]).log_odds  # ends at x = 6.1, in the column after the last
+    assert lo[1].tolist() == [F] * 6 and not lo[[0, 2]].any()
+
+
 def test_a_diagonal_beam_through_cell_corners():
     lo = one_scan([math.pi / 4], [2 * math.sqrt(2)], pose=(0.5, 0.5, 0.0)).log_odds
     assert np.argwhere(lo == F).tolist() == [[0, 0], [1, 1]]
@@ -155,4 +160,6 @@ def test_bad_input_is_named():
         m.integrate((0.5, 1.5, 0.0), np.zeros(1), np.ones(1), math.inf)
     with pytest.raises(ConfigError, match="thresholds need"):
         m.occupancy_u8(threshold_free=0.6)
+    with pytest.raises(ConfigError, match=r"thresholds need 0 < threshold_free"):
+        m.occupancy_u8(threshold_free=0.0)
     assert not m.log_odds.any()  # nothing half-applied
