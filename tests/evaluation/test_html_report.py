@@ -114,10 +114,12 @@ def test_evaluate_writes_an_html_report_beside_the_markdown(tmp_path):
 def test_the_demo_writes_an_html_report(tmp_path, monkeypatch):
     from sfw_gym import demo
 
-    def short(*args, **kwargs):  # the demo's own flow, on 40-step episodes
-        return ev.evaluate(*args, **kwargs, env_kwargs={"max_steps": 40})
+    evaluate = ev.evaluate
 
-    monkeypatch.setattr(demo, "evaluate", short)
+    def short(*args, **kwargs):  # the demo's own flow, on 40-step episodes
+        return evaluate(*args, **kwargs, env_kwargs={"max_steps": 40})
+
+    monkeypatch.setattr(ev, "evaluate", short)  # run_demo imports it when it runs
     out = tmp_path / "report"
     assert demo.run_demo(out, 1, workers=1, progress=False) == out / "index.md"
     page = _page(out / "index.html")

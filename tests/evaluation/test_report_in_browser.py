@@ -44,10 +44,12 @@ def test_evaluate_report_loads_in_a_browser(tmp_path):
 def test_demo_report_loads_in_a_browser(tmp_path, monkeypatch):
     from sfw_gym import demo
 
-    def short(*args, **kwargs):  # the demo's own flow, on 40-step episodes
-        return ev.evaluate(*args, **kwargs, env_kwargs={"max_steps": 40})
+    evaluate = ev.evaluate
 
-    monkeypatch.setattr(demo, "evaluate", short)
+    def short(*args, **kwargs):  # the demo's own flow, on 40-step episodes
+        return evaluate(*args, **kwargs, env_kwargs={"max_steps": 40})
+
+    monkeypatch.setattr(ev, "evaluate", short)  # run_demo imports it when it runs
     demo.run_demo(tmp_path, 1, workers=1, progress=False)
     images = _loads_cleanly(tmp_path / "index.html")
     assert {f"gifs/{a}_0000.gif" for a in demo.DEMO_AGENTS} <= set(images)
