@@ -19,8 +19,10 @@ kernels as Python), the kernel groups are far slower: mapper 4,010 mutants (abou
 second; its stats collection alone about 8 min, the compiled-vs-Python k-means tests dominate),
 radio 1,318, navigation several thousand; hence ``--sample`` for them (mapper 30 per module:
 24 min wall, radio 20 per module: 3 min; raycast.py in full, 276 mutants: 9.7 min). A kernel
-mutant that loops forever is stopped after ``(estimate + timeout_constant) * 15`` s
-(``TIMEOUT_CONSTANT_S``).
+mutant that loops forever is stopped after ``(estimate + timeout_constant) * 30`` CPU seconds
+(``TIMEOUT_CONSTANT_S``), where the estimate is the time of the tests that call the function:
+for a kernel that most tests call (planning's Dijkstra) that can exceed an hour, so stop such a
+mutant by hand with ``kill -XCPU <pid>`` (mutmut records it as a timeout) and make the loop end.
 Issue 39 (2026-11-27, load 5-7 from other work): evaluation, 180 sampled mutants of its 9 slow
 modules, 26 min; navigation with the agents' unit tests, 10-35 mutants/min (a full run of the
 four issue-39 modules, 2,358 mutants, would have taken over an hour, hence ``--sample``).
@@ -196,9 +198,9 @@ GROUPS: dict[str, tuple[list[str], list[str]]] = {
 }
 
 #: mutmut's ``timeout_constant`` for groups whose tests have no slow fixtures (pyproject's 30 s
-#: is for the agents' whole-episode module fixtures). A mutant's wall limit is
-#: ``(estimated test time + constant) * 15``: with 30 s, every kernel mutant that loops forever
-#: (e.g. an index step mutated to 0) held a worker for 7.5 min or more.
+#: is for the agents' whole-episode module fixtures). A mutant's CPU limit is mutmut 3.8's
+#: ``(estimated test time + constant) * timeout_multiplier (15) * 2``: with 30 s, every kernel
+#: mutant that loops forever (e.g. an index step mutated to 0) held a worker 15 min or more.
 TIMEOUT_CONSTANT_S = {"mapper": 5.0, "radio": 5.0, "world": 5.0, "navigation": 5.0}
 
 COLUMNS = ["mutants", "killed", "survived", "timeout", "no tests", "other", "equivalent"]

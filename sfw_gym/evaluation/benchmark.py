@@ -120,21 +120,16 @@ def run_benchmark(
     tables for a browser) and returns the results.
     ``episodes`` caps the episodes per env (a quick look; recorded in the results);
     ``routers`` places every episode's routers (positions ``[[x, y], ...]`` or a count; None:
-    a plan's own, else the env's k-means placement: :func:`~sfw_gym.evaluation.runner.
-    episode_routers`);
+    a plan's own, else the env's k-means placement: :func:`~sfw_gym.envs.episode.build_scene`);
     ``workers``, ``backend`` and ``address`` as :func:`~sfw_gym.evaluation.evaluate`'s."""
     from sfw_gym import __version__
     from sfw_gym.agents import is_privileged
     from sfw_gym.evaluation.rollout import EpisodeSpec
-    from sfw_gym.evaluation.runner import (
-        check_routers,
-        episode_routers,
-        routers_json,
-        run_specs,
-    )
+    from sfw_gym.evaluation.runner import check_routers, load_plans, routers_json, run_specs
 
     proto = load_protocol(protocol)
     first, last = split_seeds(proto, split)
+    routers = routers_json(routers)
     out = Path(out)
     specs: list[EpisodeSpec] = []
     for env in proto["envs"]:
@@ -146,9 +141,9 @@ def run_benchmark(
             files += [str(p) for p in split_plan_files(proto, plans, split)]
         if len(files) > last - first + 1:
             raise ConfigError(f"protocol: {len(files)} episodes exceed the {split} split's seeds")
-        used = episode_routers(routers_json(routers), files)
+        distinct_plans = load_plans(files)
         if routers is not None:
-            check_routers(env["id"], env.get("kwargs"), used, first)
+            check_routers(env["id"], env.get("kwargs"), routers, distinct_plans, first)
         for i, plan in enumerate(files):
             specs.append(
                 EpisodeSpec(
@@ -158,7 +153,7 @@ def run_benchmark(
                     agent_seed=agent_seed_for(first + i, agent_seed),
                     env_id=env["id"],
                     floorplan=plan,
-                    routers=used[plan],
+                    routers=routers,
                     env_kwargs=dict(env.get("kwargs") or {}),
                     agent_params=dict(agent_params or {}),
                     npz_path=None,
@@ -171,7 +166,7 @@ def run_benchmark(
         "agent_params": json.loads(json.dumps(agent_params or {})),
         "split": split,
         "plans": None if plans is None else str(plans),
-    } | ({} if routers is None else {"routers": routers_json(routers)})
+    } | ({} if routers is None else {"routers": routers})
     require_same_run(out, run, "benchmark")
     start = time.perf_counter()
     records = run_specs(specs, out, executor)
@@ -189,7 +184,7 @@ def run_benchmark(
         "plans": None if plans is None else Path(plans).name,
         "episodes": [_episode_row(r, proto) for r in records],
         "timing": {"wall_s": time.perf_counter() - start, "workers": workers},
-    } | ({} if routers is None else {"routers": routers_json(routers)})
+    } | ({} if routers is None else {"routers": routers})
     results["summary"] = summarize_results(results, proto)
     write_text_atomic(out / "results.json", json.dumps(results, indent=1, sort_keys=True) + "\n")
     write_report(out / "results.md", results_markdown(results))  # and index.html

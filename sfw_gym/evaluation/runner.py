@@ -57,9 +57,9 @@ __all__ = [
     "CHECKPOINT",
     "EpisodeSpec",
     "check_routers",
-    "episode_routers",
     "evaluate",
     "load_checkpoint",
+    "load_plans",
     "plan_files",
     "routers_json",
     "run_episode",
@@ -113,19 +113,16 @@ def plan_files(floorplans: str | Path | None, option: str = "--floorplans") -> l
     return [str(p) for p in files]
 
 
-def episode_routers(
-    routers: list[list[float]] | int | None, plans: Sequence[str | None]
-) -> dict[str | None, list[list[float]] | int | None]:
-    """Each plan file's ``routers`` reset option: ``routers`` for all (None: the env's choice,
-    a plan's own routers, else its k-means placement: :func:`~sfw_gym.envs.episode.
-    build_scene`). Loads each plan once, so a malformed one fails before any episode."""
+def load_plans(plans: Sequence[str | None]) -> list[str | None]:
+    """The distinct plan files among ``plans`` (None: the env's procedural plans), each loaded
+    once so that a malformed one fails before any episode."""
     from sfw_gym.world import load_floorplan
 
     files = list(dict.fromkeys(plans))
     for plan in files:
         if plan:
             load_floorplan(plan)
-    return dict.fromkeys(files, routers)
+    return files
 
 
 def routers_json(routers: Any) -> list[list[float]] | int | None:
@@ -138,16 +135,17 @@ def routers_json(routers: Any) -> list[list[float]] | int | None:
 def check_routers(
     env_id: str,
     env_kwargs: dict[str, Any] | None,
-    used: dict[str | None, Any],
+    routers: list[list[float]] | int,
+    plans: Sequence[str | None],
     seed: int,
 ) -> None:
-    """Reset the env once on each plan with its routers: ``--routers``' one-line error (a
-    router in a plan's wall, more than the env's ``n_routers``) before any episode runs."""
+    """Reset the env once on each of ``plans`` with ``routers``: ``--routers``' one-line error
+    (a router in a plan's wall, more than the env's ``n_routers``) before any episode runs."""
     import gymnasium as gym
 
     env = gym.make(env_id, **(env_kwargs or {}))
     try:
-        for plan, routers in used.items():
+        for plan in plans:
             options = {"routers": routers} | ({"floorplan": plan} if plan else {})
             try:
                 env.reset(seed=seed, options=options)
@@ -191,7 +189,7 @@ def evaluate(
         agent_params: Per agent name, constructor parameters.
         routers: Every episode's routers, positions ``[[x, y], ...]`` (metres) or a count;
             None: each plan's own routers where it stores them, else the env's k-means
-            placement (:func:`episode_routers`).
+            placement (:func:`~sfw_gym.envs.episode.build_scene`).
         workers: Worker processes (1: run in this process).
         gif_episodes: Write GIFs of the first this many episodes of every agent.
         curve_every: Curve sampling interval, steps.
@@ -244,9 +242,10 @@ def evaluate(
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     plans = plan_files(floorplans)
-    used = episode_routers(routers_json(routers), plans[:episodes])
+    routers = routers_json(routers)
+    distinct_plans = load_plans(plans[:episodes])
     if routers is not None:  # fail early on routers the env refuses (in a wall, too many)
-        check_routers(env_id, env_kwargs, used, seed)
+        check_routers(env_id, env_kwargs, routers, distinct_plans, seed)
     specs = [  # episode-major: every agent's episode 0 first
         EpisodeSpec(
             agent=name,
@@ -254,7 +253,7 @@ def evaluate(
             seed=seed + i,
             env_id=env_id,
             floorplan=plans[i % len(plans)],
-            routers=used[plans[i % len(plans)]],
+            routers=routers,
             env_kwargs=dict(env_kwargs or {}),
             agent_params=dict((agent_params or {}).get(name, {})),
             curve_every=curve_every,
@@ -266,8 +265,7 @@ def evaluate(
     ]
     records = load_checkpoint(out / CHECKPOINT)
     manifest = evaluation_manifest(
-        out, records, agents, episodes, seed, env_id, floorplans, env_kwargs, agent_params,
-        routers_json(routers),
+        out, records, agents, episodes, seed, env_id, floorplans, env_kwargs, agent_params, routers,
     )  # fmt: skip
     write_text_atomic(out / "config.json", json.dumps(manifest, indent=2) + "\n")
     mine = run_specs(specs, out, executor, vector_envs)

@@ -111,15 +111,8 @@ def test_evaluate_writes_an_html_report_beside_the_markdown(tmp_path):
 
 
 @pytest.mark.slow
-def test_the_demo_writes_an_html_report(tmp_path, monkeypatch):
-    from sfw_gym import demo
-
-    evaluate = ev.evaluate
-
-    def short(*args, **kwargs):  # the demo's own flow, on 40-step episodes
-        return evaluate(*args, **kwargs, env_kwargs={"max_steps": 40})
-
-    monkeypatch.setattr(ev, "evaluate", short)  # run_demo imports it when it runs
+def test_the_demo_writes_an_html_report(tmp_path, short_demo):
+    demo = short_demo
     out = tmp_path / "report"
     assert demo.run_demo(out, 1, workers=1, progress=False) == out / "index.md"
     page = _page(out / "index.html")

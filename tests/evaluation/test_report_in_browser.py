@@ -41,15 +41,8 @@ def test_evaluate_report_loads_in_a_browser(tmp_path):
     assert shot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-def test_demo_report_loads_in_a_browser(tmp_path, monkeypatch):
-    from sfw_gym import demo
-
-    evaluate = ev.evaluate
-
-    def short(*args, **kwargs):  # the demo's own flow, on 40-step episodes
-        return evaluate(*args, **kwargs, env_kwargs={"max_steps": 40})
-
-    monkeypatch.setattr(ev, "evaluate", short)  # run_demo imports it when it runs
+def test_demo_report_loads_in_a_browser(tmp_path, short_demo):
+    demo = short_demo
     demo.run_demo(tmp_path, 1, workers=1, progress=False)
     images = _loads_cleanly(tmp_path / "index.html")
     assert {f"gifs/{a}_0000.gif" for a in demo.DEMO_AGENTS} <= set(images)
